@@ -1,0 +1,110 @@
+"""python -m training.prepare: paired BVH takes -> feature arrays for training (git-ignored).
+
+Writes OUT/{train,validation,test}.npz (both roles, all phase offsets, mirrored copies in train)
+and OUT/stats.npz (normalization), then prints frames per split and feature sizes.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+from tqdm import tqdm
+
+from . import features as F
+from .dataset import (DEFAULT_DATA, TEST_TAKES, VALIDATION_TAKES, DataError, discover_takes,
+                      load_pair, pair_tracks, phases, samples)
+
+DEFAULT_OUT = "runs/data"
+
+
+def split_of(take: str, validation: list[str], test: list[str]) -> str:
+    return "validation" if take in validation else "test" if take in test else "train"
+
+
+def prepare(data: str, out: str, validation: list[str], test: list[str], leader: str | None = None,
+            all_phases: bool = True, quiet: bool = False) -> dict:
+    takes = discover_takes(data, leader)
+    names = [t.name for t in takes]
+    for n in validation + test:
+        if n not in names:
+            raise DataError(f"split take {n} is not in {data} (have {', '.join(names)})")
+    parts: dict[str, list[dict]] = {"train": [], "validation": [], "test": []}
+    dancer_frames = {"train": 0, "validation": 0, "test": 0}
+    for take in tqdm(takes, desc="prepare", unit="take", disable=quiet):
+        lead, follow = load_pair(take)
+        split = split_of(take.name, validation, test)
+        dancer_frames[split] += len(range(0, lead.frames, phases(lead)))
+        # Extra samples from the 4 phase offsets of 120 fps and mirroring help training only;
+        # validation and test stay one clean pass so their numbers mean frames of real motion.
+        n_phase = phases(lead) if (all_phases and split == "train") else 1
+        mirrors = (False, True) if split == "train" else (False,)
+        for phase in range(n_phase):
+            for mirror in mirrors:
+                s = samples(*pair_tracks(lead, follow, phase, mirror))
+                n = len(s["frame"])
+                s["take"] = np.full(n, names.index(take.name), np.int16)
+                s["phase"] = np.full(n, phase, np.int8)
+                s["mirror"] = np.full(n, mirror, np.bool_)
+                parts[split].append(s)
+    outdir = Path(out)
+    outdir.mkdir(parents=True, exist_ok=True)
+    summary = {"takes": {k: sorted({names[p["take"][0]] for p in v}) for k, v in parts.items()},
+               "dancer_frames_30fps": dancer_frames, "samples": {}}
+    arrays = {}
+    for split, plist in parts.items():
+        if not plist:
+            raise DataError(f"split {split} is empty; choose other --validation/--test takes")
+        arrays[split] = {k: np.concatenate([p[k] for p in plist]) for k in plist[0]}
+        np.savez(outdir / f"{split}.npz", takes=np.array(names), **arrays[split])
+        summary["samples"][split] = len(arrays[split]["frame"])
+    stats = {}
+    for role in ("follower", "leader"):
+        for kind in ("input", "output", "intention"):
+            mean, std = F.normalization(arrays["train"][f"{role}_{kind}"])
+            stats[f"{role}_{kind}_mean"], stats[f"{role}_{kind}_std"] = mean, std
+    np.savez(outdir / "stats.npz", **stats)
+    summary["sizes"] = {"input": F.INPUT_SIZE, "output": F.OUTPUT_SIZE, "intention": F.INTENTION_SIZE}
+    return summary
+
+
+def print_summary(s: dict) -> None:
+    print("split        takes                     dancer frames @30fps   samples per role")
+    for split in ("train", "validation", "test"):
+        print(f"{split:<12} {','.join(s['takes'][split]):<25} {s['dancer_frames_30fps'][split]:>21} "
+              f"{s['samples'][split]:>18}")
+    total = sum(s["dancer_frames_30fps"].values())
+    print(f"total dancer frames at 30 fps (per dancer): {total}")
+    print("feature sizes:")
+    for title, layout in (("follower input I", F.FOLLOWER_INPUT_LAYOUT),
+                          ("leader input I", F.LEADER_INPUT_LAYOUT),
+                          ("output O", F.OUTPUT_LAYOUT), ("intention", F.INTENTION_LAYOUT)):
+        blocks = " | ".join(f"{n} {k}" for n, k in layout)
+        print(f"  {title} ({sum(k for _, k in layout)}): {blocks}")
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m training.prepare", description=__doc__)
+    ap.add_argument("--data", default=DEFAULT_DATA, help="folder of SUBJECT_TAKE.bvh pairs")
+    ap.add_argument("--out", default=DEFAULT_OUT, help="output folder (git-ignored)")
+    ap.add_argument("--validation", default=",".join(VALIDATION_TAKES), help="comma-separated takes")
+    ap.add_argument("--test", default=",".join(TEST_TAKES), help="comma-separated takes")
+    ap.add_argument("--leader", default=None, help="subject that leads (default: first by name)")
+    ap.add_argument("--one-phase", action="store_true", help="use only phase 0 of 120 fps takes")
+    args = ap.parse_args(argv)
+    t0 = time.time()
+    try:
+        s = prepare(args.data, args.out, [t for t in args.validation.split(",") if t],
+                    [t for t in args.test.split(",") if t], args.leader, not args.one_phase)
+    except DataError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+    print_summary(s)
+    print(f"wrote {args.out}/{{train,validation,test,stats}}.npz in {time.time() - t0:.1f} s")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,444 @@
+"""python -m training.train: intention predictor, then adversarial codebook matching.
+
+    python -m training.train --all              # every shipped model (follower, follower_ccm, leader)
+    python -m training.train --model follower   # one model (names in MODELS below)
+    python -m training.train --all --smoke      # tiny run for CI (< 2 min)
+    torchrun --nproc_per_node 2 -m training.train --model follower   # data parallel (DDP)
+
+Each model lives in runs/models/NAME/: checkpoint.pt (resume with --resume), losses.png,
+history.json. Bad input (no prepared data, feature sizes that do not match, a corrupt checkpoint)
+stops with a one-line error instead of quietly starting over.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import sys
+import time
+from dataclasses import asdict, dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+import torch
+import torch.distributed as dist
+import torch.nn.functional as F
+from tqdm import tqdm
+
+from . import features as feat
+from .models import CodebookMatching, Discriminator, IntentionPredictor, ModelConfig
+
+DEFAULT_DATA = "runs/data"
+DEFAULT_OUT = "runs/models"
+
+
+@dataclass
+class TrainConfig:
+    model: ModelConfig = field(default_factory=ModelConfig)
+    intention_epochs: int = 30
+    epochs: int = 40
+    batch_size: int = 256
+    lr: float = 1e-3
+    weight_decay: float = 1e-4
+    lambda_reconstruction: float = 1.0
+    lambda_codebook: float = 1.0
+    lambda_generator: float = 0.01        # 0 switches the adversarial term off ("w/o GAN")
+    end_to_end: bool = False              # train the intention predictor jointly ...
+    scheduled_sampling: bool = True       # ... feeding its prediction with probability epoch/E
+    control_noise: float = 0.05           # leader: metres of noise on the 1 s control key
+    control_rotation: float = 15.0        # leader: degrees of random turn of the control path
+    seed: int = 1
+
+
+# The models `--all` trains (shipped), and the ones evaluation adds (ablations, larger CCM).
+MODELS = {
+    "follower": TrainConfig(),
+    "follower_ccm": TrainConfig(model=ModelConfig(intention=False)),
+    "leader": TrainConfig(model=ModelConfig(role="leader")),
+    "follower_small": TrainConfig(model=ModelConfig(hidden=256, intention_hidden=128)),
+    "follower_ccm_large": TrainConfig(model=ModelConfig(intention=False, channels=24)),
+    "follower_no_gan": TrainConfig(lambda_generator=0.0),
+    "follower_end_to_end": TrainConfig(end_to_end=True),
+    "follower_end_to_end_no_ss": TrainConfig(end_to_end=True, scheduled_sampling=False),
+}
+SHIPPED = ["follower", "follower_ccm", "leader"]
+
+
+class TrainError(RuntimeError):
+    pass
+
+
+# ---------------------------------------------------------------- data
+
+def load_split(data: str, split: str, role: str) -> dict[str, np.ndarray]:
+    path = Path(data) / f"{split}.npz"
+    if not path.exists():
+        raise TrainError(f"{path} not found: run `python -m training.prepare --out {data}` first")
+    with np.load(path) as z:
+        arrays = {k: z[f"{role}_{k}"] for k in ("input", "output", "intention")}
+    sizes = {"input": feat.INPUT_SIZE, "output": feat.OUTPUT_SIZE, "intention": feat.INTENTION_SIZE}
+    for k, n in sizes.items():
+        if arrays[k].shape[1] != n:
+            raise TrainError(f"{path}: {role} {k} has {arrays[k].shape[1]} features, this code "
+                             f"expects {n}; re-run training.prepare")
+    return arrays
+
+
+def load_stats(data: str, role: str) -> dict[str, torch.Tensor]:
+    path = Path(data) / "stats.npz"
+    if not path.exists():
+        raise TrainError(f"{path} not found: run `python -m training.prepare --out {data}` first")
+    with np.load(path) as z:
+        return {f"{k}_{s}": torch.from_numpy(z[f"{role}_{k}_{s}"])
+                for k in ("input", "output", "intention") for s in ("mean", "std")}
+
+
+def augment_control(x: torch.Tensor, cfg: TrainConfig, gen: torch.Generator) -> torch.Tensor:
+    """Leader only: turn and jitter the control path (raw features) so that a steered path that
+    the recording never took still reads as a plausible intention."""
+    sl = feat.block_slices(feat.LEADER_INPUT_LAYOUT)["control"]
+    keys = x[:, sl].reshape(-1, feat.KEYS, 4).clone()
+    b = keys.shape[0]
+    a = (torch.rand(b, 1, generator=gen) * 2 - 1) * math.radians(cfg.control_rotation)
+    c, s = torch.cos(a), torch.sin(a)
+    for i in (0, 2):   # (x, z) position and (x, z) forward both turn about the root
+        px, pz = keys[..., i].clone(), keys[..., i + 1].clone()
+        keys[..., i], keys[..., i + 1] = c * px + s * pz, -s * px + c * pz
+    ramp = torch.arange(1, feat.KEYS + 1) / feat.KEYS
+    keys[..., :2] += torch.randn(b, feat.KEYS, 2, generator=gen) * cfg.control_noise * ramp[None, :, None]
+    x = x.clone()
+    x[:, sl] = keys.reshape(b, -1)
+    return x
+
+
+# ---------------------------------------------------------------- distributed
+
+def setup_distributed(device: str):
+    if "WORLD_SIZE" not in os.environ or int(os.environ["WORLD_SIZE"]) == 1:
+        return 0, 1
+    backend = "nccl" if device.startswith("cuda") else "gloo"
+    dist.init_process_group(backend)
+    return dist.get_rank(), dist.get_world_size()
+
+
+def pick_device(name: str) -> str:
+    if name == "auto":
+        if torch.cuda.is_available():
+            return f"cuda:{int(os.environ.get('LOCAL_RANK', 0))}"
+        return "cpu"
+    return name
+
+
+def average_gradients(modules, world: int):
+    """All-reduce gradients by hand: the GAN's alternating updates touch different modules per
+    step, which DistributedDataParallel's single-backward assumption does not fit."""
+    if world == 1:
+        return
+    for m in modules:
+        for p in m.parameters():
+            if p.grad is not None:
+                dist.all_reduce(p.grad)
+                p.grad /= world
+
+
+def broadcast_parameters(modules, world: int):
+    if world == 1:
+        return
+    for m in modules:
+        for p in m.state_dict().values():
+            dist.broadcast(p, 0)
+
+
+# ---------------------------------------------------------------- training
+
+def cosine(step: int, total: int, lr: float) -> float:
+    return lr * 0.5 * (1 + math.cos(math.pi * min(step, total) / max(total, 1)))
+
+
+def plot_history(history: dict, path: Path, title: str):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    keys = [k for k in history if history[k]]
+    fig, axes = plt.subplots(1, len(keys), figsize=(3.2 * len(keys), 2.8))
+    for ax, k in zip(np.atleast_1d(axes), keys):
+        ax.plot(np.arange(1, len(history[k]) + 1), history[k])
+        ax.set_title(k, fontsize=9)
+        ax.set_xlabel("epoch", fontsize=8)
+        ax.set_yscale("log" if min(history[k]) > 0 else "linear")
+    fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
+def save_checkpoint(path: Path, state: dict):
+    tmp = path.with_suffix(".tmp")
+    torch.save(state, tmp)
+    tmp.replace(path)   # a crash mid-write never leaves a half checkpoint behind
+
+
+def load_checkpoint(path: Path) -> dict:
+    try:
+        return torch.load(path, map_location="cpu", weights_only=False)
+    except Exception as e:  # torch raises many types for a damaged file
+        raise TrainError(f"{path}: checkpoint is unreadable ({e.__class__.__name__}); "
+                         f"delete it to train from scratch") from None
+
+
+def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = "cpu",
+                resume: bool = False, quiet: bool = False, rank: int = 0, world: int = 1) -> dict:
+    torch.manual_seed(cfg.seed)
+    np.random.seed(cfg.seed)
+    role = cfg.model.role
+    train = load_split(data, "train", role)
+    val = load_split(data, "validation", role)
+    stats = load_stats(data, role)
+    run = Path(out) / name
+    run.mkdir(parents=True, exist_ok=True)
+    ckpt_path = run / "checkpoint.pt"
+
+    def norm(a, k):
+        return ((torch.from_numpy(a) - stats[f"{k}_mean"]) / stats[f"{k}_std"]).float()
+
+    xr = torch.from_numpy(train["input"]).float()          # raw, for leader augmentation
+    y, j = norm(train["output"], "output"), norm(train["intention"], "intention")
+    xv, yv, jv = norm(val["input"], "input"), norm(val["output"], "output"), norm(val["intention"], "intention")
+    mcfg = cfg.model
+    predictor = IntentionPredictor(mcfg).to(device)
+    matching = CodebookMatching(mcfg).to(device)
+    disc = Discriminator(mcfg).to(device)
+    opt_p = torch.optim.AdamW(predictor.parameters(), lr=cfg.lr, weight_decay=cfg.weight_decay)
+    gen_params = list(matching.parameters()) + (list(predictor.parameters()) if cfg.end_to_end else [])
+    opt_g = torch.optim.AdamW(gen_params, lr=cfg.lr, weight_decay=cfg.weight_decay)
+    opt_d = torch.optim.AdamW(disc.parameters(), lr=cfg.lr, weight_decay=cfg.weight_decay)
+    history = {"intention_train": [], "intention_val": [], "reconstruction": [], "codebook": [],
+               "generator": [], "discriminator": [], "val_mse": [], "val_codebook": []}
+    stage, epoch, seconds = "intention", 0, 0.0
+    if resume and ckpt_path.exists():
+        ck = load_checkpoint(ckpt_path)
+        if ck.get("config") != asdict(cfg):
+            raise TrainError(f"{ckpt_path}: saved with another configuration; use a new --out or delete it")
+        predictor.load_state_dict(ck["predictor"]); matching.load_state_dict(ck["matching"])
+        disc.load_state_dict(ck["disc"]); opt_p.load_state_dict(ck["opt_p"])
+        opt_g.load_state_dict(ck["opt_g"]); opt_d.load_state_dict(ck["opt_d"])
+        history, stage, epoch, seconds = ck["history"], ck["stage"], ck["epoch"], ck["seconds"]
+        if rank == 0 and not quiet:
+            print(f"{name}: resumed at {stage} epoch {epoch}")
+    elif ckpt_path.exists() and not resume and rank == 0 and not quiet:
+        print(f"{name}: {ckpt_path} exists; training from scratch over it (use --resume to continue)")
+    broadcast_parameters([predictor, matching, disc], world)
+
+    gen = torch.Generator().manual_seed(cfg.seed + 1000 * rank)
+    n = len(xr)
+    steps_per_epoch = max(1, n // (cfg.batch_size * world))
+
+    def batches(epoch_seed):
+        perm = torch.randperm(n, generator=torch.Generator().manual_seed(cfg.seed * 7919 + epoch_seed))
+        perm = perm[rank::world]   # each process its own shard of one shared shuffle
+        for s in range(steps_per_epoch):
+            idx = perm[s * cfg.batch_size:(s + 1) * cfg.batch_size]
+            if len(idx):
+                yield idx
+
+    def inputs(idx):
+        x = xr[idx]
+        if role == "leader" and cfg.control_noise + cfg.control_rotation > 0:
+            x = augment_control(x, cfg, gen)
+        return ((x - stats["input_mean"]) / stats["input_std"]).to(device)
+
+    def save(stage_, epoch_):
+        if rank == 0:
+            save_checkpoint(ckpt_path, {
+                "config": asdict(cfg), "name": name, "stage": stage_, "epoch": epoch_,
+                "seconds": seconds, "history": history, "predictor": predictor.state_dict(),
+                "matching": matching.state_dict(), "disc": disc.state_dict(),
+                "opt_p": opt_p.state_dict(), "opt_g": opt_g.state_dict(), "opt_d": opt_d.state_dict()})
+
+    # Stage 1: the intention predictor alone (MSE), then frozen. End-to-end variants skip it.
+    if mcfg.intention and not cfg.end_to_end and stage == "intention":
+        total = cfg.intention_epochs * steps_per_epoch
+        while epoch < cfg.intention_epochs:
+            t0 = time.time()
+            predictor.train()
+            bar = tqdm(batches(epoch), total=steps_per_epoch, disable=quiet or rank > 0,
+                       desc=f"{name} intention {epoch + 1}/{cfg.intention_epochs}", leave=False)
+            losses = []
+            for i, idx in enumerate(bar):
+                for g in opt_p.param_groups:
+                    g["lr"] = cosine(epoch * steps_per_epoch + i, total, cfg.lr)
+                loss = F.mse_loss(predictor(inputs(idx)), j[idx].to(device))
+                opt_p.zero_grad(); loss.backward(); average_gradients([predictor], world); opt_p.step()
+                losses.append(loss.item())
+                bar.set_postfix(mse=f"{np.mean(losses[-50:]):.4f}")
+            predictor.eval()
+            with torch.no_grad():
+                v = F.mse_loss(predictor(xv.to(device)), jv.to(device)).item()
+            history["intention_train"].append(float(np.mean(losses)))
+            history["intention_val"].append(v)
+            epoch += 1
+            seconds += time.time() - t0
+            if rank == 0 and not quiet:
+                print(f"{name} intention {epoch}/{cfg.intention_epochs}  train {np.mean(losses):.4f}  val {v:.4f}")
+            save("intention", epoch)
+        stage, epoch = "matching", 0
+        save(stage, epoch)
+    elif stage == "intention":
+        stage, epoch = "matching", 0
+
+    # Stage 2: codebook matching (+ adversarial term), intention predictor frozen.
+    if mcfg.intention and not cfg.end_to_end:
+        predictor.eval()
+        for p in predictor.parameters():
+            p.requires_grad_(False)
+    total = cfg.epochs * steps_per_epoch
+    bce = F.binary_cross_entropy_with_logits
+    while epoch < cfg.epochs:
+        t0 = time.time()
+        matching.train(); disc.train()
+        if cfg.end_to_end:
+            predictor.train()
+        bar = tqdm(batches(10_000 + epoch), total=steps_per_epoch, disable=quiet or rank > 0,
+                   desc=f"{name} matching {epoch + 1}/{cfg.epochs}", leave=False)
+        sums = {"reconstruction": [], "codebook": [], "generator": [], "discriminator": []}
+        p_pred = epoch / cfg.epochs   # scheduled sampling: share of predicted intentions
+        for i, idx in enumerate(bar):
+            lr = cosine(epoch * steps_per_epoch + i, total, cfg.lr)
+            for o in (opt_g, opt_d):
+                for g in o.param_groups:
+                    g["lr"] = lr
+            x, yb = inputs(idx), y[idx].to(device)
+            intention, extra = None, 0.0
+            if mcfg.intention:
+                if cfg.end_to_end:
+                    pred = predictor(x)
+                    extra = F.mse_loss(pred, j[idx].to(device))
+                    if cfg.scheduled_sampling:
+                        use = (torch.rand(len(idx), 1, generator=gen) < p_pred).to(device)
+                        intention = torch.where(use, pred, j[idx].to(device))
+                    else:
+                        intention = pred
+                else:
+                    with torch.no_grad():
+                        intention = predictor(x)
+            recon, s, s_hat, code, code_hat = matching(x, yb, intention)
+            l_r = F.mse_loss(recon, yb)
+            l_c = F.mse_loss(code, code_hat)
+            loss = cfg.lambda_reconstruction * l_r + cfg.lambda_codebook * l_c + extra
+            l_g = torch.zeros(())
+            if cfg.lambda_generator > 0:
+                # Discriminator step on detached logits, then the generator term for the encoders.
+                d_real, d_fake = disc(s.detach()), disc(s_hat.detach())
+                l_d = bce(d_real, torch.ones_like(d_real)) + bce(d_fake, torch.zeros_like(d_fake))
+                opt_d.zero_grad(); l_d.backward(); average_gradients([disc], world); opt_d.step()
+                d_gen = disc(s_hat)
+                l_g = bce(d_gen, torch.ones_like(d_gen))
+                loss = loss + cfg.lambda_generator * l_g
+                sums["discriminator"].append(l_d.item())
+            opt_g.zero_grad(); loss.backward()
+            average_gradients([matching, predictor] if cfg.end_to_end else [matching], world)
+            opt_g.step()
+            sums["reconstruction"].append(l_r.item()); sums["codebook"].append(l_c.item())
+            sums["generator"].append(l_g.item())
+            bar.set_postfix(rec=f"{np.mean(sums['reconstruction'][-50:]):.4f}",
+                            cb=f"{np.mean(sums['codebook'][-50:]):.4f}")
+        val_mse, val_cb = validate(predictor, matching, mcfg, xv, yv, device)
+        for k, v in sums.items():
+            history[k].append(float(np.mean(v)) if v else 0.0)
+        history["val_mse"].append(val_mse)
+        history["val_codebook"].append(val_cb)
+        epoch += 1
+        seconds += time.time() - t0
+        if rank == 0 and not quiet:
+            print(f"{name} matching {epoch}/{cfg.epochs}  rec {history['reconstruction'][-1]:.4f}  "
+                  f"cb {history['codebook'][-1]:.4f}  G {history['generator'][-1]:.3f}  "
+                  f"val mse {val_mse:.4f}  val cb {val_cb:.4f}  ({time.time() - t0:.1f} s)")
+        save("matching", epoch)
+    stage = "done"
+    save(stage, epoch)
+    if rank == 0:
+        plot_history(history, run / "losses.png", name)
+        (run / "history.json").write_text(json.dumps({"seconds": seconds, **history}, indent=1))
+    return {"name": name, "seconds": seconds, "val_mse": history["val_mse"][-1] if history["val_mse"] else None}
+
+
+@torch.no_grad()
+def validate(predictor, matching, mcfg, xv, yv, device, batch=4096):
+    """Teacher-forced validation: argmax code from the input encoder, MSE on normalized output,
+    and the codebook matching error (MSE between target and estimated one-hot codes)."""
+    predictor.eval(); matching.eval()
+    se, cb, n = 0.0, 0.0, 0
+    for s in range(0, len(xv), batch):
+        x, yb = xv[s:s + batch].to(device), yv[s:s + batch].to(device)
+        intention = predictor(x) if mcfg.intention else None
+        y_hat, code_hat = matching.generate(x, intention, 0.0)
+        from .models import sample_codes
+        code = sample_codes(matching.target_logits(x, yb, intention), mcfg.channels, 0.0)
+        se += F.mse_loss(y_hat, yb, reduction="sum").item() / yb.shape[1]
+        cb += F.mse_loss(code, code_hat, reduction="sum").item() / code.shape[1]
+        n += len(x)
+    return se / n, cb / n
+
+
+def smoke(cfg: TrainConfig) -> TrainConfig:
+    """A configuration that exercises every code path in seconds (CI)."""
+    return replace(cfg, intention_epochs=1, epochs=2,
+                   model=replace(cfg.model, hidden=32, intention_hidden=32, channels=2, classes=4))
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m training.train", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--model", action="append", choices=sorted(MODELS), help="model(s) to train")
+    ap.add_argument("--all", action="store_true", help=f"train the shipped models: {', '.join(SHIPPED)}")
+    ap.add_argument("--ablations", action="store_true", help="train the evaluation-only models too")
+    ap.add_argument("--data", default=DEFAULT_DATA, help="prepared data (training.prepare --out)")
+    ap.add_argument("--out", default=DEFAULT_OUT)
+    ap.add_argument("--epochs", type=int, help="override matching epochs")
+    ap.add_argument("--intention-epochs", type=int)
+    ap.add_argument("--lambda-generator", type=float, help="override λG (λC is 1)")
+    ap.add_argument("--smoke", action="store_true", help="tiny sizes and 2 epochs (CI)")
+    ap.add_argument("--resume", action="store_true", help="continue from runs/models/NAME/checkpoint.pt")
+    ap.add_argument("--device", default="cpu", help="cpu, cuda, cuda:N or auto")
+    ap.add_argument("--threads", type=int, default=0, help="torch CPU threads (0 = torch default)")
+    args = ap.parse_args(argv)
+    names = list(args.model or [])
+    if args.all:
+        names += [n for n in SHIPPED if n not in names]
+    if args.ablations:
+        names += [n for n in MODELS if n not in names]
+    if not names:
+        ap.error("name a --model, or use --all")
+    if args.threads:
+        torch.set_num_threads(args.threads)
+    device = pick_device(args.device)
+    rank, world = setup_distributed(device)
+    t0 = time.time()
+    try:
+        for name in names:
+            cfg = MODELS[name]
+            if args.smoke:
+                cfg = smoke(cfg)
+            if args.epochs is not None:
+                cfg = replace(cfg, epochs=args.epochs)
+            if args.intention_epochs is not None:
+                cfg = replace(cfg, intention_epochs=args.intention_epochs)
+            if args.lambda_generator is not None:
+                cfg = replace(cfg, lambda_generator=args.lambda_generator)
+            r = train_model(name, cfg, args.data, args.out, device, args.resume, rank=rank, world=world)
+            if rank == 0:
+                print(f"{name}: done in {r['seconds']:.0f} s, val mse {r['val_mse']:.4f}")
+    except TrainError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+    finally:
+        if world > 1:
+            dist.destroy_process_group()
+    if rank == 0:
+        print(f"total wall time {time.time() - t0:.0f} s on {device} x{world}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
