@@ -1,0 +1,143 @@
+"""python -m training.export: trained checkpoints -> dynamic-int8 ONNX step models + manifest.
+
+One ONNX file per model holds the whole step (normalization, intention, input encoder, Gumbel-max
+sampling with temperature and noise as inputs, gather decoder, de-normalization), so the page
+only builds features and reads results. Dynamic int8 (per channel) because static QDQ int8 runs
+6-8x slower in the browser's WASM backend.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from . import features as feat
+from .dataset import DEFAULT_DATA, DataError, discover_takes, load_pair
+from .models import CodebookMatching, IntentionPredictor, ModelConfig, StepModel
+from .skeleton import FPS, JOINT_NAMES, KEY_JOINTS, PARENTS
+from .train import SHIPPED, TrainError, load_checkpoint, load_stats
+
+MANIFEST_VERSION = 1
+OPSET = 18
+DEFAULT_TEMPERATURE = 0.5
+CREDIT = ("The data used in this project was obtained from mocap.cs.cmu.edu. "
+          "The database was created with funding from NSF EIA-0196217.")
+
+
+def load_step_model(run: Path, data: str) -> StepModel:
+    ckpt = run / "checkpoint.pt"
+    if not ckpt.exists():
+        raise TrainError(f"{ckpt} not found: train it first (python -m training.train --model {run.name})")
+    ck = load_checkpoint(ckpt)
+    if ck.get("stage") != "done":
+        raise TrainError(f"{ckpt}: training did not finish (stage {ck.get('stage')}); "
+                         f"continue it with --resume")
+    cfg = ModelConfig(**ck["config"]["model"])
+    predictor = IntentionPredictor(cfg) if cfg.intention else None
+    if predictor is not None:
+        predictor.load_state_dict(ck["predictor"])
+    matching = CodebookMatching(cfg)
+    matching.load_state_dict(ck["matching"])
+    model = StepModel(cfg, predictor, matching, load_stats(data, cfg.role))
+    return model.eval()
+
+
+def export_onnx(model: StepModel, path: Path) -> None:
+    cfg = model.cfg
+    x = torch.zeros(2, cfg.input_size)
+    t = torch.ones(1)
+    u = torch.full((2, cfg.latent), 0.5)
+    names = ["output", "intention", "code"] if cfg.intention else ["output", "code"]
+    torch.onnx.export(model, (x, t, u), str(path), opset_version=OPSET, dynamo=False,
+                      input_names=["input", "temperature", "noise"], output_names=names,
+                      dynamic_axes={"input": {0: "batch"}, "noise": {0: "batch"},
+                                    **{n: {0: "batch"} for n in names}})
+
+
+def quantize(src: Path, dst: Path) -> None:
+    from onnxruntime.quantization import QuantType, quantize_dynamic
+    quantize_dynamic(str(src), str(dst), per_channel=True, weight_type=QuantType.QInt8)
+
+
+def skeleton_offsets(data: str) -> dict:
+    """Bone offsets (metres) of each role, from the first take: the page draws and exports BVH
+    with them. Offsets are constant per dancer, so this is not frame-by-frame data."""
+    take = discover_takes(data)[0]
+    lead, follow = load_pair(take)
+    return {"leader": np.round(lead.offsets, 5).tolist(), "follower": np.round(follow.offsets, 5).tolist()}
+
+
+def start_pose(stats_mean: np.ndarray) -> dict:
+    """A neutral standing pose per role from the mean output pose (an average over all frames):
+    the page starts both dancers from it."""
+    pose = stats_mean[feat.block_slices(feat.OUTPUT_LAYOUT)["pose"]].reshape(feat.N_JOINTS, 12)
+    return {"hip": np.round(pose[0, :3], 4).tolist(),
+            "forward": np.round(pose[:, 6:9], 4).tolist(), "up": np.round(pose[:, 9:12], 4).tolist()}
+
+
+def write_manifest(out: Path, models: dict[str, StepModel], data: str, prepared: str) -> dict:
+    stats = np.load(Path(prepared) / "stats.npz")
+    manifest = {
+        "version": MANIFEST_VERSION,
+        "fps": FPS,
+        "skeleton": {"names": JOINT_NAMES, "parents": PARENTS, "offsets": skeleton_offsets(data)},
+        "keyJoints": KEY_JOINTS,
+        "layout": {"input": feat.INPUT_SIZE, "output": feat.OUTPUT_SIZE, "intention": feat.INTENTION_SIZE,
+                   "followerInput": feat.FOLLOWER_INPUT_LAYOUT, "leaderInput": feat.LEADER_INPUT_LAYOUT,
+                   "outputBlocks": feat.OUTPUT_LAYOUT},
+        "startPose": {role: start_pose(stats[f"{role}_output_mean"]) for role in ("leader", "follower")},
+        "models": {},
+        "defaultTemperature": DEFAULT_TEMPERATURE,
+        "credit": CREDIT,
+    }
+    for name, m in models.items():
+        f = out / f"{name}.onnx"
+        manifest["models"][name] = {"file": f.name, "bytes": f.stat().st_size, "role": m.cfg.role,
+                                    "channels": m.cfg.channels, "classes": m.cfg.classes,
+                                    "intention": m.cfg.intention, "hidden": m.cfg.hidden}
+    (out / "manifest.json").write_text(json.dumps(manifest, indent=1))
+    return manifest
+
+
+def export_all(names: list[str], runs: str, out: str, data: str, prepared: str, keep_fp32: str | None):
+    out_dir = Path(out)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    fp32_dir = Path(keep_fp32) if keep_fp32 else Path(runs) / "fp32"
+    fp32_dir.mkdir(parents=True, exist_ok=True)
+    models = {}
+    for name in names:
+        model = load_step_model(Path(runs) / name, prepared)
+        fp32 = fp32_dir / f"{name}.onnx"
+        export_onnx(model, fp32)
+        quantize(fp32, out_dir / f"{name}.onnx")
+        models[name] = model
+        print(f"{name}: fp32 {fp32.stat().st_size / 1e6:.2f} MB -> int8 "
+              f"{(out_dir / f'{name}.onnx').stat().st_size / 1e6:.2f} MB")
+    return write_manifest(out_dir, models, data, prepared)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m training.export", description=__doc__)
+    ap.add_argument("--model", action="append", help=f"default: {', '.join(SHIPPED)}")
+    ap.add_argument("--runs", default="runs/models", help="training output folder")
+    ap.add_argument("--prepared", default="runs/data", help="prepared data (for normalization)")
+    ap.add_argument("--data", default=DEFAULT_DATA, help="BVH folder (skeleton offsets)")
+    ap.add_argument("--out", default="public/models")
+    ap.add_argument("--fp32", default=None, help="where to keep the fp32 ONNX (default RUNS/fp32)")
+    args = ap.parse_args(argv)
+    try:
+        m = export_all(args.model or SHIPPED, args.runs, args.out, args.data, args.prepared, args.fp32)
+    except (TrainError, DataError) as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+    total = sum(v["bytes"] for v in m["models"].values())
+    print(f"wrote {args.out}/manifest.json; models total {total / 1e6:.2f} MB")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
