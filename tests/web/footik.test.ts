@@ -1,0 +1,77 @@
+// web/footik.ts: the two-bone IK keeps bone lengths and reaches what it can; the lock keeps a
+// planted foot still, re-plants a stale lock, and holds ankles above the floor.
+
+import { describe, expect, it } from 'vitest';
+import { ANKLE_FLOOR, FootLock, MAX_LOCK_DISTANCE, twoBoneIk } from '../../web/footik';
+
+/** A left leg: thigh (11) at hip height, knee (12) slightly forward, foot (13) below. */
+function leg(): Float64Array {
+  const p = new Float64Array(51);
+  p.set([0.1, 0.95, 0], 33);
+  p.set([0.1, 0.52, 0.04], 36);
+  p.set([0.1, 0.09, 0], 39);
+  p.set([-0.1, 0.95, 0], 42); // right leg, untouched by a left-foot lock
+  p.set([-0.1, 0.52, 0.04], 45);
+  p.set([-0.1, 0.09, 0], 48);
+  return p;
+}
+const dist = (p: ArrayLike<number>, i: number, j: number) => Math.hypot(p[3 * i] - p[3 * j], p[3 * i + 1] - p[3 * j + 1], p[3 * i + 2] - p[3 * j + 2]);
+
+describe('twoBoneIk', () => {
+  it('puts a reachable foot exactly on the target, bones unchanged, thigh fixed, knee bent forward', () => {
+    const p = leg();
+    const lengths = [dist(p, 11, 12), dist(p, 12, 13)];
+    twoBoneIk(p, 11, 12, 13, 0.15, 0.2, 0.1, 0, 0, 1);
+    expect([p[39], p[40], p[41]].map((v, i) => v - [0.15, 0.2, 0.1][i]).every((d) => Math.abs(d) < 1e-12)).toBe(true);
+    expect(dist(p, 11, 12)).toBeCloseTo(lengths[0], 12);
+    expect(dist(p, 12, 13)).toBeCloseTo(lengths[1], 12);
+    expect([p[33], p[34], p[35]]).toEqual([0.1, 0.95, 0]);
+    expect(p[38]).toBeGreaterThan(0.05); // the knee stays on its side (forward)
+  });
+
+  it('stretches toward an unreachable target without changing bone lengths', () => {
+    const p = leg();
+    const lengths = [dist(p, 11, 12), dist(p, 12, 13)];
+    twoBoneIk(p, 11, 12, 13, 0.1, -1, 0, 0, 0, 1);
+    expect(dist(p, 11, 12)).toBeCloseTo(lengths[0], 9);
+    expect(dist(p, 12, 13)).toBeCloseTo(lengths[1], 9);
+    expect(dist(p, 11, 13)).toBeCloseTo(lengths[0] + lengths[1], 5);
+  });
+});
+
+describe('FootLock', () => {
+  it('holds a planted foot while the body moves, leaves the other foot alone', () => {
+    const lock = new FootLock();
+    const p = leg();
+    lock.apply(p, [1, 0], 0);
+    const moved = leg();
+    for (let i = 0; i < 51; i += 3) moved[i + 2] += 0.03; // the whole body 3 cm forward
+    const right = Array.from(moved.subarray(42, 51));
+    lock.apply(moved, [1, 0], 0);
+    expect(moved[41]).toBeCloseTo(0, 9);
+    expect(moved[39]).toBeCloseTo(0.1, 9);
+    expect(Array.from(moved.subarray(42, 51))).toEqual(right);
+  });
+
+  it('re-plants a lock that fell too far behind (reset, glitch)', () => {
+    const lock = new FootLock();
+    lock.apply(leg(), [1, 1], 0);
+    const far = leg();
+    for (let i = 0; i < 51; i += 3) far[i] += MAX_LOCK_DISTANCE + 0.1;
+    const before = Array.from(far);
+    lock.apply(far, [1, 1], 0);
+    before.forEach((v, i) => expect(far[i]).toBeCloseTo(v, 9));
+  });
+
+  it('never draws an ankle below the floor', () => {
+    const lock = new FootLock();
+    const low = leg();
+    for (let i = 0; i < 51; i += 3) low[i + 1] -= 0.08; // ankle at 1 cm
+    lock.apply(low, [0, 0], 0);
+    expect(low[40]).toBeCloseTo(ANKLE_FLOOR, 9);
+    const planted = leg();
+    for (let i = 0; i < 51; i += 3) planted[i + 1] -= 0.08;
+    new FootLock().apply(planted, [1, 1], 0);
+    expect(planted[40]).toBeCloseTo(ANKLE_FLOOR, 9);
+  });
+});

@@ -1,0 +1,286 @@
+// The page's Simulation (createSimulation in web/rollout.ts) on fake policies: views in world
+// space, compare mode, ghosts that leave the real state alone, resets on absurd output, leader
+// playback from a recording, foot locking on the drawn pose only, step timing.
+
+import { describe, expect, it } from 'vitest';
+import { FOLLOWER_INPUT_LAYOUT, INPUT_SIZE, LEADER_INPUT_LAYOUT, OUTPUT_LAYOUT, OUTPUT_SIZE, Track, blockSlices } from '../../web/features';
+import { NOW, type DuetSimulation, createDuetSimulation, createSimulation } from '../../web/rollout';
+import type { Motion } from '../../web/skeleton';
+import type { Policy } from '../../web/policy';
+import type { Manifest } from '../../web/types';
+import { ANKLE_FLOOR } from '../../web/footik';
+import { fixture, trackOf } from './fixture';
+
+const data = fixture('rollout');
+const OUT = blockSlices(OUTPUT_LAYOUT);
+const chunk = (flat: number[]) => Array.from({ length: flat.length / 3 }, (_, i) => flat.slice(3 * i, 3 * i + 3));
+
+const manifest = {
+  version: 1,
+  fps: 30,
+  skeleton: { names: [], parents: [], offsets: { leader: chunk(data.offsets.leader), follower: chunk(data.offsets.follower) } },
+  keyJoints: [4, 7, 10, 13, 16],
+  layout: { input: 660, output: 323, intention: 90 },
+  startPose: data.startPose,
+  models: {},
+  defaultTemperature: 0.5,
+  credit: '',
+} as unknown as Manifest;
+
+interface FakeOptions {
+  role: 'leader' | 'follower';
+  /** Forward speed of the fake dancer, m per step. */
+  step?: number;
+  contacts?: [number, number];
+  intention?: boolean;
+  /** Per batch sample i: extra sideways step (ghosts differ). */
+  spread?: number;
+  broken?: boolean;
+}
+
+/** A stand-in for Policy: "keep the current pose, move `step` forward", built from its own input. */
+class FakePolicy {
+  readonly input = new Float32Array(INPUT_SIZE);
+  readonly result = { output: new Float32Array(OUTPUT_SIZE), intention: null as Float32Array | null };
+  readonly entry = { intention: false };
+  runs = 0;
+  private readonly batches = new Map<number, { input: Float32Array; output: Float32Array }>();
+
+  constructor(readonly options: FakeOptions) {
+    this.entry.intention = !!options.intention;
+    if (options.intention) this.result.intention = new Float32Array(90);
+  }
+
+  get hasIntention() {
+    return this.entry.intention;
+  }
+
+  async run(_temperature: number) {
+    this.runs++;
+    this.fill(this.input, 0, this.result.output, 0, 0);
+    return this.result;
+  }
+
+  batchInput(k: number) {
+    if (!this.batches.has(k)) this.batches.set(k, { input: new Float32Array(k * INPUT_SIZE), output: new Float32Array(k * OUTPUT_SIZE) });
+    return this.batches.get(k)!.input;
+  }
+
+  async runBatch(k: number, _temperature: number) {
+    const b = this.batches.get(k)!;
+    for (let i = 0; i < k; i++) this.fill(b.input, i * INPUT_SIZE, b.output, i * OUTPUT_SIZE, i);
+    return { output: b.output, intention: null };
+  }
+
+  private fill(input: Float32Array, at: number, out: Float32Array, to: number, sample: number) {
+    const o = this.options;
+    const self = blockSlices(o.role === 'leader' ? LEADER_INPUT_LAYOUT : FOLLOWER_INPUT_LAYOUT).self_pose.start;
+    const dz = o.step ?? 0;
+    const dx = (o.spread ?? 0) * sample;
+    out.fill(0, to, to + OUTPUT_SIZE);
+    out[to] = dx;
+    out[to + 1] = dz;
+    for (let k = 0; k < 6; k++) {
+      out[to + OUT.trajectory_future.start + 4 * k + 1] = dz * 5 * (k + 1);
+      out[to + OUT.trajectory_future.start + 4 * k + 3] = 1;
+    }
+    // The pose in the next root space: the same as now, since the root moved with the body.
+    for (let i = 0; i < 204; i++) out[to + OUT.pose.start + i] = input[at + self + i];
+    const [l, r] = o.contacts ?? [1, 1];
+    out[to + OUT.contacts.start] = l;
+    out[to + OUT.contacts.start + 1] = r;
+    if (o.broken) out[to + 5] = NaN;
+  }
+}
+
+const policy = (o: FakeOptions) => new FakePolicy(o) as unknown as Policy;
+const steer = { x: 0, z: 0, active: false };
+
+function simulation(followers: FakeOptions[] = [{ role: 'follower', intention: true }], leader: FakeOptions = { role: 'leader' }) {
+  const lead = new FakePolicy(leader);
+  const follow = followers.map((o) => new FakePolicy(o));
+  const asPolicy = (p: FakePolicy) => p as unknown as Policy;
+  const sim = createDuetSimulation({ manifest, leader: asPolicy(lead), followers: follow.map(asPolicy), seed: 1 });
+  return { sim, lead, follow };
+}
+
+const finite = (a: ArrayLike<number>) => Array.from(a).every(Number.isFinite);
+
+describe('createSimulation', () => {
+  it('starts both dancers in world space: leader at the origin, follower 0.8 m ahead facing it', () => {
+    const sim = createSimulation({ manifest, leader: policy({ role: 'leader' }), followers: [policy({ role: 'follower' })], seed: 1 });
+    expect(sim.leader.root).toEqual([0, 0]);
+    expect(sim.followers[0].root[1]).toBeCloseTo(0.8, 12);
+    expect(sim.followers[0].heading).toBeCloseTo(Math.PI, 12);
+    expect(sim.leader.positions).toHaveLength(51);
+    expect(sim.leader.future).toHaveLength(12);
+    expect(finite(sim.leader.positions) && finite(sim.followers[0].positions)).toBe(true);
+    expect(sim.followers[0].intention).toBeUndefined();
+    const withIntention = createSimulation({ manifest, leader: policy({ role: 'leader' }), followers: [policy({ role: 'follower', intention: true })], seed: 1 });
+    // Before any prediction the intention shows the leader's head where it is (not the origin).
+    expect(withIntention.followers[0].intention![1]).toBeCloseTo(withIntention.leader.positions[4 * 3 + 1], 5);
+  });
+
+  it('steps: still models keep still dancers still, the intention is drawn in world space, timing is kept', async () => {
+    const { sim, lead, follow } = simulation();
+    const before = Float32Array.from(sim.followers[0].positions);
+    for (let i = 0; i < 5; i++) await sim.step(steer, 0.5);
+    expect(lead.runs).toBe(5);
+    expect(follow[0].runs).toBe(5);
+    for (let i = 0; i < 51; i++) expect(sim.followers[0].positions[i]).toBeCloseTo(before[i], 5);
+    expect(sim.followers[0].intention).toHaveLength(90);
+    // A zero intention in root space is the follower's own root on the floor.
+    expect(sim.followers[0].intention![2]).toBeCloseTo(0.8, 5);
+    const ms = sim.stepMs();
+    expect(ms.median).toBeGreaterThanOrEqual(0);
+    expect(ms.p95).toBeGreaterThanOrEqual(ms.median);
+  });
+
+  it('moves the drawn future and root with the model output', async () => {
+    const { sim } = simulation([{ role: 'follower', step: 0.02 }], { role: 'leader', step: 0.02 });
+    for (let i = 0; i < 10; i++) await sim.step(steer, 0.5);
+    expect(sim.leader.root[1]).toBeCloseTo(0.2, 6); // leader faces +Z
+    expect(sim.followers[0].root[1]).toBeCloseTo(0.6, 6); // follower faces -Z
+    expect(sim.leader.future[11]).toBeCloseTo(0.2 + 0.02 * 30, 5);
+  });
+
+  it('steering bends the leader plan toward the stick', async () => {
+    const { sim, lead } = simulation();
+    for (let i = 0; i < 3; i++) await sim.step({ x: 1, z: 0, active: true }, 0.5);
+    // The control block (the leader's future in its own root space; it faces +Z, so x is world x)
+    // bends toward the stick; the fake model itself just walks straight on.
+    const control = blockSlices(LEADER_INPUT_LAYOUT).control.start;
+    expect(lead.input[control + 4 * 5]).toBeGreaterThan(0.1);
+    expect(lead.input[control + 4 * 5 + 1]).toBeCloseTo(0, 6);
+  });
+
+  it('compare mode: two followers, each its own dancer and model; the leader reacts to the first', async () => {
+    const { sim, lead: leaderPolicy, follow } = simulation([{ role: 'follower', step: 0.01 }, { role: 'follower', step: -0.01 }]);
+    for (let i = 0; i < 4; i++) await sim.step(steer, 0.5);
+    expect(sim.followers).toHaveLength(2);
+    expect(follow[0].runs).toBe(4);
+    expect(follow[1].runs).toBe(4);
+    expect(sim.followers[0].root[1]).toBeCloseTo(0.8 - 0.04, 6);
+    expect(sim.followers[1].root[1]).toBeCloseTo(0.8 + 0.04, 6);
+    // The leader's last input saw followers[0] as its partner (the leader stands at the origin
+    // facing +Z, so root space is world space): the partner hip is followers[0]'s previous hip.
+    const s = sim as DuetSimulation;
+    expect(s.duet.leader.rootX).toBe(0);
+    const hipZ = s.duet.followers.map((f) => f.track.positions[(NOW - 1) * 51 + 2]);
+    const partnerPose = blockSlices(LEADER_INPUT_LAYOUT).partner_pose.start;
+    expect(leaderPolicy.input[partnerPose + 2]).toBeCloseTo(hipZ[0], 5);
+    expect(Math.abs(leaderPolicy.input[partnerPose + 2] - hipZ[1])).toBeGreaterThan(0.05);
+  });
+
+  it('resets a dancer whose model output is absurd, and never draws the absurd pose', async () => {
+    const { sim } = simulation([{ role: 'follower', broken: true }]);
+    await sim.step(steer, 0.5);
+    const s = sim as DuetSimulation;
+    expect(s.duet.followers[0].resets).toBe(1);
+    expect(finite(sim.followers[0].positions)).toBe(true);
+    expect(sim.followers[0].root[1]).toBeCloseTo(0.8, 6);
+  });
+
+  it('ghosts: k sampled next poses of the first follower, the real state untouched', async () => {
+    const { sim } = simulation([{ role: 'follower', spread: 0.05 }]);
+    await sim.step(steer, 0.5);
+    const s = sim as DuetSimulation;
+    const track = Float64Array.from(s.duet.followers[0].track.positions);
+    const drawn = Float32Array.from(sim.followers[0].positions);
+    const ghosts = await sim.ghosts(3);
+    expect(ghosts).toHaveLength(3);
+    for (const g of ghosts) expect(g.length === 51 && finite(g)).toBe(true);
+    // Sample i stepped 0.05·i sideways (in the follower's frame, which faces -Z: world -X).
+    expect(ghosts[1][0] - ghosts[0][0]).toBeCloseTo(-0.05, 5);
+    expect(ghosts[2][0] - ghosts[0][0]).toBeCloseTo(-0.1, 5);
+    expect(s.duet.followers[0].track.positions).toEqual(track);
+    expect(sim.followers[0].positions).toEqual(drawn);
+    expect(await sim.ghosts(0)).toEqual([]);
+  });
+
+  it('reset() goes back to the start pose', async () => {
+    const { sim } = simulation([{ role: 'follower', step: 0.02 }], { role: 'leader', step: 0.02 });
+    for (let i = 0; i < 5; i++) await sim.step(steer, 0.5);
+    sim.reset();
+    expect(sim.leader.root).toEqual([0, 0]);
+    expect(sim.followers[0].root[1]).toBeCloseTo(0.8, 12);
+  });
+});
+
+describe('leader playback', () => {
+  const features = fixture('features');
+  const track = trackOf(features, 'leader');
+  const recording: Motion = { positions: track.positions, rotations: track.rotations, offsets: Float64Array.from(data.offsets.leader), fps: 30, frames: track.frames };
+
+  it('drives the leader from the recording (moved rigidly onto the leader), not from the leader model', async () => {
+    const { sim, lead } = simulation();
+    const s = sim as DuetSimulation;
+    s.setLeaderPlayback(recording);
+    for (let i = 0; i < 3; i++) await sim.step(steer, 0.5);
+    expect(lead.runs).toBe(0);
+    expect(s.leaderPlayback).toEqual({ frame: 3, frames: track.frames });
+    // Heights are the recording's; horizontal distances between joints too.
+    const p = s.duet.leader.track.positions;
+    for (let j = 0; j < 17; j++) expect(p[NOW * 51 + 3 * j + 1]).toBeCloseTo(track.positions[3 * 51 + 3 * j + 1], 9);
+    const dist = (a: ArrayLike<number>, i: number, j: number, base: number) =>
+      Math.hypot(a[base + 3 * i] - a[base + 3 * j], a[base + 3 * i + 2] - a[base + 3 * j + 2]);
+    expect(dist(p, 7, 16, NOW * 51)).toBeCloseTo(dist(track.positions, 7, 16, 3 * 51), 9);
+    // The plan (what the follower reads as the leader's future) is the recording's future, moved the same way.
+    const plan = s.duet.leader.track.root;
+    const futureDistance = Math.hypot(plan[2 * (NOW + 30)] - plan[2 * NOW], plan[2 * (NOW + 30) + 1] - plan[2 * NOW + 1]);
+    const root = Track.fromMotion(recording).root;
+    const recorded = Math.hypot(root[2 * 33] - root[2 * 3], root[2 * 33 + 1] - root[2 * 3 + 1]);
+    expect(futureDistance).toBeCloseTo(recorded, 9);
+  });
+
+  it('loops at the end and hands back to the model with null', async () => {
+    const { sim, lead } = simulation();
+    const s = sim as DuetSimulation;
+    s.setLeaderPlayback(recording);
+    for (let i = 0; i < track.frames + 2; i++) await sim.step(steer, 0.5);
+    expect(s.leaderPlayback!.frame).toBe(3);
+    expect(finite(sim.leader.positions)).toBe(true);
+    s.setLeaderPlayback(null);
+    await sim.step(steer, 0.5);
+    expect(lead.runs).toBe(1);
+  });
+
+  it('after reset() the recording starts over from a still first frame at the start position', async () => {
+    const { sim } = simulation();
+    const s = sim as DuetSimulation;
+    s.setLeaderPlayback(recording);
+    await sim.step(steer, 0.5);
+    sim.reset();
+    expect(s.leaderPlayback!.frame).toBe(0);
+    expect(sim.leader.root[0]).toBeCloseTo(0, 12);
+    expect(sim.leader.root[1]).toBeCloseTo(0, 12);
+    expect(sim.leader.heading).toBeCloseTo(0, 12);
+  });
+});
+
+describe('foot locking (drawn pose only)', () => {
+  it('keeps a planted foot where contact began while the body walks on, then lets it go', async () => {
+    const { sim, follow } = simulation([{ role: 'follower', step: 0.003, contacts: [1, 0] }]);
+    const s = sim as DuetSimulation;
+    await sim.step(steer, 0.5);
+    const planted = Array.from(sim.followers[0].positions.subarray(13 * 3, 13 * 3 + 3));
+    for (let i = 0; i < 8; i++) await sim.step(steer, 0.5);
+    const drawn = sim.followers[0].positions;
+    const modelled = s.duet.followers[0].positions;
+    for (let a = 0; a < 3; a++) expect(drawn[13 * 3 + a]).toBeCloseTo(planted[a], 5);
+    // The model's foot moved on with the body (2.4 cm); the track the features read is untouched.
+    expect(Math.abs(modelled[13 * 3 + 2] - planted[2])).toBeGreaterThan(0.02);
+    // Bones keep their lengths.
+    const bone = (p: ArrayLike<number>, i: number, j: number) => Math.hypot(p[3 * i] - p[3 * j], p[3 * i + 1] - p[3 * j + 1], p[3 * i + 2] - p[3 * j + 2]);
+    expect(bone(drawn, 11, 12)).toBeCloseTo(bone(modelled, 11, 12), 5);
+    expect(bone(drawn, 12, 13)).toBeCloseTo(bone(modelled, 12, 13), 5);
+    // The right foot has no contact: drawn where the model put it.
+    for (let a = 0; a < 3; a++) expect(drawn[16 * 3 + a]).toBeCloseTo(modelled[16 * 3 + a], 5);
+    expect(drawn[13 * 3 + 1]).toBeGreaterThanOrEqual(ANKLE_FLOOR - 1e-6);
+
+    // Contact ends: within a few steps the drawn foot is the model's again.
+    follow[0].options.contacts = [0, 0];
+    for (let i = 0; i < 8; i++) await sim.step(steer, 0.5);
+    for (let a = 0; a < 3; a++) expect(sim.followers[0].positions[13 * 3 + a]).toBeCloseTo(s.duet.followers[0].positions[13 * 3 + a], 6);
+  });
+});

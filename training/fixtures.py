@@ -1,0 +1,511 @@
+"""Fixtures that pin web/*.ts to the Python reference: `python -m training.fixtures`.
+
+Writes tests/fixtures/{bvh,features,rollout}.json: inputs, and what training/bvh.py,
+skeleton.py, features.py and rollout.py compute from them. tests/web/*.test.ts run the TypeScript
+mirror on the same inputs and compare every number (1e-5, relative for large values);
+tests/python/test_fixtures.py checks that the files still match this code.
+
+All motion here is procedural (sinusoidal joint rotations, seeded random rotations, two dancers
+circling each other) and every BVH is generated text: no recorded motion is ever written out.
+Inputs are rounded BEFORE the expected outputs are computed from them, so the TypeScript side reads
+exactly the numbers Python used; only the outputs are rounded (7 significant digits).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+
+from . import features as feat
+from . import rollout as ro
+from .bvh import BvhError, axis_rotation, forward_kinematics, local_transforms, parse_bvh
+from .features import Track
+from .skeleton import (JOINT_NAMES, MIRROR, PARENTS, Motion, facing_direction,
+                       forward_kinematics_reduced, gaussian_smooth, mirror_motion, reduce_bvh,
+                       resample, root_from_motion)
+
+OUT_DIR = Path(__file__).resolve().parent.parent / "tests" / "fixtures"
+FRAMES = 63            # 30 past + 2 frames t + 31 future: valid_frames(63) == [30, 31]
+SEED = 20240611
+
+
+# ---------------------------------------------------------------- number formatting
+
+def out7(x):
+    """Expected outputs: 7 significant digits, flattened (TypeScript stores everything flat)."""
+    a = np.asarray(x, dtype=np.float64).ravel()
+    return [float(f"{v:.7g}") if np.isfinite(v) else None for v in a]
+
+
+def exact(x):
+    """Inputs: written as they are (already rounded by the caller), flattened."""
+    return [float(v) for v in np.asarray(x, dtype=np.float64).ravel()]
+
+
+# ---------------------------------------------------------------- BVH text
+
+TINY_BVH = """HIERARCHY
+ROOT Hips
+{
+  OFFSET 0.0 0.0 0.0
+  CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation
+  JOINT Spine
+  {
+    OFFSET 0.0 5.0 0.5
+    CHANNELS 3 Xrotation Yrotation Zrotation
+    End Site
+    {
+      OFFSET 0.0 3.0 0.0
+    }
+  }
+  JOINT Leg
+  {
+    OFFSET 1.0 -1.0 0.0
+    CHANNELS 3 Yrotation Zrotation Xrotation
+    End Site
+    {
+      OFFSET 0.0 -4.0 0.0
+    }
+  }
+}
+MOTION
+Frames: 3
+Frame Time: 0.0333333
+1.0 2.0 3.0 10.0 20.0 30.0 5.0 -15.0 45.0 -30.0 12.5 60.0
+1.5 2.0 2.5 -10.0 0.0 90.0 0.0 0.0 0.0 0.0 0.0 0.0
+-2.0 0.5 1.0 170.0 -45.0 5.0 90.0 90.0 -90.0 33.0 -66.0 99.0
+"""
+
+# The 17 kept joints plus joints the reduction must fold away (collars, buttocks) and End Sites.
+# (name, parent name, offset in BVH units, channel order or None)
+ZXY, XYZ, YZX = "Zrotation Xrotation Yrotation", "Xrotation Yrotation Zrotation", "Yrotation Zrotation Xrotation"
+FULL_JOINTS = [
+    ("hip", None, (0.0, 0.0, 0.0), "Xposition Yposition Zposition " + ZXY),
+    ("abdomen", "hip", (0.0, 0.07, 0.0), ZXY),
+    ("chest", "abdomen", (0.0, 0.12, 0.01), XYZ),
+    ("neck", "chest", (0.0, 0.16, -0.01), ZXY),
+    ("head", "neck", (0.0, 0.08, 0.01), YZX),
+    ("lCollar", "chest", (0.03, 0.12, 0.0), ZXY),      # dropped: constant rotation
+    ("lShldr", "lCollar", (0.09, 0.0, 0.0), ZXY),
+    ("lForeArm", "lShldr", (0.19, 0.0, 0.0), XYZ),
+    ("lHand", "lForeArm", (0.17, 0.0, 0.0), ZXY),
+    ("rCollar", "chest", (-0.03, 0.12, 0.0), ZXY),     # dropped: constant rotation
+    ("rShldr", "rCollar", (-0.09, 0.0, 0.0), ZXY),
+    ("rForeArm", "rShldr", (-0.19, 0.0, 0.0), YZX),
+    ("rHand", "rForeArm", (-0.17, 0.0, 0.0), ZXY),
+    ("lButtock", "hip", (0.04, -0.02, 0.0), None),     # dropped: no channels at all
+    ("lThigh", "lButtock", (0.02, -0.02, 0.0), ZXY),
+    ("lShin", "lThigh", (0.0, -0.29, 0.0), XYZ),
+    ("lFoot", "lShin", (0.0, -0.28, 0.0), ZXY),
+    ("rButtock", "hip", (-0.04, -0.02, 0.0), None),
+    ("rThigh", "rButtock", (-0.02, -0.02, 0.0), ZXY),
+    ("rShin", "rThigh", (0.0, -0.29, 0.0), ZXY),
+    ("rFoot", "rShin", (0.0, -0.28, 0.0), YZX),
+]
+LEAVES = {"head", "lHand", "rHand", "lFoot", "rFoot"}
+FULL_FRAMES = 9      # at 120 fps: 3 frames at 30 fps for phase 0, 2 for phase 1
+
+
+def full_bvh_text(rng: np.random.Generator, rotating_collar: bool = False) -> str:
+    children: dict[str | None, list[int]] = {}
+    for i, (_, parent, _, _) in enumerate(FULL_JOINTS):
+        children.setdefault(parent, []).append(i)
+    lines = ["HIERARCHY"]
+    columns: list[str] = []   # (joint, channel) per motion column, to generate values
+
+    def emit(i: int, depth: int) -> None:
+        name, parent, off, chans = FULL_JOINTS[i]
+        pad = "  " * depth
+        lines.append(f"{pad}{'ROOT' if parent is None else 'JOINT'} {name}")
+        lines.append(f"{pad}{{")
+        lines.append(f"{pad}  OFFSET {off[0]:.4f} {off[1]:.4f} {off[2]:.4f}")
+        if chans:
+            lines.append(f"{pad}  CHANNELS {len(chans.split())} {chans}")
+            columns.extend(f"{name}:{c}" for c in chans.split())
+        for c in children.get(name, []):
+            emit(c, depth + 1)
+        if name in LEAVES:
+            lines.append(f"{pad}  End Site")
+            lines.append(f"{pad}  {{")
+            lines.append(f"{pad}    OFFSET 0.0000 {0.05 if name == 'head' else -0.03:.4f} 0.0300")
+            lines.append(f"{pad}  }}")
+        lines.append(f"{pad}}}")
+
+    emit(0, 0)
+    lines += ["MOTION", f"Frames: {FULL_FRAMES}", "Frame Time: 0.0083333"]
+    phase = rng.uniform(0, 2 * np.pi, len(columns))
+    amp = rng.uniform(5, 40, len(columns))
+    for f in range(FULL_FRAMES):
+        row = []
+        for c, col in enumerate(columns):
+            joint, chan = col.split(":")
+            if chan.endswith("position"):
+                v = {"X": 0.3 + 0.01 * f, "Y": 0.62 + 0.005 * math.sin(f), "Z": -0.2 + 0.02 * f}[chan[0]]
+            elif joint.endswith("Collar"):
+                v = 7.5 if not rotating_collar else 7.5 + f   # constant: foldable into the offsets
+            else:
+                v = amp[c] * math.sin(0.4 * f + phase[c])
+            row.append(f"{v:.4f}")
+        lines.append(" ".join(row))
+    return "\n".join(lines) + "\n"
+
+
+def bvh_fixture(rng: np.random.Generator) -> dict:
+    tiny = parse_bvh(TINY_BVH, "tiny.bvh")
+    tiny_rot, tiny_pos = local_transforms(tiny)
+    world_rot, world_pos = forward_kinematics(tiny.parents, tiny_rot, tiny_pos)
+
+    text = full_bvh_text(rng)
+    full = parse_bvh(text, "full.bvh")
+    motion = reduce_bvh(full, "full.bvh")
+    full_rot, full_pos = local_transforms(full)
+    _, full_world = forward_kinematics(full.parents, full_rot, full_pos)
+    resampled = resample(motion, 30, 1)
+    root, heading = root_from_motion(motion)
+    mirrored = mirror_motion(motion)
+    fk = forward_kinematics_reduced(motion.offsets, motion.positions[:, 0], motion.rotations)
+
+    smooth_in = np.round(rng.normal(size=(7, 3)), 6)
+
+    # Broken files: the phrase each message must contain (in Python and TypeScript alike).
+    no_lfoot = text.replace("JOINT lFoot", "JOINT lToe")
+    errors = [
+        ("", None),
+        ("hello world", "not a BVH file"),
+        ("HIERARCHY ROOT a { OFFSET 0 0 0 CHANNELS 1 Xrotation }", "malformed BVH"),
+        ("HIERARCHY ROOT a { OFFSET 0 zero 0 } MOTION Frames: 1 Frame Time: 0.1", "malformed BVH"),
+        ("HIERARCHY ROOT a { OFFSET 0 0 0 CHANNELS 1 Xrotation } MOTION Frames: 2 Frame Time: 0.1 5", "but holds 1 numbers"),
+        ("HIERARCHY ROOT a { OFFSET 0 0 0 CHANNELS 1 Xrotation } MOTION Frames: 1 Frame Time: 0 5", "Frame Time must be positive"),
+        ("HIERARCHY ROOT a { OFFSET 0 0 0 CHANNELS 1 Xrotation } MOTION Frames 1 Frame Time: 0.1 5", "lacks 'Frames:'"),
+        ("HIERARCHY ROOT a { WHAT 0 0 0 } MOTION Frames: 1 Frame Time: 0.1", "unexpected token"),
+    ]
+    parse_errors = []
+    for bad, phrase in errors:
+        if phrase is None:   # empty: Python says "not a BVH file", TypeScript names the emptiness
+            parse_errors.append({"text": bad, "phrase": "empty"})
+            continue
+        try:
+            parse_bvh(bad, "bad.bvh")
+        except BvhError as e:
+            assert phrase in str(e), (phrase, str(e))
+        else:
+            raise AssertionError(f"no error for {bad!r}")
+        parse_errors.append({"text": bad, "phrase": phrase})
+    reduce_errors = []
+    for bad, phrase in [(no_lfoot, "lacks joint(s) lFoot"),
+                        (full_bvh_text(np.random.default_rng(1), rotating_collar=True), "rotates; cannot reduce")]:
+        try:
+            reduce_bvh(parse_bvh(bad, "bad.bvh"), "bad.bvh")
+        except BvhError as e:
+            assert phrase in str(e), (phrase, str(e))
+        else:
+            raise AssertionError("no reduce error")
+        reduce_errors.append({"text": bad, "phrase": phrase})
+
+    return {
+        "tiny": {
+            "text": TINY_BVH, "names": tiny.names, "parents": tiny.parents,
+            "offsets": exact(tiny.offsets), "channels": tiny.channels, "frameTime": tiny.frame_time,
+            "frames": tiny.frames, "motion": exact(tiny.motion),
+            "localRotations": out7(tiny_rot), "localPositions": out7(tiny_pos),
+            "worldRotations": out7(world_rot), "worldPositions": out7(world_pos),
+        },
+        "full": {
+            "text": text, "names": full.names, "parents": full.parents, "frames": full.frames,
+            "fullWorldPositions": out7(full_world),
+            "reduced": {"positions": out7(motion.positions), "rotations": out7(motion.rotations),
+                        "offsets": out7(motion.offsets), "fps": motion.fps},
+            "resampledPhase1": {"frames": resampled.frames, "positions": out7(resampled.positions)},
+            "root": out7(root), "heading": out7(heading),
+            "facing": out7(facing_direction(motion.positions)),
+            "mirrored": {"positions": out7(mirrored.positions), "rotations": out7(mirrored.rotations),
+                         "offsets": out7(mirrored.offsets)},
+            "fkReduced": out7(fk),
+        },
+        "smooth": {"input": exact(smooth_in), "width": 3,
+                   "sigma2": out7(gaussian_smooth(smooth_in, 2.0)),
+                   "sigma0_7": out7(gaussian_smooth(smooth_in, 0.7)),
+                   "sigma0": out7(gaussian_smooth(smooth_in, 0.0))},
+        "constants": {"names": JOINT_NAMES, "parents": PARENTS, "mirror": MIRROR},
+        "parseErrors": parse_errors,
+        "reduceErrors": reduce_errors,
+    }
+
+
+# ---------------------------------------------------------------- procedural dancers
+
+# Offsets (metres) of a plausible 17-joint dancer: arms out along x (a T pose at rest), legs down.
+OFFSETS = np.array([
+    [0, 0, 0], [0, 0.10, 0], [0, 0.18, 0.01], [0, 0.25, -0.01], [0, 0.12, 0.02],
+    [0.18, 0.20, 0], [0.28, 0, 0], [0.25, 0, 0],
+    [-0.18, 0.20, 0], [-0.28, 0, 0], [-0.25, 0, 0],
+    [0.09, -0.06, 0], [0, -0.44, 0.01], [0, -0.42, -0.02],
+    [-0.09, -0.06, 0], [0, -0.44, 0.01], [0, -0.42, -0.02],
+], dtype=np.float64)
+
+
+def euler(angles_deg: np.ndarray) -> np.ndarray:
+    """[F, 3] (x, y, z) degrees -> [F, 3, 3] as Rz Rx Ry (the CMU channel order)."""
+    return (axis_rotation("Z", angles_deg[:, 2]) @ axis_rotation("X", angles_deg[:, 0])
+            @ axis_rotation("Y", angles_deg[:, 1]))
+
+
+def procedural_dancer(rng: np.random.Generator, frames: int, centre_angle: np.ndarray,
+                      offsets: np.ndarray, scale: float) -> Motion:
+    """A dancer on a circle around a drifting centre, facing the centre, stepping and swinging."""
+    t = np.arange(frames) / 30.0
+    J = len(PARENTS)
+    local = np.empty((frames, J, 3, 3))
+    # Sinusoidal joint angles with random amplitudes and phases, plus seeded random jitter.
+    amp = rng.uniform(3, 25, (J, 3))
+    freq = rng.uniform(0.5, 2.5, (J, 3))
+    phase = rng.uniform(0, 2 * np.pi, (J, 3))
+    angles = amp * np.sin(2 * np.pi * freq * t[:, None, None] + phase) + rng.normal(0, 0.3, (frames, J, 3))
+    angles[:, 5, 2] -= 70    # left arm down from the T pose
+    angles[:, 8, 2] += 70    # right arm down
+    # Legs step in turn: each swings through half a cycle and stands still (planted) the other half.
+    step = np.sin(2 * np.pi * 1.2 * t)
+    angles[:, 11:17] = 0
+    angles[:, 11, 0] = 30 * np.maximum(0, step)
+    angles[:, 14, 0] = 30 * np.maximum(0, -step)
+    angles[:, 12, 0] = -25 * np.maximum(0, step)
+    angles[:, 15, 0] = -25 * np.maximum(0, -step)
+    angles[:, 0] *= 0.1
+    for j in range(J):
+        local[:, j] = euler(angles[:, j])
+    # Circle around a drifting centre, facing it (heading = atan2 of the direction to the centre).
+    centre = np.stack([0.12 * t - 0.3, 0.05 * t + 0.2], -1)
+    pos = centre + scale * np.stack([np.cos(centre_angle), np.sin(centre_angle)], -1)
+    to_centre = centre - pos
+    facing = np.arctan2(to_centre[:, 0], to_centre[:, 1]) + 0.1 * np.sin(2 * np.pi * 0.7 * t)
+    local[:, 0] = np.stack([ro.rotation_y(h) for h in facing]) @ local[:, 0]
+    world = np.empty_like(local)
+    for j, p in enumerate(PARENTS):
+        world[:, j] = local[:, j] if p < 0 else world[:, p] @ local[:, j]
+    hip = np.stack([pos[:, 0], 1.0 + 0.02 * np.sin(2 * np.pi * 2.4 * t), pos[:, 1]], -1)
+    positions = forward_kinematics_reduced(offsets, hip, world)
+    return Motion(np.round(positions, 6), np.round(world, 6), offsets, 30.0)
+
+
+def procedural_pair(rng: np.random.Generator) -> tuple[Motion, Motion]:
+    t = np.arange(FRAMES) / 30.0
+    angle = 1.3 + 0.5 * t    # the pair turns slowly; the leader's heading crosses ±pi
+    lead_offsets = OFFSETS.copy()
+    follow_offsets = np.round(OFFSETS * 0.94, 6)
+    leader = procedural_dancer(rng, FRAMES, angle, lead_offsets, 0.45)
+    follower = procedural_dancer(rng, FRAMES, angle + np.pi, follow_offsets, 0.45)
+    return leader, follower
+
+
+# Rotations are read only at the frames t and t+1 (pose blocks) and, in the rollout, at NOW = 30.
+# The others are zero: the fixture stays small, and a read from a wrong frame shows.
+ROTATION_FRAMES = (28, 35)
+
+
+def rounded_track(motion: Motion) -> Track:
+    root, heading = root_from_motion(motion)
+    rotations = np.zeros_like(motion.rotations)
+    a, b = ROTATION_FRAMES
+    rotations[a:b] = motion.rotations[a:b]
+    return Track(motion.positions, rotations, np.round(root, 6), np.round(heading, 6))
+
+
+def features_fixture(rng: np.random.Generator, lead: Track, follow: Track) -> dict:
+    frames = feat.valid_frames(FRAMES)
+    assert list(frames) == [30, 31]
+    # Stand-alone block inputs: random but shaped like the real thing.
+    pts = np.round(rng.normal(0, 2, (4, 3)), 6)
+    root = np.round(rng.normal(0, 1, 2), 6)
+    heading = np.round(rng.uniform(-np.pi, np.pi), 6)
+    key_roots = np.round(rng.normal(0, 1, (feat.KEYS, 2)), 6)
+    key_headings = np.round(rng.uniform(-4, 4, feat.KEYS), 6)
+    key_pos = np.round(rng.normal(0, 1, (feat.KEYS, 5, 3)), 6)
+    t = 30
+    pose_args = (lead.positions[t], lead.positions[t - 1], lead.rotations[t])
+    updates = [  # root, heading, next root, next heading (the last two wrap across ±pi)
+        ([0.1, 0.2], 0.3, [0.15, 0.18], 0.35),
+        ([1.0, -2.0], 3.1, [1.02, -2.01], -3.12),
+        ([-0.5, 0.5], -3.1, [-0.52, 0.49], 3.05),
+    ]
+    contacts_cases = []
+    for f in range(1, FRAMES):
+        contacts_cases.append(feat.foot_contacts(lead.positions[f], lead.positions[f - 1]))
+    contacts_cases = np.array(contacts_cases)
+    assert 0 < contacts_cases.mean() < 1, "the fixture should hold both planted and moving feet"
+    # Hand-made feet around the thresholds (far from the origin, so x or z cannot stand in for y):
+    # (left foot now, left before, right now, right before)
+    feet = [
+        ([2.0, 0.10, -3.0], [2.0, 0.10, -3.01], [2.5, 0.20, -3.0], [2.5, 0.20, -3.0]),    # low+slow | high
+        ([2.0, 0.14, -3.0], [2.03, 0.14, -3.0], [2.5, 0.08, -3.0], [2.5, 0.06, -3.0]),     # fast x | slow
+        ([-4.0, 0.12, 5.0], [-4.0, 0.10, 5.0], [-4.0, 0.05, 5.0], [-4.0, 0.05, 5.02]),   # fast y | fast z
+        ([0.3, 0.149, 0.3], [0.3, 0.149, 0.3], [0.3, 0.151, 0.3], [0.3, 0.151, 0.3]),     # just below | above
+    ]
+    foot_pairs = []
+    for l_now, l_before, r_now, r_before in feet:
+        now, before = np.full((17, 3), 1.0), np.full((17, 3), 1.0)
+        now[13], before[13], now[16], before[16] = l_now, l_before, r_now, r_before
+        foot_pairs.append((now, before))
+
+    h = np.asarray(heading)
+    return {
+        "frames": FRAMES, "t": [int(f) for f in frames],
+        "rotationFrames": list(ROTATION_FRAMES),
+        "leader": {"positions": exact(lead.positions), "root": exact(lead.root), "heading": exact(lead.heading),
+                   "rotations": exact(lead.rotations[slice(*ROTATION_FRAMES)])},
+        "follower": {"positions": exact(follow.positions), "root": exact(follow.root), "heading": exact(follow.heading),
+                     "rotations": exact(follow.rotations[slice(*ROTATION_FRAMES)])},
+        "constants": {
+            "KEYS": feat.KEYS, "KEY_STEP": feat.KEY_STEP, "PAST_OFFSETS": feat.PAST_OFFSETS.tolist(),
+            "FUTURE_OFFSETS": feat.FUTURE_OFFSETS.tolist(), "HISTORY": feat.HISTORY,
+            "INPUT_SIZE": feat.INPUT_SIZE, "OUTPUT_SIZE": feat.OUTPUT_SIZE, "INTENTION_SIZE": feat.INTENTION_SIZE,
+            "FOLLOWER_INPUT_LAYOUT": feat.FOLLOWER_INPUT_LAYOUT, "LEADER_INPUT_LAYOUT": feat.LEADER_INPUT_LAYOUT,
+            "OUTPUT_LAYOUT": feat.OUTPUT_LAYOUT, "INTENTION_LAYOUT": feat.INTENTION_LAYOUT,
+            "CONTACT_HEIGHT": feat.CONTACT_HEIGHT, "CONTACT_SPEED": feat.CONTACT_SPEED,
+            "followerSlices": {k: [v.start, v.stop] for k, v in feat.block_slices(feat.FOLLOWER_INPUT_LAYOUT).items()},
+        },
+        "rootSpace": {
+            "points": exact(pts), "root": exact(root), "heading": float(heading),
+            "toPoints": out7(feat.to_root_space_points(pts, root, h)),
+            "toDirections": out7(feat.to_root_space_directions(pts, h)),
+            "fromPoints": out7(feat.from_root_space_points(pts, root, h)),
+            "fromDirections": out7(feat.from_root_space_directions(pts, h)),
+        },
+        "blocks": {
+            "root": exact(root), "heading": float(heading),
+            "keyRoots": exact(key_roots), "keyHeadings": exact(key_headings),
+            "trajectory": out7(feat.trajectory_block(key_roots, key_headings, root, h)),
+            "keyPositions": exact(key_pos),
+            "keyJoints": out7(feat.key_joints_block(key_pos, root, h)),
+            "poseFrame": t,
+            "pose": out7(feat.pose_block(*pose_args, root, h)),
+            "rootUpdates": [{"args": [r[0], r[1], hd, n[0], n[1], nh],
+                             "expected": out7(feat.root_update(np.array(r), np.array(hd), np.array(n), np.array(nh)))}
+                            for r, hd, n, nh in updates],
+            "footContacts": out7(contacts_cases),
+            "footCases": [{"positions": exact(n), "previous": exact(b), "expected": out7(feat.foot_contacts(n, b))}
+                          for n, b in foot_pairs],
+        },
+        "followerInput": out7(feat.follower_input(lead, follow, frames)),
+        "leaderInput": out7(feat.leader_input(follow, lead, frames)),
+        "followerOutput": out7(feat.output_features(follow, frames)),
+        "leaderOutput": out7(feat.output_features(lead, frames)),
+        "followerIntention": out7(feat.intention_target(lead, follow, frames)),
+        "leaderIntention": out7(feat.intention_target(follow, lead, frames)),
+    }
+
+
+# ---------------------------------------------------------------- rollout
+
+def start_pose_of(track: Track, t: int, fps: float = 30.0) -> dict:
+    """A start pose like training/export.py's: a pose block (own root space), 4 decimals."""
+    pose = feat.pose_block(track.positions[t], track.positions[t - 1], track.rotations[t],
+                           track.root[t], track.heading[t], fps).reshape(feat.N_JOINTS, 12)
+    return {"hip": np.round(pose[0, :3], 4).tolist(), "forward": np.round(pose[:, 6:9], 4).tolist(),
+            "up": np.round(pose[:, 9:12], 4).tolist()}
+
+
+def dancer_state(d: ro.Dancer) -> dict:
+    """What a step changes: the current frame, the frame before and the oldest (the shift), the
+    root path with its plan, contacts, intention."""
+    t, now = d.track, ro.NOW
+    return {"positionsNow": out7(t.positions[now]), "positionsBefore": out7(t.positions[now - 1]),
+            "positionsFirst": out7(t.positions[0]), "rotationsNow": out7(t.rotations[now]),
+            "root": out7(t.root), "heading": out7(t.heading), "contacts": out7(d.contacts),
+            "resets": d.resets, "intention": None if d.intention is None else out7(d.intention)}
+
+
+def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_offsets, follow_offsets) -> dict:
+    vectors_f = np.round(rng.normal(size=(5, 3)), 6)
+    vectors_u = np.round(rng.normal(size=(5, 3)), 6)
+    start_pose = {"leader": start_pose_of(lead, 30), "follower": start_pose_of(follow, 32)}  # rotations exist there
+    manifest = {"skeleton": {"offsets": {"leader": lead_offsets.tolist(), "follower": follow_offsets.tolist()}},
+                "startPose": start_pose}
+    started = ro.start_duet(manifest)
+
+    def window(track: Track) -> Track:   # frames 0..60 of a procedural track: NOW is its frame 30
+        n = ro.TRACK_FRAMES
+        return Track(track.positions[:n].copy(), track.rotations[:n].copy(), track.root[:n].copy(),
+                     track.heading[:n].copy())
+
+    def plausible(track: Track, t: int) -> np.ndarray:
+        """An output a model could give: the true next frame, a little noisy, in float32."""
+        o = feat.output_features(track, np.array([t]))[0]
+        o = o + rng.normal(0, 0.01, o.shape)
+        o[feat.block_slices(feat.OUTPUT_LAYOUT)["contacts"]] = rng.uniform(0, 1, 2)
+        return o.astype(np.float32).astype(np.float64)
+
+    duet = ro.Duet(ro.Dancer(lead_offsets, window(lead)), ro.Dancer(follow_offsets, window(follow)), start_pose)
+    duet.steering.velocity = np.array([0.3, -0.2])
+    steps = []
+    scenarios = [
+        # (stick, what to do to the leader output, ... to the follower output)
+        ([0.6, -0.5], None, None),
+        ([0.0, 0.0], "nan", None),
+        ([0.2, 0.9], None, "jump"),
+        ([1.0, 1.0], "far", None),
+    ]
+    for i, (stick, lead_bad, follow_bad) in enumerate(scenarios):
+        before_velocity = duet.steering.velocity.copy()
+        ro.steer_plan(duet.leader, duet.steering, np.array(stick, float))
+        planned_root = duet.leader.track.root.copy()
+        xl, xf = ro.step_inputs(duet)
+        ol, of = plausible(lead, 30 + i % 2), plausible(follow, 30 + i % 2)
+        fi = feat.intention_target(lead, follow, np.array([30]))[0].astype(np.float32).astype(np.float64)
+        spoil = {"nan": (50, float("nan")), "far": (117 + 12 * 7, 3.5), "jump": (0, 1.2)}  # lHand x
+        lead_out, follow_out = ol.copy(), of.copy()
+        for out, bad in ((lead_out, lead_bad), (follow_out, follow_bad)):
+            if bad:
+                k, v = spoil[bad]
+                out[k] = v
+        absurd = [ro.output_is_absurd(duet.leader, lead_out), ro.output_is_absurd(duet.follower, follow_out)]
+        ro.finish_step(duet, lead_out, follow_out, fi)
+        steps.append({
+            "stick": stick, "steeringBefore": exact(before_velocity),
+            "steeringAfter": out7(duet.steering.velocity), "plannedLeaderRoot": out7(planned_root),
+            "leaderInput": out7(xl), "followerInput": out7(xf),
+            "leaderOutput": [None if not np.isfinite(v) else float(v) for v in lead_out],
+            "followerOutput": [float(v) for v in follow_out],
+            "followerIntention": exact(fi), "absurd": absurd,
+            "leader": dancer_state(duet.leader), "follower": dancer_state(duet.follower),
+        })
+    return {
+        "NOW": ro.NOW, "TRACK_FRAMES": ro.TRACK_FRAMES,
+        "rotationsFromVectors": {"forward": exact(vectors_f), "up": exact(vectors_u),
+                                 "expected": out7(ro.rotations_from_vectors(vectors_f, vectors_u))},
+        "offsets": {"leader": exact(lead_offsets), "follower": exact(follow_offsets)},
+        "startPose": start_pose,
+        "startDuet": {"leader": dancer_state(started.leader), "follower": dancer_state(started.follower)},
+        "steps": steps,
+    }
+
+
+def build() -> dict[str, dict]:
+    rng = np.random.default_rng(SEED)
+    bvh = bvh_fixture(rng)
+    leader, follower = procedural_pair(rng)
+    lead, follow = rounded_track(leader), rounded_track(follower)
+    return {
+        "bvh": bvh,
+        "features": features_fixture(rng, lead, follow),
+        "rollout": rollout_fixture(rng, lead, follow, leader.offsets, follower.offsets),
+    }
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--out", default=str(OUT_DIR))
+    args = ap.parse_args(argv)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    for name, data in build().items():
+        path = out / f"{name}.json"
+        path.write_text(json.dumps(data, separators=(",", ":"), allow_nan=False) + "\n")
+        print(f"{path}: {path.stat().st_size / 1024:.0f} KiB")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

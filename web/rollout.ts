@@ -1,0 +1,521 @@
+// The duet at run time: TypeScript mirror of training/rollout.py, and the page's Simulation.
+//
+// Each dancer is a `Track` of 61 frames: 30 past, the current frame at index NOW = 30, and 30 slots
+// of planned future of which only the key frames (NOW+5, ..., NOW+30) are filled. The features are
+// the very functions training used, read at frame NOW, so training and run time cannot differ.
+//
+// One step: the leader's plan is its last predicted future bent toward the user's steering; both
+// models read the current state (the follower sees that plan as the leader's future); both outputs
+// move their dancer one frame on. Absurd output (non-finite, a joint > 3 m from the root, a root
+// jump > 1 m) resets that dancer beside its partner and is counted, never drawn.
+//
+// Differences from Python, none of which changes a number: a duet has a list of followers (two in
+// compare mode, each reacting to the same leader; the leader reacts to the first); outputs are
+// read at an offset so batched (ghost) results need no copies; scratch arrays are preallocated.
+
+import {
+  FUTURE_OFFSETS, HISTORY, INPUT_SIZE, INTENTION_SIZE, KEYS, N_JOINTS, OUTPUT_LAYOUT, OUTPUT_SIZE, type Out, Track,
+  blockSlices, followerInput, fromRootSpaceDirections, fromRootSpacePoints, leaderInput, wrapAngle,
+} from './features';
+import { FPS, KEY_JOINTS, type Motion, PARENTS, forwardKinematicsReduced } from './skeleton';
+import { FootLock } from './footik';
+import { LeaderPlayback } from './playback';
+import { StepTimer } from './timing';
+import type { Policy } from './policy';
+import type { CreateSimulation, DancerView, Simulation, SimulationOptions, Steer } from './types';
+
+export const NOW = HISTORY;
+export const TRACK_FRAMES = 2 * HISTORY + 1;
+const OUT = blockSlices(OUTPUT_LAYOUT);
+
+export const MAX_SPEED = 1.2; // m/s of the steered path at full stick
+export const STEER_HALFLIFE = 0.25; // s for the steered velocity to get halfway to the stick's
+export const MAX_JOINT_DISTANCE = 3.0; // m from the root: beyond this the output is absurd
+export const MAX_ROOT_JUMP = 1.0; // m in one step
+export const START_DISTANCE = 0.8; // m between the partners at the start and after a reset
+
+/**
+ * `count` forward (R ez) and up (R ey) vectors -> orthonormal row-major 3x3 matrices at out[at..]
+ * (Gram-Schmidt on forward): columns x = up × z, y = z × x, z = forward.
+ */
+export function rotationsFromVectors(
+  forward: ArrayLike<number>, up: ArrayLike<number>, count: number, out: Float64Array, at = 0,
+): void {
+  for (let i = 0; i < count; i++) {
+    const f0 = forward[3 * i], f1 = forward[3 * i + 1], f2 = forward[3 * i + 2];
+    const fn = Math.max(Math.sqrt(f0 * f0 + f1 * f1 + f2 * f2), 1e-9);
+    const z0 = f0 / fn, z1 = f1 / fn, z2 = f2 / fn;
+    const u0 = up[3 * i], u1 = up[3 * i + 1], u2 = up[3 * i + 2];
+    let x0 = u1 * z2 - u2 * z1, x1 = u2 * z0 - u0 * z2, x2 = u0 * z1 - u1 * z0;
+    const xn = Math.max(Math.sqrt(x0 * x0 + x1 * x1 + x2 * x2), 1e-9);
+    x0 /= xn;
+    x1 /= xn;
+    x2 /= xn;
+    const y0 = z1 * x2 - z2 * x1, y1 = z2 * x0 - z0 * x2, y2 = z0 * x1 - z1 * x0;
+    const o = at + 9 * i;
+    out[o] = x0; out[o + 1] = y0; out[o + 2] = z0;
+    out[o + 3] = x1; out[o + 4] = y1; out[o + 5] = z1;
+    out[o + 6] = x2; out[o + 7] = y2; out[o + 8] = z2;
+  }
+}
+
+/** A neutral standing pose in the dancer's own root space (manifest.startPose[role]). */
+export interface StartPose {
+  hip: number[];
+  /** 17 × (x, y, z) */
+  forward: number[][];
+  /** 17 × (x, y, z) */
+  up: number[][];
+}
+
+export class Dancer {
+  readonly track = Track.empty(TRACK_FRAMES);
+  /** Left, right foot in 0..1, as the model last said. */
+  readonly contacts = new Float64Array(2);
+  /** [6 × 5 × 3] world: what this dancer expects of its partner (null until a model says). */
+  intention: Float64Array | null = null;
+  resets = 0;
+
+  constructor(readonly offsets: Float64Array) {}
+
+  get rootX(): number {
+    return this.track.root[2 * NOW];
+  }
+
+  get rootZ(): number {
+    return this.track.root[2 * NOW + 1];
+  }
+
+  get heading(): number {
+    return this.track.heading[NOW];
+  }
+
+  /** The current joint positions [17 × 3] (a view into the track). */
+  get positions(): Float64Array {
+    return this.track.positions.subarray(NOW * 51, NOW * 51 + 51);
+  }
+
+  /** Make this dancer an exact copy of `other` (same offsets assumed): for trying outputs out. */
+  copyFrom(other: Dancer): void {
+    this.track.positions.set(other.track.positions);
+    this.track.rotations.set(other.track.rotations);
+    this.track.root.set(other.track.root);
+    this.track.heading.set(other.track.heading);
+    this.contacts.set(other.contacts);
+  }
+}
+
+const poseVectors = new Float64Array(N_JOINTS * 3 * 2);
+const poseRotations = new Float64Array(N_JOINTS * 9);
+const turnedRotations = new Float64Array(N_JOINTS * 9);
+const hipScratch = new Float64Array(3);
+const hipWorld = new Float64Array(3);
+
+/** Fill the whole track with one still pose: the start pose at this root and heading. */
+function standStill(d: Dancer, pose: StartPose, rootX: number, rootZ: number, heading: number): void {
+  for (let j = 0; j < N_JOINTS; j++) {
+    for (let k = 0; k < 3; k++) {
+      poseVectors[3 * j + k] = pose.forward[j][k];
+      poseVectors[51 + 3 * j + k] = pose.up[j][k];
+    }
+  }
+  rotationsFromVectors(poseVectors, poseVectors.subarray(51), N_JOINTS, poseRotations);
+  // R_y(heading) · R, column by column (rotation_y in Python).
+  const c = Math.cos(heading);
+  const s = Math.sin(heading);
+  for (let j = 0; j < N_JOINTS; j++) {
+    for (let k = 0; k < 3; k++) {
+      const x = poseRotations[9 * j + k], y = poseRotations[9 * j + 3 + k], z = poseRotations[9 * j + 6 + k];
+      turnedRotations[9 * j + k] = c * x + s * z;
+      turnedRotations[9 * j + 3 + k] = y;
+      turnedRotations[9 * j + 6 + k] = -s * x + c * z;
+    }
+  }
+  hipScratch[0] = pose.hip[0];
+  hipScratch[1] = pose.hip[1];
+  hipScratch[2] = pose.hip[2];
+  fromRootSpacePoints(hipScratch, 0, 1, rootX, rootZ, heading, hipWorld, 0);
+  const t = d.track;
+  forwardKinematicsReduced(d.offsets, hipWorld, 0, turnedRotations, 0, t.positions, 0);
+  for (let f = 1; f < TRACK_FRAMES; f++) t.positions.copyWithin(f * 51, 0, 51);
+  for (let f = 0; f < TRACK_FRAMES; f++) {
+    t.rotations.set(turnedRotations, f * 153);
+    t.root[2 * f] = rootX;
+    t.root[2 * f + 1] = rootZ;
+    t.heading[f] = heading;
+  }
+}
+
+/** A dancer standing still in the start pose, with a still history and a still plan. */
+export function startDancer(offsets: ArrayLike<number>, startPose: StartPose, rootX: number, rootZ: number, heading: number): Dancer {
+  const d = new Dancer(Float64Array.from(offsets));
+  standStill(d, startPose, rootX, rootZ, heading);
+  return d;
+}
+
+/** Output O (raw, 323, read at output[at..]) a dancer must not take: non-finite, a joint too far, a jump. */
+export function outputIsAbsurd(_d: Dancer, output: ArrayLike<number>, at = 0): boolean {
+  for (let i = 0; i < OUTPUT_SIZE; i++) if (!Number.isFinite(output[at + i])) return true;
+  let farthest = 0;
+  for (let j = 0; j < N_JOINTS; j++) {
+    const p = at + OUT.pose.start + 12 * j;
+    farthest = Math.max(farthest, Math.sqrt(output[p] ** 2 + output[p + 1] ** 2 + output[p + 2] ** 2));
+  }
+  const r = at + OUT.root_update.start;
+  const jump = Math.sqrt(output[r] ** 2 + output[r + 1] ** 2);
+  return farthest > MAX_JOINT_DISTANCE || jump > MAX_ROOT_JUMP;
+}
+
+const rootLocal = new Float64Array(3);
+const rootWorld = new Float64Array(3);
+const futureLocal = new Float64Array(KEYS * 3);
+const futureWorld = new Float64Array(KEYS * 3);
+
+/** Move the dancer one frame on with a model output O (raw, 323, read at output[at..]). */
+export function applyOutput(d: Dancer, output: ArrayLike<number>, at = 0): void {
+  const t = d.track;
+  const r = at + OUT.root_update.start;
+  rootLocal[0] = output[r];
+  rootLocal[1] = 0;
+  rootLocal[2] = output[r + 1];
+  fromRootSpacePoints(rootLocal, 0, 1, t.root[2 * NOW], t.root[2 * NOW + 1], t.heading[NOW], rootWorld, 0);
+  const rootX = rootWorld[0];
+  const rootZ = rootWorld[2];
+  const heading = wrapAngle(t.heading[NOW] + output[r + 2]);
+  // Shift the past one frame back; the current slot gets the new frame.
+  t.shiftPast(NOW);
+  t.root[2 * NOW] = rootX;
+  t.root[2 * NOW + 1] = rootZ;
+  t.heading[NOW] = heading;
+  const pose = at + OUT.pose.start;
+  for (let j = 0; j < N_JOINTS; j++) {
+    for (let k = 0; k < 3; k++) {
+      poseVectors[3 * j + k] = output[pose + 12 * j + 6 + k];
+      poseVectors[51 + 3 * j + k] = output[pose + 12 * j + 9 + k];
+    }
+  }
+  fromRootSpaceDirections(poseVectors, 0, 2 * N_JOINTS, heading, poseVectors, 0); // forward and up, in place
+  rotationsFromVectors(poseVectors, poseVectors.subarray(51), N_JOINTS, t.rotations, NOW * 153);
+  hipScratch[0] = output[pose];
+  hipScratch[1] = output[pose + 1];
+  hipScratch[2] = output[pose + 2];
+  fromRootSpacePoints(hipScratch, 0, 1, rootX, rootZ, heading, hipWorld, 0);
+  forwardKinematicsReduced(d.offsets, hipWorld, 0, t.rotations, NOW * 153, t.positions, NOW * 51);
+  // The predicted future root path becomes the plan (the leader's is bent by steering later).
+  const future = at + OUT.trajectory_future.start;
+  for (let k = 0; k < KEYS; k++) {
+    futureLocal[3 * k] = output[future + 4 * k];
+    futureLocal[3 * k + 1] = 0;
+    futureLocal[3 * k + 2] = output[future + 4 * k + 1];
+  }
+  fromRootSpacePoints(futureLocal, 0, KEYS, rootX, rootZ, heading, futureWorld, 0);
+  for (let k = 0; k < KEYS; k++) {
+    t.root[2 * (NOW + FUTURE_OFFSETS[k])] = futureWorld[3 * k];
+    t.root[2 * (NOW + FUTURE_OFFSETS[k]) + 1] = futureWorld[3 * k + 2];
+    futureLocal[3 * k] = output[future + 4 * k + 2];
+    futureLocal[3 * k + 2] = output[future + 4 * k + 3];
+  }
+  fromRootSpaceDirections(futureLocal, 0, KEYS, heading, futureWorld, 0);
+  for (let k = 0; k < KEYS; k++) t.heading[NOW + FUTURE_OFFSETS[k]] = Math.atan2(futureWorld[3 * k], futureWorld[3 * k + 2]);
+  const c = at + OUT.contacts.start;
+  d.contacts[0] = Math.min(1, Math.max(0, output[c]));
+  d.contacts[1] = Math.min(1, Math.max(0, output[c + 1]));
+}
+
+/** Recover a dancer that produced absurd output: stand it in front of its partner, facing it. */
+export function resetBeside(d: Dancer, partner: Dancer, startPose: StartPose): void {
+  const h = partner.heading;
+  const rootX = partner.rootX + START_DISTANCE * Math.sin(h);
+  const rootZ = partner.rootZ + START_DISTANCE * Math.cos(h);
+  standStill(d, startPose, rootX, rootZ, h + Math.PI);
+  d.contacts.fill(0);
+  d.resets += 1;
+}
+
+/** The user's stick (world x, z; length <= 1) turned into a smooth velocity for the plan. */
+export class Steering {
+  readonly velocity = new Float64Array(2);
+
+  update(stickX: number, stickZ: number, dt = 1 / FPS): void {
+    const decay = 0.5 ** (dt / STEER_HALFLIFE);
+    const tx = stickX * MAX_SPEED;
+    const tz = stickZ * MAX_SPEED;
+    this.velocity[0] = tx + (this.velocity[0] - tx) * decay;
+    this.velocity[1] = tz + (this.velocity[1] - tz) * decay;
+  }
+}
+
+/**
+ * Bend the leader's planned future root path toward the stick.
+ *
+ * With no stick, the plan is the leader's own last prediction (it dances on its own). With the
+ * stick held, each key moves toward where the smoothed steering velocity would carry the root,
+ * in proportion to how far the stick is pushed.
+ */
+export function steerPlan(leader: Dancer, steering: Steering, stickX: number, stickZ: number): void {
+  steering.update(stickX, stickZ);
+  const weight = Math.min(1, Math.sqrt(stickX * stickX + stickZ * stickZ));
+  if (weight <= 0) return;
+  const root = leader.track.root;
+  for (const off of FUTURE_OFFSETS) {
+    const k = 2 * (NOW + off);
+    const targetX = root[2 * NOW] + (steering.velocity[0] * off) / FPS;
+    const targetZ = root[2 * NOW + 1] + (steering.velocity[1] * off) / FPS;
+    root[k] += weight * (targetX - root[k]);
+    root[k + 1] += weight * (targetZ - root[k + 1]);
+  }
+}
+
+export interface Duet {
+  leader: Dancer;
+  /** One, or two in compare mode; the leader reacts to the first. */
+  followers: Dancer[];
+  startPose: { leader: StartPose; follower: StartPose };
+  steering: Steering;
+  frame: number;
+}
+
+/** The parts of manifest.json a duet starts from. */
+export interface DuetManifest {
+  skeleton: { offsets: { leader: number[][]; follower: number[][] } };
+  startPose: unknown;
+}
+
+/** Still T-ish rest pose (all rotations identity), ankles 8 cm up: for manifests without a start pose. */
+export function restStartPose(offsets: number[][]): StartPose {
+  const y = new Float64Array(N_JOINTS);
+  let lowest = 0;
+  for (let j = 1; j < N_JOINTS; j++) {
+    y[j] = y[PARENTS[j]] + offsets[j][1];
+    lowest = Math.min(lowest, y[j]);
+  }
+  return {
+    hip: [0, 0.08 - lowest, 0],
+    forward: Array.from({ length: N_JOINTS }, () => [0, 0, 1]),
+    up: Array.from({ length: N_JOINTS }, () => [0, 1, 0]),
+  };
+}
+
+function isStartPose(value: unknown): value is StartPose {
+  const p = value as StartPose | undefined;
+  const rows = (a: unknown) => Array.isArray(a) && a.length === N_JOINTS && a.every((r) => Array.isArray(r) && r.length === 3);
+  return !!p && Array.isArray(p.hip) && p.hip.length === 3 && rows(p.forward) && rows(p.up);
+}
+
+/** Both partners standing still, 0.8 m apart and facing each other (leader at the origin facing +Z). */
+export function startDuet(manifest: DuetManifest, followerCount = 1): Duet {
+  const offsets = manifest.skeleton.offsets;
+  const poses = (manifest.startPose ?? {}) as Record<string, unknown>;
+  const startPose = {
+    leader: isStartPose(poses.leader) ? poses.leader : restStartPose(offsets.leader),
+    follower: isStartPose(poses.follower) ? poses.follower : restStartPose(offsets.follower),
+  };
+  const leader = startDancer(offsets.leader.flat(), startPose.leader, 0, 0, 0);
+  const followers = Array.from({ length: followerCount }, () =>
+    startDancer(offsets.follower.flat(), startPose.follower, 0, START_DISTANCE, Math.PI));
+  return { leader, followers, startPose, steering: new Steering(), frame: 0 };
+}
+
+/** Both models' inputs at NOW: the leader's (partner = first follower) and each follower's. */
+export function stepInputs(duet: Duet, leaderOut: Out | null, followerOuts: Out[]): void {
+  if (leaderOut) leaderInput(duet.followers[0].track, duet.leader.track, NOW, leaderOut);
+  duet.followers.forEach((f, i) => followerInput(duet.leader.track, f.track, NOW, followerOuts[i]));
+}
+
+const intentionLocal = new Float64Array(INTENTION_SIZE);
+
+/**
+ * Move everyone one frame on. A null leader output means the leader was moved already (playback).
+ * Each absurd output resets its dancer beside its partner instead.
+ */
+export function finishStep(
+  duet: Duet, leaderOutput: ArrayLike<number> | null, followerOutputs: ArrayLike<number>[],
+  followerIntentions: (ArrayLike<number> | null)[] = [],
+): void {
+  if (leaderOutput) {
+    if (outputIsAbsurd(duet.leader, leaderOutput)) resetBeside(duet.leader, duet.followers[0], duet.startPose.leader);
+    else applyOutput(duet.leader, leaderOutput);
+  }
+  duet.followers.forEach((f, i) => {
+    if (outputIsAbsurd(f, followerOutputs[i])) resetBeside(f, duet.leader, duet.startPose.follower);
+    else applyOutput(f, followerOutputs[i]);
+    const intention = followerIntentions[i];
+    if (intention) {
+      for (let k = 0; k < INTENTION_SIZE; k++) intentionLocal[k] = intention[k];
+      f.intention ??= new Float64Array(INTENTION_SIZE);
+      fromRootSpacePoints(intentionLocal, 0, KEYS * KEY_JOINTS.length, f.rootX, f.rootZ, f.heading, f.intention, 0);
+    }
+  });
+  duet.frame += 1;
+}
+
+// =================================================================================================
+// The page's Simulation: policies in, DancerViews out.
+
+/** Per dancer: what the page draws, kept up to date from the dancer after every step. */
+class View implements DancerView {
+  root: [number, number] = [0, 0];
+  heading = 0;
+  readonly positions = new Float32Array(N_JOINTS * 3);
+  readonly future = new Float32Array(KEYS * 2);
+  intention?: Float32Array;
+  readonly feet = new FootLock();
+  private resets = -1;
+
+  constructor(withIntention: boolean) {
+    if (withIntention) this.intention = new Float32Array(INTENTION_SIZE);
+  }
+
+  update(d: Dancer, jumped = false): void {
+    this.root[0] = d.rootX;
+    this.root[1] = d.rootZ;
+    this.heading = d.heading;
+    const t = d.track;
+    for (let i = 0; i < 51; i++) this.positions[i] = t.positions[NOW * 51 + i];
+    for (let k = 0; k < KEYS; k++) {
+      this.future[2 * k] = t.root[2 * (NOW + FUTURE_OFFSETS[k])];
+      this.future[2 * k + 1] = t.root[2 * (NOW + FUTURE_OFFSETS[k]) + 1];
+    }
+    if (this.intention && d.intention) this.intention.set(d.intention);
+    // A dancer that was just placed anew must not drag its old foot locks along.
+    if (jumped || d.resets !== this.resets) this.feet.clear();
+    this.resets = d.resets;
+    this.feet.apply(this.positions, d.contacts, d.heading);
+  }
+}
+
+export class DuetSimulation implements Simulation {
+  readonly leader: DancerView;
+  readonly followers: DancerView[];
+  duet: Duet;
+  private readonly leaderView: View;
+  private readonly followerViews: View[];
+  private readonly leaderPolicy: Policy;
+  private readonly followerPolicies: Policy[];
+  private readonly followerInputs: Float32Array[];
+  // Own copies of each model's result: two roles may never share a Policy's result arrays.
+  private readonly leaderOutput = new Float32Array(OUTPUT_SIZE);
+  private readonly followerOutputs: Float32Array[];
+  private readonly followerIntentions: (Float32Array | null)[];
+  private readonly timer = new StepTimer(300);
+  private playback: LeaderPlayback | null = null;
+  private temperature: number;
+  private readonly ghost: Dancer;
+  private readonly ghostPoses: Float32Array[] = [];
+
+  constructor(private readonly options: SimulationOptions) {
+    const { manifest, leader, followers } = options;
+    if (followers.length < 1) throw new RangeError('a duet needs at least one follower');
+    this.leaderPolicy = leader;
+    this.followerPolicies = followers;
+    this.followerInputs = followers.map((p) => p.input);
+    this.temperature = manifest.defaultTemperature ?? 0.5;
+    this.duet = startDuet(manifest, followers.length);
+    this.leaderView = new View(false);
+    this.followerViews = followers.map((p) => new View(p.hasIntention));
+    this.leader = this.leaderView;
+    this.followers = this.followerViews;
+    this.followerOutputs = followers.map(() => new Float32Array(OUTPUT_SIZE));
+    this.followerIntentions = followers.map((p) => (p.hasIntention ? new Float32Array(INTENTION_SIZE) : null));
+    this.ghost = new Dancer(this.duet.followers[0].offsets);
+    this.updateViews(true);
+  }
+
+  reset(): void {
+    this.duet = startDuet(this.options.manifest, this.followerPolicies.length);
+    this.playback?.start(this.duet.leader.track);
+    this.timer.clear();
+    this.updateViews(true);
+  }
+
+  async step(steer: Steer, temperature: number): Promise<void> {
+    const started = performance.now();
+    this.temperature = temperature;
+    const duet = this.duet;
+    const playing = this.playback !== null;
+    if (!playing) steerPlan(duet.leader, duet.steering, steer.active ? steer.x : 0, steer.active ? steer.z : 0);
+    stepInputs(duet, playing ? null : this.leaderPolicy.input, this.followerInputs);
+    if (!playing) {
+      const result = await this.leaderPolicy.run(temperature);
+      this.leaderOutput.set(result.output);
+    }
+    for (let i = 0; i < this.followerPolicies.length; i++) {
+      const result = await this.followerPolicies[i].run(temperature);
+      this.followerOutputs[i].set(result.output);
+      if (result.intention) this.followerIntentions[i]?.set(result.intention);
+    }
+    if (this.playback) this.playback.advance(duet.leader.track, duet.leader.contacts);
+    finishStep(duet, playing ? null : this.leaderOutput, this.followerOutputs, this.followerIntentions);
+    this.updateViews(false);
+    this.timer.add(performance.now() - started);
+  }
+
+  /**
+   * k alternative next poses of the first follower: its model run once on k copies of its current
+   * input (each sample draws its own noise), each output applied to a scratch copy of the dancer.
+   */
+  async ghosts(k: number): Promise<Float32Array[]> {
+    if (k <= 0) return [];
+    const policy = this.followerPolicies[0];
+    const follower = this.duet.followers[0];
+    const input = policy.batchInput(k);
+    followerInput(this.duet.leader.track, follower.track, NOW, input, 0);
+    for (let i = 1; i < k; i++) input.copyWithin(i * INPUT_SIZE, 0, INPUT_SIZE);
+    const { output } = await policy.runBatch(k, this.temperature);
+    while (this.ghostPoses.length < k) this.ghostPoses.push(new Float32Array(N_JOINTS * 3));
+    for (let i = 0; i < k; i++) {
+      this.ghost.copyFrom(follower);
+      if (!outputIsAbsurd(this.ghost, output, i * OUTPUT_SIZE)) applyOutput(this.ghost, output, i * OUTPUT_SIZE);
+      const p = this.ghost.track.positions;
+      for (let n = 0; n < 51; n++) this.ghostPoses[i][n] = p[NOW * 51 + n];
+    }
+    return this.ghostPoses.slice(0, k);
+  }
+
+  stepMs(): { median: number; p95: number } {
+    return this.timer.summary();
+  }
+
+  /**
+   * Drive the leader from a recorded motion (30 fps, e.g. motionFromBvhText) instead of the leader
+   * model, or go back to the model with null. The recording starts where the leader stands now,
+   * facing where it faces, and loops.
+   */
+  setLeaderPlayback(motion: Motion | null): void {
+    if (!motion) {
+      this.playback = null;
+      return;
+    }
+    const playback = new LeaderPlayback(motion);
+    playback.takeOver(this.duet.leader.track);
+    this.playback = playback;
+  }
+
+  /** Whether the leader follows a recording; the recording's current frame and length. */
+  get leaderPlayback(): { frame: number; frames: number } | null {
+    return this.playback ? { frame: this.playback.frame, frames: this.playback.frames } : null;
+  }
+
+  private updateViews(jumped: boolean): void {
+    const leader = this.duet.leader;
+    this.leaderView.update(leader, jumped);
+    this.duet.followers.forEach((f, i) => {
+      const view = this.followerViews[i];
+      view.update(f, jumped);
+      // Before the first prediction: the leader's key joints where they are now, at every key.
+      if (view.intention && !f.intention) {
+        for (let k = 0; k < KEYS; k++) {
+          KEY_JOINTS.forEach((j, n) => {
+            for (let a = 0; a < 3; a++) view.intention![(k * KEY_JOINTS.length + n) * 3 + a] = leader.track.positions[NOW * 51 + 3 * j + a];
+          });
+        }
+      }
+    });
+  }
+}
+
+export function createDuetSimulation(options: SimulationOptions): DuetSimulation {
+  return new DuetSimulation(options);
+}
+
+export const createSimulation: CreateSimulation = createDuetSimulation;
