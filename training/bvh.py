@@ -12,6 +12,9 @@ from pathlib import Path
 import numpy as np
 
 
+VALID_CHANNELS = {a + kind for a in "XYZ" for kind in ("position", "rotation")}
+
+
 class BvhError(ValueError):
     """The file is not a BVH we can read. The message is meant for a user, one line."""
 
@@ -43,6 +46,8 @@ def parse_bvh(text: str, source: str = "<string>") -> Bvh:
     offsets: list[list[float]] = []
     channels: list[list[str]] = []
     stack: list[int] = []
+    if "MOTION" not in tokens:
+        raise BvhError(f"{source}: malformed BVH (no MOTION section)")
     i = 1
     try:
         while tokens[i] != "MOTION":
@@ -72,6 +77,9 @@ def parse_bvh(text: str, source: str = "<string>") -> Bvh:
             elif tok == "CHANNELS":
                 n = int(tokens[i + 1])
                 channels[stack[-1]] = tokens[i + 2:i + 2 + n]
+                bad = [c for c in channels[stack[-1]] if c not in VALID_CHANNELS]
+                if bad:
+                    raise BvhError(f"{source}: joint '{names[stack[-1]]}' has unknown channel {bad[0]!r}")
                 i += 2 + n
             else:
                 raise BvhError(f"{source}: unexpected token {tok!r} in HIERARCHY")

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from .bvh import BvhError, read_bvh
-from .features import (Track, follower_input, intention_target, leader_input, output_features,
+from .features import (HISTORY, Track, follower_input, intention_target, leader_input, output_features,
                        valid_frames)
 from .skeleton import FPS, Motion, mirror_motion, reduce_bvh, resample
 
@@ -88,6 +88,11 @@ def load_pair(take: Take) -> tuple[Motion, Motion]:
                         f"{take.follower_path.name} {follow_bvh.frames})")
     if abs(lead_bvh.frame_time - follow_bvh.frame_time) > 1e-6:
         raise DataError(f"take {take.name}: partners have different frame times")
+    # A sample needs 1 s of past, the next frame and 1 s of future after it.
+    min_seconds = (2 * HISTORY + 2) / FPS
+    if lead_bvh.frames * lead_bvh.frame_time < min_seconds:
+        raise DataError(f"take {take.name}: {lead_bvh.frames * lead_bvh.frame_time:.2f} s is too short "
+                        f"(a sample needs {min_seconds:.2f} s)")
     try:
         return (reduce_bvh(lead_bvh, str(take.leader_path)),
                 reduce_bvh(follow_bvh, str(take.follower_path)))

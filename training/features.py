@@ -97,13 +97,13 @@ def trajectory_block(key_roots, key_headings, root, heading):
     fwd = np.stack([np.sin(key_headings), np.zeros_like(key_headings), np.cos(key_headings)], -1)
     fwd_local = to_root_space_directions(fwd, heading[..., None])
     block = np.stack([local[..., 0], local[..., 2], fwd_local[..., 0], fwd_local[..., 2]], -1)
-    return block.reshape(block.shape[:-2] + (-1,))
+    return block.reshape(block.shape[:-2] + (block.shape[-2] * 4,))
 
 
 def key_joints_block(key_positions, root, heading):
     """Key-joint positions [..., K, 5, 3] -> [..., K*5*3] in root space."""
     local = to_root_space_points(key_positions, root[..., None, None, :], heading[..., None, None])
-    return local.reshape(local.shape[:-3] + (-1,))
+    return local.reshape(local.shape[:-3] + (local.shape[-3] * local.shape[-2] * 3,))
 
 
 def pose_block(positions, previous_positions, rotations, root, heading, fps=FPS):
@@ -117,7 +117,7 @@ def pose_block(positions, previous_positions, rotations, root, heading, fps=FPS)
     fwd = to_root_space_directions(rotations[..., :, 2], h)
     up = to_root_space_directions(rotations[..., :, 1], h)
     block = np.concatenate([pos, vel, fwd, up], -1)
-    return block.reshape(block.shape[:-2] + (-1,))
+    return block.reshape(block.shape[:-2] + (block.shape[-2] * 12,))
 
 
 def root_update(root, heading, next_root, next_heading):

@@ -75,8 +75,12 @@ def load_split(data: str, split: str, role: str) -> dict[str, np.ndarray]:
     path = Path(data) / f"{split}.npz"
     if not path.exists():
         raise TrainError(f"{path} not found: run `python -m training.prepare --out {data}` first")
-    with np.load(path) as z:
-        arrays = {k: z[f"{role}_{k}"] for k in ("input", "output", "intention")}
+    try:
+        with np.load(path) as z:
+            arrays = {k: z[f"{role}_{k}"] for k in ("input", "output", "intention")}
+    except Exception as e:  # zipfile, pickle and key errors all mean the same thing here
+        raise TrainError(f"{path}: unreadable or not written by training.prepare "
+                         f"({e.__class__.__name__}); re-run training.prepare") from None
     sizes = {"input": feat.INPUT_SIZE, "output": feat.OUTPUT_SIZE, "intention": feat.INTENTION_SIZE}
     for k, n in sizes.items():
         if arrays[k].shape[1] != n:
@@ -89,9 +93,13 @@ def load_stats(data: str, role: str) -> dict[str, torch.Tensor]:
     path = Path(data) / "stats.npz"
     if not path.exists():
         raise TrainError(f"{path} not found: run `python -m training.prepare --out {data}` first")
-    with np.load(path) as z:
-        return {f"{k}_{s}": torch.from_numpy(z[f"{role}_{k}_{s}"])
-                for k in ("input", "output", "intention") for s in ("mean", "std")}
+    try:
+        with np.load(path) as z:
+            return {f"{k}_{s}": torch.from_numpy(z[f"{role}_{k}_{s}"])
+                    for k in ("input", "output", "intention") for s in ("mean", "std")}
+    except Exception as e:
+        raise TrainError(f"{path}: unreadable or not written by training.prepare "
+                         f"({e.__class__.__name__}); re-run training.prepare") from None
 
 
 def augment_control(x: torch.Tensor, cfg: TrainConfig, gen: torch.Generator) -> torch.Tensor:

@@ -1,0 +1,125 @@
+"""Shared fixtures for the Python tests.
+
+The CMU salsa takes are read from DUET_DATA (default ../shared/data/cmu-salsa next to the
+repository); tests that need them are skipped when the folder is absent. Everything derived from
+the data (copies, prepared arrays, checkpoints, ONNX files) is written under pytest's tmp folders,
+never into the repository.
+
+The expensive steps run once per session and are shared: prepare 3 short takes, smoke-train the
+shipped models on them, export those models.
+"""
+from __future__ import annotations
+
+import os
+import shutil
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+REPO = Path(__file__).resolve().parents[2]
+if str(REPO) not in sys.path:
+    sys.path.insert(0, str(REPO))
+
+DATA = Path(os.environ.get("DUET_DATA", REPO.parent / "shared" / "data" / "cmu-salsa")).resolve()
+# The three shortest clean-enough takes: 10 trains, 12 validates, 06 tests (see dataset.py).
+SMALL_TAKES = {"train": "10", "validation": "12", "test": "06"}
+# Frame counts at 120 fps, from the data README (an independent record of what the files hold).
+README_FRAMES = {"01": 2242, "02": 2101, "03": 1830, "04": 1871, "06": 1772, "07": 2071,
+                 "09": 2575, "10": 1197, "11": 2108, "12": 1690, "13": 2271, "15": 2140}
+
+
+def have_data() -> bool:
+    return all((DATA / f"{s}_{t}.bvh").is_file() for s in ("60", "61") for t in README_FRAMES)
+
+
+needs_data = pytest.mark.skipif(not have_data(), reason=f"CMU salsa data not found in {DATA} (set DUET_DATA)")
+
+
+def pytest_configure(config):
+    config.addinivalue_line("markers", "slow: takes more than a few seconds (still part of the suite)")
+
+
+def copy_takes(dst: Path, takes, data: Path = DATA) -> Path:
+    """Copy the lead and follow files of `takes` into dst (a tmp folder)."""
+    dst.mkdir(parents=True, exist_ok=True)
+    for t in takes:
+        for s in ("60", "61"):
+            shutil.copy(data / f"{s}_{t}.bvh", dst / f"{s}_{t}.bvh")
+    return dst
+
+
+# ---------------------------------------------------------------- real data in memory
+
+@pytest.fixture(scope="session")
+def real_bvh():
+    """The lead of take 10 (shortest take) as parsed BVH."""
+    if not have_data():
+        pytest.skip(f"CMU salsa data not found in {DATA}")
+    from training.bvh import read_bvh
+    return read_bvh(DATA / "60_10.bvh")
+
+
+@pytest.fixture(scope="session")
+def real_pair():
+    """Leader and follower Motion of take 10 at 120 fps."""
+    if not have_data():
+        pytest.skip(f"CMU salsa data not found in {DATA}")
+    from training.dataset import discover_takes, load_pair, select_takes
+    take = select_takes(discover_takes(DATA), ["10"])[0]
+    return load_pair(take)
+
+
+@pytest.fixture(scope="session")
+def real_tracks(real_pair):
+    """(leader Track, follower Track) of take 10 at 30 fps, phase 0, as training builds them."""
+    from training.dataset import pair_tracks
+    return pair_tracks(*real_pair)
+
+
+# ---------------------------------------------------------------- prepared / trained / exported
+
+@pytest.fixture(scope="session")
+def data3(tmp_path_factory):
+    if not have_data():
+        pytest.skip(f"CMU salsa data not found in {DATA}")
+    return copy_takes(tmp_path_factory.mktemp("data3"), SMALL_TAKES.values())
+
+
+@pytest.fixture(scope="session")
+def prepared3(data3, tmp_path_factory):
+    """training.prepare on 3 takes (all phases, mirrored train): train 10, validation 12, test 06."""
+    from training.prepare import main
+    out = tmp_path_factory.mktemp("prepared3")
+    rc = main(["--data", str(data3), "--out", str(out), "--validation", SMALL_TAKES["validation"],
+               "--test", SMALL_TAKES["test"]])
+    assert rc == 0
+    return out
+
+
+@pytest.fixture(scope="session")
+def smoke_runs(prepared3, tmp_path_factory):
+    """`training.train --all --smoke` on the 3-take data: one folder per shipped model."""
+    from training.train import main
+    out = tmp_path_factory.mktemp("runs")
+    rc = main(["--all", "--smoke", "--data", str(prepared3), "--out", str(out)])
+    assert rc == 0
+    return out
+
+
+@pytest.fixture(scope="session")
+def exported(smoke_runs, prepared3, data3, tmp_path_factory):
+    """`training.export` of the smoke models: int8 models + manifest in `models`, fp32 in `fp32`."""
+    from training.export import main
+    root = tmp_path_factory.mktemp("exported")
+    models, fp32 = root / "models", root / "fp32"
+    rc = main(["--runs", str(smoke_runs), "--prepared", str(prepared3), "--data", str(data3),
+               "--out", str(models), "--fp32", str(fp32)])
+    assert rc == 0
+    return {"models": models, "fp32": fp32, "runs": smoke_runs, "prepared": prepared3}
+
+
+@pytest.fixture
+def rng():
+    return np.random.default_rng(12345)

@@ -1,0 +1,195 @@
+"""python -m training.prepare: bad input folders fail with exit 2 and one 'error:' line; the real
+data prints per-split frame counts and feature sizes and writes the arrays (in tmp only)."""
+from __future__ import annotations
+
+import math
+import re
+import shutil
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from training.prepare import main
+
+from conftest import DATA, README_FRAMES, REPO, copy_takes, needs_data
+
+pytestmark = needs_data
+
+
+def run_main(capsys, *args):
+    rc = main(list(map(str, args)))
+    out, err = capsys.readouterr()
+    return rc, out, err
+
+
+def assert_one_error_line(rc, err, *words):
+    """Exit 2; stderr ends with exactly one 'error: ...' line (tqdm may have drawn a bar before
+    it) that contains every word."""
+    assert rc == 2, err
+    lines = [l for l in re.split(r"[\r\n]+", err) if l.strip()]
+    errors = [l for l in lines if l.startswith("error:")]
+    assert len(errors) == 1 and lines[-1] == errors[0], err
+    for w in words:
+        assert w in errors[0], f"{w!r} not in {errors[0]!r}"
+
+
+def assert_nothing_written(out_dir):
+    assert not any(out_dir.glob("*.npz")) if out_dir.exists() else True
+
+
+def test_missing_data_folder(tmp_path, capsys):
+    rc, _, err = run_main(capsys, "--data", tmp_path / "nowhere", "--out", tmp_path / "out")
+    assert_one_error_line(rc, err, "nowhere", "does not exist")
+    assert_nothing_written(tmp_path / "out")
+
+
+def test_folder_without_bvh_files(tmp_path, capsys):
+    (tmp_path / "data").mkdir()
+    (tmp_path / "data" / "notes.txt").write_text("hello")
+    rc, _, err = run_main(capsys, "--data", tmp_path / "data", "--out", tmp_path / "out")
+    assert_one_error_line(rc, err, "no .bvh files")
+
+
+def test_take_without_partner(tmp_path, capsys):
+    data = copy_takes(tmp_path / "data", ["10"])
+    (data / "60_12.bvh").write_bytes((DATA / "60_12.bvh").read_bytes())
+    rc, _, err = run_main(capsys, "--data", data, "--out", tmp_path / "out")
+    assert_one_error_line(rc, err, "60_12", "no partner", "61_12.bvh")
+    assert_nothing_written(tmp_path / "out")
+
+
+def test_badly_named_file(tmp_path, capsys):
+    data = copy_takes(tmp_path / "data", ["10"])
+    (data / "salsa.bvh").write_bytes((DATA / "60_12.bvh").read_bytes())
+    rc, _, err = run_main(capsys, "--data", data, "--out", tmp_path / "out")
+    assert_one_error_line(rc, err, "salsa.bvh", "SUBJECT_TAKE")
+
+
+def test_three_subjects(tmp_path, capsys):
+    data = copy_takes(tmp_path / "data", ["10"])
+    (data / "62_10.bvh").write_bytes((DATA / "61_10.bvh").read_bytes())
+    rc, _, err = run_main(capsys, "--data", data, "--out", tmp_path / "out")
+    assert_one_error_line(rc, err, "two subjects", "60, 61, 62")
+
+
+def truncated(text: str, keep: int, fix_header: bool) -> str:
+    head, motion = text.split("MOTION", 1)
+    lines = motion.strip().splitlines()   # Frames:, Frame Time:, then one line per frame
+    frames = lines[2:2 + keep]
+    header = f"Frames: {keep}" if fix_header else lines[0]
+    return head + "MOTION\n" + "\n".join([header, lines[1], *frames]) + "\n"
+
+
+def test_partners_with_different_frame_counts(tmp_path, capsys):
+    data = copy_takes(tmp_path / "data", ["10"])
+    (data / "61_10.bvh").write_text(truncated((DATA / "61_10.bvh").read_text(), 1000, fix_header=True))
+    rc, _, err = run_main(capsys, "--data", data, "--out", tmp_path / "out", "--validation", "10", "--test", "10")
+    assert_one_error_line(rc, err, "take 10", "different frame counts", "60_10.bvh 1197", "61_10.bvh 1000")
+    assert_nothing_written(tmp_path / "out")
+
+
+def test_truncated_download(tmp_path, capsys):
+    """A file cut short (its header still says 1197 frames) is a BVH error, not a crash."""
+    data = copy_takes(tmp_path / "data", ["10"])
+    (data / "61_10.bvh").write_text(truncated((DATA / "61_10.bvh").read_text(), 1000, fix_header=False))
+    rc, _, err = run_main(capsys, "--data", data, "--out", tmp_path / "out", "--validation", "10", "--test", "10")
+    assert_one_error_line(rc, err, "61_10.bvh", "1197 frames")
+
+
+def test_file_that_is_not_bvh(tmp_path, capsys):
+    data = copy_takes(tmp_path / "data", ["10"])
+    (data / "61_10.bvh").write_bytes(b"\x89PNG\r\n\x1a\n" + bytes(range(256)) * 4)
+    rc, _, err = run_main(capsys, "--data", data, "--out", tmp_path / "out", "--validation", "10", "--test", "10")
+    assert_one_error_line(rc, err, "61_10.bvh", "not a BVH")
+    assert_nothing_written(tmp_path / "out")
+
+
+def test_skeleton_lacking_a_joint(tmp_path, capsys):
+    data = copy_takes(tmp_path / "data", ["10"])
+    (data / "60_10.bvh").write_text((DATA / "60_10.bvh").read_text().replace("lFoot", "lToe"))
+    rc, _, err = run_main(capsys, "--data", data, "--out", tmp_path / "out", "--validation", "10", "--test", "10")
+    assert_one_error_line(rc, err, "60_10.bvh", "lFoot")
+    assert_nothing_written(tmp_path / "out")
+
+
+def test_take_too_short_for_a_sample(tmp_path, capsys):
+    """A take of 200 frames at 120 fps is 50 frames at 30 fps: less than the 2 s + 1 frame that one
+    sample needs. prepare must say so (exit 2 naming the take) or leave it out, never crash."""
+    data = copy_takes(tmp_path / "data", ["06", "10", "12"])
+    for s in ("60", "61"):
+        p = data / f"{s}_10.bvh"
+        p.write_text(truncated(p.read_text(), 200, fix_header=True))
+    rc, out, err = run_main(capsys, "--data", data, "--out", tmp_path / "out", "--validation", "12", "--test", "12")
+    if rc == 2:
+        assert_one_error_line(rc, err, "10")
+    else:
+        assert rc == 0
+        with np.load(tmp_path / "out" / "stats.npz") as z:
+            assert all(np.isfinite(z[k]).all() for k in z.files)
+
+
+def test_split_take_not_in_folder(tmp_path, capsys):
+    data = copy_takes(tmp_path / "data", ["10"])
+    rc, _, err = run_main(capsys, "--data", data, "--out", tmp_path / "out")   # default validation 12
+    assert_one_error_line(rc, err, "split take 12")
+
+
+def test_empty_training_split(tmp_path, capsys):
+    data = copy_takes(tmp_path / "data", ["10"])
+    rc, _, err = run_main(capsys, "--data", data, "--out", tmp_path / "out", "--validation", "10", "--test", "10")
+    assert_one_error_line(rc, err, "split train is empty")
+
+
+def test_unknown_leader(tmp_path, capsys):
+    data = copy_takes(tmp_path / "data", ["10"])
+    rc, _, err = run_main(capsys, "--data", data, "--out", tmp_path / "out", "--leader", "99")
+    assert_one_error_line(rc, err, "leader subject '99'")
+
+
+@pytest.mark.slow
+def test_real_data(tmp_path):
+    """The whole CMU folder through the real command line (a subprocess, as a user runs it)."""
+    out = tmp_path / "prepared"
+    try:
+        r = subprocess.run([sys.executable, "-m", "training.prepare", "--data", str(DATA), "--out", str(out)],
+                           cwd=REPO, capture_output=True, text=True, timeout=300)
+        check_real_data(r, out)
+    finally:
+        shutil.rmtree(out, ignore_errors=True)   # ~270 MB of arrays; pytest keeps old tmp folders
+
+
+def check_real_data(r, out):
+    assert r.returncode == 0, r.stderr
+    # Dancer frames at 30 fps per take: every 4th of the 120 fps frames (README frame counts).
+    frames30 = {t: math.ceil(f / 4) for t, f in README_FRAMES.items()}
+    expect = {"train": sum(v for t, v in frames30.items() if t not in ("12", "02", "13")),
+              "validation": frames30["12"], "test": frames30["02"] + frames30["13"]}
+    # Samples per role: frames with a second of context each side; train has the 4 phases of
+    # 120 fps and a mirrored copy of each.
+    valid = lambda f: max(0, f - 61)   # noqa: E731
+    samples = {"train": sum(2 * valid(math.ceil((f - p) / 4)) for t, f in README_FRAMES.items()
+                            if t not in ("12", "02", "13") for p in range(4)),
+               "validation": valid(frames30["12"]), "test": valid(frames30["02"]) + valid(frames30["13"])}
+    for split, takes in (("train", "01,03,04,06,07,09,10,11,15"), ("validation", "12"), ("test", "02,13")):
+        line = next(l for l in r.stdout.splitlines() if l.startswith(split))
+        assert line.split()[1:] == [takes, str(expect[split]), str(samples[split])], line
+    total = sum(expect.values())
+    assert 5900 < total < 6100
+    assert f"total dancer frames at 30 fps (per dancer): {total}" in r.stdout
+    for text in ("follower input I (660)", "leader input I (660)", "output O (323)", "intention (90)",
+                 "partner_trajectory_past 24", "self_pose 204", "control 24", "contacts 2"):
+        assert text in r.stdout, text
+    # The arrays on disk agree with the summary.
+    with np.load(out / "validation.npz") as z:
+        assert z["follower_input"].shape == (samples["validation"], 660)
+        assert z["leader_output"].shape == (samples["validation"], 323)
+        assert z["follower_intention"].shape == (samples["validation"], 90)
+        assert list(z["takes"]) == sorted(README_FRAMES)
+        assert not z["mirror"].any() and (z["phase"] == 0).all()
+    with np.load(out / "stats.npz") as z:
+        for role in ("follower", "leader"):
+            std = z[f"{role}_input_std"]
+            assert std.shape == (660,) and np.isfinite(std).all() and std.min() >= 1e-2 - 1e-9
+            assert z[f"{role}_output_mean"].shape == (323,)

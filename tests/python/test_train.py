@@ -1,0 +1,221 @@
+"""python -m training.train: smoke runs of the shipped models, resume, bad input, DDP (2 CPU
+processes). All on 3 prepared takes in tmp (conftest.prepared3)."""
+from __future__ import annotations
+
+import json
+import math
+import os
+import shutil
+import subprocess
+import sys
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+import torch
+
+from training import features as feat
+from training import train as T
+
+from conftest import REPO, needs_data
+
+pytestmark = needs_data
+
+
+def run_main(capsys, *args):
+    rc = T.main(list(map(str, args)))
+    out, err = capsys.readouterr()
+    return rc, out, err
+
+
+def error_line(err: str) -> str:
+    lines = [l for l in err.replace("\r", "\n").splitlines() if l.strip()]
+    assert lines and lines[-1].startswith("error: "), err
+    assert sum(l.startswith("error:") for l in lines) == 1, err
+    return lines[-1]
+
+
+# ---------------------------------------------------------------- smoke runs
+
+@pytest.mark.parametrize("name", T.SHIPPED)
+def test_smoke_training_writes_its_outputs(smoke_runs, name):
+    run = smoke_runs / name
+    assert (run / "losses.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    h = json.loads((run / "history.json").read_text())
+    smoke = T.smoke(T.MODELS[name])
+    assert len(h["val_mse"]) == smoke.epochs == 2
+    assert len(h["reconstruction"]) == 2 and len(h["val_codebook"]) == 2
+    has_intention = smoke.model.intention
+    assert len(h["intention_train"]) == (1 if has_intention else 0)
+    assert all(math.isfinite(v) for k in ("val_mse", "reconstruction", "codebook", "generator") for v in h[k])
+    assert h["seconds"] > 0
+    ck = torch.load(run / "checkpoint.pt", map_location="cpu", weights_only=False)
+    assert ck["stage"] == "done" and ck["epoch"] == 2 and ck["name"] == name
+    assert ck["config"]["model"] == smoke.model.to_dict()
+    assert {"predictor", "matching", "disc", "opt_p", "opt_g", "opt_d"} <= set(ck)
+
+
+def test_resume_continues_an_interrupted_run(prepared3, tmp_path, monkeypatch, capsys):
+    """Kill the run in its second matching epoch (validation raises), then --resume: it picks up
+    at matching epoch 1 with the saved intention predictor and history instead of starting over."""
+    calls = {"n": 0}
+    real_validate = T.validate
+
+    def crashing_validate(*a, **k):
+        calls["n"] += 1
+        if calls["n"] == 2:
+            raise KeyboardInterrupt("simulated crash")
+        return real_validate(*a, **k)
+
+    monkeypatch.setattr(T, "validate", crashing_validate)
+    args = ["--model", "follower", "--smoke", "--data", prepared3, "--out", tmp_path]
+    with pytest.raises(KeyboardInterrupt):
+        T.main(list(map(str, args)))
+    monkeypatch.setattr(T, "validate", real_validate)
+    ckpt = tmp_path / "follower" / "checkpoint.pt"
+    crashed = torch.load(ckpt, map_location="cpu", weights_only=False)
+    assert (crashed["stage"], crashed["epoch"]) == ("matching", 1)
+    assert not (tmp_path / "follower" / "history.json").exists()
+    capsys.readouterr()
+
+    rc, out, _ = run_main(capsys, *args, "--resume")
+    assert rc == 0
+    assert "resumed at matching epoch 1" in out
+    assert "intention 1/1" not in out            # stage 1 is not trained again
+    done = torch.load(ckpt, map_location="cpu", weights_only=False)
+    assert (done["stage"], done["epoch"]) == ("done", 2)
+    h = json.loads((tmp_path / "follower" / "history.json").read_text())
+    assert len(h["val_mse"]) == 2 and h["val_mse"][0] == crashed["history"]["val_mse"][0]
+    assert h["intention_train"] == crashed["history"]["intention_train"]
+    for k, v in crashed["predictor"].items():     # the frozen predictor came from the checkpoint
+        assert torch.equal(v, done["predictor"][k]), k
+
+
+def test_resume_of_a_finished_run_changes_nothing(smoke_runs, prepared3, tmp_path, capsys):
+    shutil.copytree(smoke_runs / "follower_ccm", tmp_path / "follower_ccm")
+    before = torch.load(tmp_path / "follower_ccm" / "checkpoint.pt", map_location="cpu", weights_only=False)
+    rc, out, _ = run_main(capsys, "--model", "follower_ccm", "--smoke", "--data", prepared3, "--out", tmp_path, "--resume")
+    assert rc == 0 and "resumed at done epoch 2" in out
+    after = torch.load(tmp_path / "follower_ccm" / "checkpoint.pt", map_location="cpu", weights_only=False)
+    for k, v in before["matching"].items():
+        assert torch.equal(v, after["matching"][k]), k
+
+
+# ---------------------------------------------------------------- bad input
+
+def test_missing_prepared_data(tmp_path, capsys):
+    rc, _, err = run_main(capsys, "--model", "follower", "--smoke", "--data", tmp_path / "none", "--out", tmp_path / "out")
+    assert rc == 2
+    line = error_line(err)
+    assert "train.npz not found" in line and "training.prepare" in line
+
+
+def test_mismatched_feature_sizes(tmp_path, capsys):
+    data = tmp_path / "data"
+    data.mkdir()
+    n = 10
+    arrays = {f"{role}_{k}": np.zeros((n, w), np.float32)
+              for role in ("follower", "leader")
+              for k, w in (("input", 600), ("output", feat.OUTPUT_SIZE), ("intention", feat.INTENTION_SIZE))}
+    for split in ("train", "validation"):
+        np.savez(data / f"{split}.npz", **arrays)
+    rc, _, err = run_main(capsys, "--model", "follower", "--smoke", "--data", data, "--out", tmp_path / "out")
+    assert rc == 2
+    line = error_line(err)
+    assert "follower input has 600 features" in line and "expects 660" in line and "re-run training.prepare" in line
+
+
+@pytest.mark.parametrize("damage", ["truncated", "foreign"])
+def test_unreadable_prepared_data(prepared3, tmp_path, capsys, damage):
+    """train.npz cut short (prepare writes it in place, so an interrupted prepare leaves this) or
+    an npz from something else: bad input like the cases above, so exit 2 with one 'error:'
+    line naming the file, not a BadZipFile / KeyError traceback."""
+    data = tmp_path / "data"
+    shutil.copytree(prepared3, data)
+    if damage == "truncated":
+        good = (prepared3 / "train.npz").read_bytes()
+        (data / "train.npz").write_bytes(good[:len(good) // 3])
+    else:
+        np.savez(data / "train.npz", x=np.zeros(3))
+    rc, _, err = run_main(capsys, "--model", "follower", "--smoke", "--data", data, "--out", tmp_path / "out")
+    assert rc == 2
+    assert "train.npz" in error_line(err)
+
+
+@pytest.mark.parametrize("damage", ["garbage", "truncated"])
+def test_corrupt_checkpoint_is_reported_and_kept(smoke_runs, prepared3, tmp_path, capsys, damage):
+    run = tmp_path / "follower"
+    run.mkdir()
+    ckpt = run / "checkpoint.pt"
+    if damage == "garbage":
+        ckpt.write_bytes(b"this is not a checkpoint\x00\xff" * 100)
+    else:   # a half-written file, as a crash mid-copy would leave
+        good = (smoke_runs / "follower" / "checkpoint.pt").read_bytes()
+        ckpt.write_bytes(good[:len(good) // 2])
+    before = ckpt.read_bytes()
+    rc, _, err = run_main(capsys, "--model", "follower", "--smoke", "--data", prepared3, "--out", tmp_path, "--resume")
+    assert rc == 2
+    line = error_line(err)
+    assert "checkpoint.pt" in line and "unreadable" in line
+    assert ckpt.read_bytes() == before, "the damaged checkpoint was overwritten"
+    assert not (run / "history.json").exists()
+
+
+def test_resume_with_another_configuration_is_refused(smoke_runs, prepared3, tmp_path, capsys):
+    shutil.copytree(smoke_runs / "follower", tmp_path / "follower")
+    before = (tmp_path / "follower" / "checkpoint.pt").read_bytes()
+    rc, _, err = run_main(capsys, "--model", "follower", "--smoke", "--epochs", "3", "--data", prepared3,
+                          "--out", tmp_path, "--resume")
+    assert rc == 2
+    assert "another configuration" in error_line(err)
+    assert (tmp_path / "follower" / "checkpoint.pt").read_bytes() == before
+
+
+def test_no_model_named_is_a_usage_error(capsys):
+    with pytest.raises(SystemExit) as e:
+        T.main([])
+    assert e.value.code == 2
+    assert "--model" in capsys.readouterr().err
+
+
+# ---------------------------------------------------------------- leader control augmentation
+
+def test_control_augmentation_turns_the_path_rigidly():
+    """With no position noise the control path is only turned about the root: distances from the
+    root and unit forward vectors are kept, the turn stays within control_rotation, and nothing
+    outside the control block changes."""
+    g = torch.Generator().manual_seed(0)
+    x = torch.randn(64, feat.INPUT_SIZE)
+    sl = feat.block_slices(feat.LEADER_INPUT_LAYOUT)["control"]
+    keys = torch.zeros(64, 6, 4)
+    keys[..., 1] = torch.arange(1, 7) * 0.2        # straight ahead
+    keys[..., 3] = 1.0                             # facing ahead
+    x[:, sl] = keys.reshape(64, -1)
+    cfg = replace(T.TrainConfig(), control_noise=0.0, control_rotation=15.0)
+    y = T.augment_control(x, cfg, g)
+    torch.testing.assert_close(y[:, :sl.start], x[:, :sl.start])
+    k = y[:, sl].reshape(64, 6, 4)
+    torch.testing.assert_close(k[..., :2].norm(dim=-1), keys[..., :2].norm(dim=-1))
+    torch.testing.assert_close(k[..., 2:].norm(dim=-1), torch.ones(64, 6))
+    angle = torch.atan2(k[..., 0], k[..., 1])
+    assert angle.abs().max() <= math.radians(15) + 1e-6 and angle.abs().max() > math.radians(5)
+    torch.testing.assert_close(angle, torch.atan2(k[..., 2], k[..., 3]))   # path and facing turn together
+
+
+# ---------------------------------------------------------------- data parallel
+
+@pytest.mark.slow
+def test_ddp_two_cpu_processes(prepared3, tmp_path):
+    torchrun = Path(sys.executable).with_name("torchrun")
+    assert torchrun.exists(), torchrun
+    env = {**os.environ, "OMP_NUM_THREADS": "1"}
+    r = subprocess.run([str(torchrun), "--standalone", "--nproc_per_node", "2", "-m", "training.train",
+                        "--model", "follower", "--smoke", "--data", str(prepared3), "--out", str(tmp_path)],
+                       cwd=REPO, env=env, capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
+    assert "on cpu x2" in r.stdout
+    h = json.loads((tmp_path / "follower" / "history.json").read_text())
+    assert len(h["val_mse"]) == 2 and all(math.isfinite(v) for v in h["val_mse"])
+    ck = torch.load(tmp_path / "follower" / "checkpoint.pt", map_location="cpu", weights_only=False)
+    assert ck["stage"] == "done"
