@@ -1,0 +1,112 @@
+// Browser benchmark of the shipped page: builds dist/, serves it with `vite preview` (COOP/COEP
+// on, so two WASM threads are possible) and loads it cold in headless Chromium, once per thread
+// count. Prints, per run: simulation step time (median/p95 over the last 300 steps: features +
+// both models + pose), cold load to the first simulated frame, and the page weight (raw and
+// gzip) of everything the page downloaded to get there.
+//
+//   npm run bench                 # threads 1 and 2
+//   node scripts/bench.mjs --seconds 20 --json
+//
+// Timings on a 2-core machine with software WebGL vary by ±20 % between runs.
+
+import { gzipSync } from 'node:zlib';
+import { build, duet, launch, sleep, startServer, waitReady } from '../tests/e2e/harness.mjs';
+
+const args = process.argv.slice(2);
+const option = (name, fallback) => {
+  const i = args.indexOf(`--${name}`);
+  return i >= 0 ? args[i + 1] : fallback;
+};
+const seconds = Number(option('seconds', 14)); // >= 10 s so the 300-step window is full
+const threadCounts = option('threads', '1,2').split(',').map(Number);
+const json = args.includes('--json');
+
+const mb = (bytes) => `${(bytes / 1e6).toFixed(2)} MB`;
+
+async function run(url, threads) {
+  const browser = await launch(); // fresh profile: a cold load, nothing cached
+  const { page } = browser;
+  const downloads = new Map();
+  page.on('response', async (response) => {
+    try {
+      const body = await response.body();
+      downloads.set(response.url(), { bytes: body.length, gzip: gzipSync(body).length });
+    } catch {
+      // redirects and aborted requests have no body
+    }
+  });
+  try {
+    await page.goto(`${url}?seed=1&threads=${threads}`);
+    await waitReady(page, 60_000);
+    const ready = await duet(page);
+    // Snapshot what the page needed to react, before any lazily loaded extras.
+    await sleep(200);
+    const files = [...downloads.entries()];
+    const transferred = await page.evaluate(() =>
+      performance.getEntriesByType('resource').reduce((sum, e) => sum + e.transferSize, 0) +
+      (performance.getEntriesByType('navigation')[0]?.transferSize ?? 0),
+    );
+
+    // Step time while steering, as a person would.
+    await page.keyboard.down('ArrowUp');
+    await sleep((seconds * 1000) / 2);
+    await page.keyboard.up('ArrowUp');
+    await page.keyboard.down('ArrowLeft');
+    await sleep((seconds * 1000) / 2);
+    await page.keyboard.up('ArrowLeft');
+    const state = await duet(page);
+    if (state.error) throw new Error(state.error);
+    const fps = await page.evaluate(
+      () =>
+        new Promise((resolve) => {
+          let frames = 0;
+          const start = performance.now();
+          const tick = () => (++frames, performance.now() - start < 2000 ? requestAnimationFrame(tick) : resolve((frames * 1000) / (performance.now() - start)));
+          requestAnimationFrame(tick);
+        }),
+    );
+    return {
+      threads: state.threads,
+      requestedThreads: threads,
+      crossOriginIsolated: await page.evaluate(() => crossOriginIsolated),
+      stepMs: state.stepMs,
+      stepsPerSecond: state.frame / seconds,
+      fps,
+      coldLoadMs: ready.firstFrameMs,
+      modelBytes: state.modelBytes,
+      pageBytes: files.reduce((sum, [, f]) => sum + f.bytes, 0),
+      pageGzipBytes: files.reduce((sum, [, f]) => sum + f.gzip, 0),
+      transferredBytes: transferred,
+      files: Object.fromEntries(files.map(([u, f]) => [new URL(u).pathname, f])),
+      consoleErrors: browser.consoleErrors,
+    };
+  } finally {
+    await browser.close();
+  }
+}
+
+await build('dist');
+const server = await startServer({ mode: 'preview', outDir: 'dist' });
+const results = [];
+try {
+  for (const threads of threadCounts) results.push(await run(server.url, threads));
+} finally {
+  await server.stop();
+}
+
+if (json) {
+  console.log(JSON.stringify(results, null, 1));
+} else {
+  for (const r of results) {
+    console.log(`\nthreads ${r.threads} (asked ${r.requestedThreads}, cross-origin isolated: ${r.crossOriginIsolated})`);
+    console.log(`  step            median ${r.stepMs.median.toFixed(2)} ms   p95 ${r.stepMs.p95.toFixed(2)} ms`);
+    console.log(`  cold load       ${(r.coldLoadMs / 1000).toFixed(2)} s to the first simulated frame`);
+    console.log(`  models          ${mb(r.modelBytes)}`);
+    console.log(`  page weight     ${mb(r.pageBytes)} raw, ${mb(r.pageGzipBytes)} gzip (${mb(r.transferredBytes)} sent by vite preview)`);
+    console.log(`  display         ${r.fps.toFixed(1)} fps (software WebGL in headless Chromium)`);
+    if (r.consoleErrors.length) console.log(`  console errors: ${r.consoleErrors.join(' | ')}`);
+  }
+  const largest = Object.entries(results[0].files).sort((a, b) => b[1].gzip - a[1].gzip).slice(0, 6);
+  console.log('\nlargest downloads (gzip):');
+  for (const [path, f] of largest) console.log(`  ${mb(f.gzip).padStart(9)}  ${path}`);
+}

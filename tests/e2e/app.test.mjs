@@ -1,0 +1,245 @@
+// End-to-end tests of the page on the Vite dev server, in headless Chromium.
+// Run: npm run test:e2e   (node --test; needs /usr/bin/chromium and models in public/models/)
+//
+// Every assertion reads window.duet (DESIGN.md "Contracts"), so the same tests hold for the
+// development simulation and for the real models.
+
+import { after, before, describe, test } from 'node:test';
+import assert from 'node:assert/strict';
+import { mkdirSync, writeFileSync } from 'node:fs';
+import { join } from 'node:path';
+import {
+  ROOT,
+  displacement,
+  distance,
+  duet,
+  launch,
+  pixelVariance,
+  reset,
+  sleep,
+  startServer,
+  touchDrag,
+  waitReady,
+  waitSteps,
+} from './harness.mjs';
+
+const HOLD_MS = 3000;
+const MIN_VARIANCE = 20; // luminance variance of a screenshot; a blank canvas is ~0
+
+let server;
+
+before(async () => {
+  server = await startServer({ mode: 'dev' });
+  // The dev server transforms modules on first request; warm it so "ready within 5 s" measures
+  // the page, not Vite's first compile.
+  const warm = await launch();
+  await warm.page.goto(`${server.url}?seed=1`);
+  await waitReady(warm.page, 60_000).catch(() => undefined);
+  await warm.close();
+});
+
+after(async () => {
+  await server?.stop();
+});
+
+describe('desktop', () => {
+  let browser;
+  let page;
+
+  before(async () => {
+    browser = await launch({ viewport: { width: 1280, height: 800 } });
+    page = browser.page;
+  });
+
+  after(async () => {
+    await browser?.close();
+  });
+
+  test('becomes ready within 5 s without errors', async () => {
+    const started = Date.now();
+    await page.goto(`${server.url}?seed=1`);
+    await waitReady(page, 5000);
+    const elapsed = Date.now() - started;
+    assert.ok(elapsed < 5000, `ready after ${elapsed} ms`);
+    await waitSteps(page, 30);
+    const state = await duet(page);
+    assert.equal(state.error, null);
+    assert.equal(state.model, 'ours');
+    assert.ok(state.stepMs.median > 0, 'step time is measured');
+    for (const key of ['leader', 'follower']) {
+      assert.equal(state[key].root.length, 2);
+      assert.ok(state[key].root.every(Number.isFinite) && Number.isFinite(state[key].heading), `${key} is finite`);
+    }
+  });
+
+  test('holding ArrowUp for 3 s moves the leader at least 1 m further than idling', async () => {
+    const idle = await displacement(page, HOLD_MS);
+    const up = await displacement(
+      page,
+      HOLD_MS,
+      () => page.keyboard.down('ArrowUp'),
+      () => page.keyboard.up('ArrowUp'),
+    );
+    assert.ok(up.moved >= idle.moved + 1, `ArrowUp moved ${up.moved.toFixed(2)} m, idle ${idle.moved.toFixed(2)} m`);
+  });
+
+  test('ArrowLeft and ArrowRight end on opposite sides', async () => {
+    const left = await displacement(
+      page,
+      HOLD_MS,
+      () => page.keyboard.down('ArrowLeft'),
+      () => page.keyboard.up('ArrowLeft'),
+    );
+    const right = await displacement(
+      page,
+      HOLD_MS,
+      () => page.keyboard.down('ArrowRight'),
+      () => page.keyboard.up('ArrowRight'),
+    );
+    // Both runs start from the reset pose: their moves must point away from each other.
+    const l = [left.end[0] - left.start[0], left.end[1] - left.start[1]];
+    const r = [right.end[0] - right.start[0], right.end[1] - right.start[1]];
+    const dot = l[0] * r[0] + l[1] * r[1];
+    assert.ok(dot < 0, `left move (${l.map((v) => v.toFixed(2))}) and right move (${r.map((v) => v.toFixed(2))}) point the same way`);
+    assert.ok(distance(left.end, right.end) > 1, `left and right end ${distance(left.end, right.end).toFixed(2)} m apart`);
+  });
+
+  test('the follower stays within 3 m of the leader through 60 s of random steering', async () => {
+    // 4× speed: 60 simulated seconds (1800 steps, every one running the real models) in ~15 s.
+    await page.goto(`${server.url}?seed=7&speed=4`);
+    await waitReady(page, 10_000);
+    await reset(page);
+    const start = (await duet(page)).frame;
+    const keys = ['ArrowUp', 'ArrowDown', 'ArrowLeft', 'ArrowRight', 'KeyW', 'KeyA', 'KeyS', 'KeyD'];
+    let random = 12345;
+    const next = () => (random = (random * 1103515245 + 12345) % 2147483648) / 2147483648;
+    let held = [];
+    let worst = 0;
+    let changeAt = 0;
+    const deadline = Date.now() + 180_000;
+    for (;;) {
+      const state = await duet(page);
+      assert.equal(state.error, null);
+      worst = Math.max(worst, distance(state.leader.root, state.follower.root));
+      if (state.frame - start >= 1800) break;
+      assert.ok(Date.now() < deadline, `only ${state.frame - start} steps in 180 s`);
+      if (state.frame >= changeAt) {
+        // New random keys every 0.5-2 simulated seconds; sometimes none (idle).
+        for (const key of held) await page.keyboard.up(key);
+        held = [];
+        const count = Math.floor(next() * 3);
+        for (let i = 0; i < count; i++) held.push(keys[Math.floor(next() * keys.length)]);
+        held = [...new Set(held)];
+        for (const key of held) await page.keyboard.down(key);
+        changeAt = state.frame + 15 + Math.floor(next() * 45);
+      }
+      await sleep(50);
+    }
+    for (const key of held) await page.keyboard.up(key);
+    assert.ok(worst < 3, `follower was ${worst.toFixed(2)} m from the leader`);
+  });
+
+  test('screenshot is not blank', async () => {
+    await page.goto(`${server.url}?seed=3&intentions=1`);
+    await waitReady(page, 10_000);
+    await page.keyboard.down('ArrowUp');
+    await sleep(1500);
+    await page.keyboard.up('ArrowUp');
+    await waitSteps(page, 10);
+    const png = await page.screenshot();
+    mkdirSync(join(ROOT, 'docs'), { recursive: true });
+    writeFileSync(join(ROOT, 'docs', 'screenshot-desktop.png'), png);
+    const variance = await pixelVariance(page, png);
+    assert.ok(variance > MIN_VARIANCE, `screenshot variance ${variance.toFixed(1)}`);
+  });
+
+  test('no console errors', () => {
+    assert.deepEqual(browser.consoleErrors, []);
+  });
+});
+
+describe('phone', () => {
+  let browser;
+  let page;
+
+  before(async () => {
+    browser = await launch({ viewport: { width: 390, height: 844 }, deviceScaleFactor: 3, isMobile: true, hasTouch: true });
+    page = browser.page;
+  });
+
+  after(async () => {
+    await browser?.close();
+  });
+
+  test('a touch drag steers the leader', async () => {
+    await page.goto(`${server.url}?seed=1`);
+    await waitReady(page, 10_000);
+    const idle = await displacement(page, HOLD_MS);
+    // Thumb down in the lower half, drag 80 px up ("away from the camera"), hold.
+    let drag;
+    const steered = await displacement(
+      page,
+      HOLD_MS,
+      async () => {
+        drag = await touchDrag(page, [195, 600], [195, 520]);
+      },
+      () => drag.release(),
+    );
+    assert.ok(steered.moved >= idle.moved + 1, `drag moved ${steered.moved.toFixed(2)} m, idle ${idle.moved.toFixed(2)} m`);
+    // The page itself must not have scrolled or zoomed.
+    const viewport = await page.evaluate(() => [window.scrollY, window.visualViewport?.scale ?? 1]);
+    assert.deepEqual(viewport, [0, 1]);
+  });
+
+  test('phone screenshot is not blank', async () => {
+    await waitSteps(page, 10);
+    const png = await page.screenshot();
+    writeFileSync(join(ROOT, 'docs', 'screenshot-phone.png'), png);
+    const variance = await pixelVariance(page, png);
+    assert.ok(variance > MIN_VARIANCE, `screenshot variance ${variance.toFixed(1)}`);
+  });
+
+  test('no console errors', () => {
+    assert.deepEqual(browser.consoleErrors, []);
+  });
+});
+
+describe('failures show a message, not a blank page', () => {
+  let browser;
+
+  before(async () => {
+    browser = await launch();
+  });
+
+  after(async () => {
+    await browser?.close();
+  });
+
+  test('missing manifest', async () => {
+    const { page } = browser;
+    await page.route('**/models/manifest.json', (route) => route.fulfill({ status: 404, body: 'not found' }));
+    await page.goto(`${server.url}?seed=1`);
+    await page.waitForFunction(() => window.duet?.error, null, { timeout: 10_000 });
+    const state = await duet(page);
+    assert.match(state.error, /missing/i);
+    assert.equal(state.ready, false);
+    assert.ok(await page.locator('.error-overlay').isVisible());
+    await page.unroute('**/models/manifest.json');
+  });
+
+  test('corrupt model', async () => {
+    const { page } = browser;
+    // Same length as the manifest says, wrong content: the session must refuse it.
+    await page.route('**/models/*.onnx', async (route) => {
+      const response = await route.fetch();
+      const body = Buffer.alloc((await response.body()).length, 7);
+      await route.fulfill({ response, body });
+    });
+    await page.goto(`${server.url}?seed=1`);
+    await page.waitForFunction(() => window.duet?.error, null, { timeout: 20_000 });
+    const state = await duet(page);
+    assert.match(state.error, /corrupt|does not match/i);
+    assert.ok(await page.locator('.error-overlay').isVisible());
+    await page.unroute('**/models/*.onnx');
+  });
+});

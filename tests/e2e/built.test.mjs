@@ -1,0 +1,48 @@
+// Smoke test of the production build: `vite build`, then `vite preview` serving dist/ from a
+// sub-path (/duet/), as a static host would. Checks that the wasm, the ORT worker threads and the
+// models all load from relative URLs, and that the page steers.
+
+import { after, before, test } from 'node:test';
+import assert from 'node:assert/strict';
+import { build, displacement, duet, launch, pixelVariance, startServer, waitReady, waitSteps } from './harness.mjs';
+
+let server;
+let browser;
+
+before(async () => {
+  await build('dist');
+  server = await startServer({ mode: 'preview', base: '/duet/', outDir: 'dist' });
+  browser = await launch();
+});
+
+after(async () => {
+  await browser?.close();
+  await server?.stop();
+});
+
+test('built site from a sub-path: ready within 5 s on two threads, steers, no console errors', async () => {
+  const { page } = browser;
+  const started = Date.now();
+  await page.goto(`${server.url}?seed=1`);
+  await waitReady(page, 5000);
+  assert.ok(Date.now() - started < 5000, `ready after ${Date.now() - started} ms`);
+  await waitSteps(page, 30);
+
+  const state = await duet(page);
+  assert.equal(state.error, null);
+  assert.equal(await page.evaluate(() => crossOriginIsolated), true, 'COOP/COEP headers make the page cross-origin isolated');
+  assert.equal(state.threads, 2);
+
+  const idle = await displacement(page, 2000);
+  const up = await displacement(
+    page,
+    2000,
+    () => page.keyboard.down('ArrowUp'),
+    () => page.keyboard.up('ArrowUp'),
+  );
+  assert.ok(up.moved >= idle.moved + 0.5, `ArrowUp moved ${up.moved.toFixed(2)} m, idle ${idle.moved.toFixed(2)} m`);
+
+  const variance = await pixelVariance(page, await page.screenshot());
+  assert.ok(variance > 20, `screenshot variance ${variance.toFixed(1)}`);
+  assert.deepEqual(browser.consoleErrors, []);
+});

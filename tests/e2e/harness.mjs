@@ -1,0 +1,202 @@
+// Shared helpers for the end-to-end tests and the bench: start a Vite server on a free port (and
+// stop it by its own pid), launch the system Chromium through playwright-core with a fresh
+// profile, and read the page's window.duet test hook. Tests assert on window.duet only, so they
+// hold for the development simulation and for the real models alike.
+
+import { spawn } from 'node:child_process';
+import { mkdtempSync, rmSync } from 'node:fs';
+import { createServer } from 'node:net';
+import { tmpdir } from 'node:os';
+import { join, resolve } from 'node:path';
+import { fileURLToPath } from 'node:url';
+import { chromium } from 'playwright-core';
+
+export const ROOT = resolve(fileURLToPath(new URL('../..', import.meta.url)));
+const VITE = join(ROOT, 'node_modules', 'vite', 'bin', 'vite.js');
+const CHROMIUM = process.env.CHROMIUM ?? '/usr/bin/chromium';
+const CHROMIUM_ARGS = [
+  '--headless',
+  '--no-sandbox',
+  '--disable-gpu',
+  '--disable-quic',
+  '--no-first-run',
+  '--disable-background-networking',
+  '--disable-component-update',
+  '--disable-sync',
+];
+
+export function freePort() {
+  return new Promise((resolvePort, reject) => {
+    const server = createServer();
+    server.once('error', reject);
+    server.listen(0, '127.0.0.1', () => {
+      const { port } = server.address();
+      server.close(() => resolvePort(port));
+    });
+  });
+}
+
+/** Run `vite build` into `outDir`. */
+export function build(outDir = 'dist') {
+  return new Promise((resolveBuild, reject) => {
+    const child = spawn(process.execPath, [VITE, 'build', '--outDir', outDir, '--emptyOutDir', '--logLevel', 'warn'], {
+      cwd: ROOT,
+      stdio: ['ignore', 'inherit', 'inherit'],
+    });
+    child.once('exit', (code) => (code === 0 ? resolveBuild() : reject(new Error(`vite build exited ${code}`))));
+  });
+}
+
+/**
+ * Start `vite` (dev) or `vite preview` (built site) on a free port. `base` serves the site from a
+ * sub-path (preview only). Returns { url, stop }; stop() kills exactly this process.
+ */
+export async function startServer({ mode = 'dev', base = '/', outDir = 'dist' } = {}) {
+  const port = await freePort();
+  const args = mode === 'dev' ? [VITE] : [VITE, 'preview', '--outDir', outDir];
+  args.push('--host', '127.0.0.1', '--port', String(port), '--strictPort');
+  if (base !== '/') args.push('--base', base);
+  const child = spawn(process.execPath, args, { cwd: ROOT, stdio: ['ignore', 'pipe', 'pipe'] });
+  let log = '';
+  child.stdout.on('data', (d) => (log += d));
+  child.stderr.on('data', (d) => (log += d));
+  const url = `http://127.0.0.1:${port}${base}`;
+  const stop = () =>
+    new Promise((done) => {
+      if (child.exitCode !== null) return done();
+      child.once('exit', () => done());
+      process.kill(child.pid, 'SIGTERM');
+    });
+  const deadline = Date.now() + 30_000;
+  for (;;) {
+    if (child.exitCode !== null) throw new Error(`vite ${mode} exited early:\n${log}`);
+    try {
+      const response = await fetch(url);
+      if (response.ok) break;
+    } catch {
+      // not listening yet
+    }
+    if (Date.now() > deadline) {
+      await stop();
+      throw new Error(`vite ${mode} did not answer on ${url}:\n${log}`);
+    }
+    await sleep(100);
+  }
+  return { url, stop, log: () => log };
+}
+
+/**
+ * Launch Chromium with a fresh user-data-dir. `options` are Playwright context options
+ * (viewport, isMobile, hasTouch, ...). Returns { context, page, consoleErrors, close }.
+ */
+export async function launch(options = {}) {
+  const profile = mkdtempSync(join(tmpdir(), 'duet-chromium-'));
+  const context = await chromium.launchPersistentContext(profile, {
+    executablePath: CHROMIUM,
+    headless: true,
+    args: CHROMIUM_ARGS,
+    viewport: { width: 1280, height: 800 },
+    ...options,
+  });
+  const page = context.pages()[0] ?? (await context.newPage());
+  const consoleErrors = [];
+  page.on('console', (message) => {
+    if (message.type() === 'error') consoleErrors.push(message.text());
+  });
+  page.on('pageerror', (error) => consoleErrors.push(String(error)));
+  const close = async () => {
+    await context.close();
+    rmSync(profile, { recursive: true, force: true });
+  };
+  return { context, page, consoleErrors, close };
+}
+
+/** A snapshot of window.duet (plain data). */
+export function duet(page) {
+  return page.evaluate(() => JSON.parse(JSON.stringify(window.duet ?? null)));
+}
+
+/** Wait until window.duet.ready (or an error); returns milliseconds from now. */
+export async function waitReady(page, timeoutMs = 5000) {
+  const started = Date.now();
+  await page.waitForFunction(() => window.duet && (window.duet.ready || window.duet.error), null, {
+    timeout: timeoutMs,
+    polling: 20,
+  });
+  const state = await duet(page);
+  if (state.error) throw new Error(`page reported an error: ${state.error}`);
+  return Date.now() - started;
+}
+
+/** Wait until the simulation has taken `steps` more steps. */
+export async function waitSteps(page, steps, timeoutMs = 30_000) {
+  const start = (await duet(page)).frame;
+  await page.waitForFunction((target) => window.duet.frame >= target, start + steps, { timeout: timeoutMs, polling: 20 });
+}
+
+/** Press R and wait for a couple of steps so the reset state is published. */
+export async function reset(page) {
+  await page.keyboard.press('r');
+  await waitSteps(page, 2);
+  return duet(page);
+}
+
+export const distance = (a, b) => Math.hypot(a[0] - b[0], a[1] - b[1]);
+export const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+
+/** Leader displacement over `ms` of wall time while `hold()` is in effect. */
+export async function displacement(page, ms, hold = async () => {}, release = async () => {}) {
+  const start = await reset(page);
+  await hold();
+  await sleep(ms);
+  await release();
+  const end = await duet(page);
+  return { start: start.leader.root, end: end.leader.root, moved: distance(start.leader.root, end.leader.root) };
+}
+
+/**
+ * Fraction-of-pixels check that a screenshot is not blank: decode the PNG in the page (no image
+ * library needed) and return the variance of the luminance.
+ */
+export async function pixelVariance(page, png) {
+  const dataUrl = `data:image/png;base64,${png.toString('base64')}`;
+  return page.evaluate(async (src) => {
+    const image = new Image();
+    image.src = src;
+    await image.decode();
+    const canvas = document.createElement('canvas');
+    canvas.width = image.width;
+    canvas.height = image.height;
+    const context = canvas.getContext('2d');
+    context.drawImage(image, 0, 0);
+    const { data } = context.getImageData(0, 0, canvas.width, canvas.height);
+    let sum = 0;
+    let sumSquares = 0;
+    const n = data.length / 4;
+    for (let i = 0; i < data.length; i += 4) {
+      const y = 0.299 * data[i] + 0.587 * data[i + 1] + 0.114 * data[i + 2];
+      sum += y;
+      sumSquares += y * y;
+    }
+    const mean = sum / n;
+    return sumSquares / n - mean * mean;
+  }, dataUrl);
+}
+
+/** Touch drag through the DevTools protocol (Playwright has no touch-move API). */
+export async function touchDrag(page, from, to, steps = 8) {
+  const cdp = await page.context().newCDPSession(page);
+  const point = (x, y) => [{ x, y, id: 1, radiusX: 8, radiusY: 8, force: 1 }];
+  await cdp.send('Input.dispatchTouchEvent', { type: 'touchStart', touchPoints: point(from[0], from[1]) });
+  for (let i = 1; i <= steps; i++) {
+    const x = from[0] + ((to[0] - from[0]) * i) / steps;
+    const y = from[1] + ((to[1] - from[1]) * i) / steps;
+    await cdp.send('Input.dispatchTouchEvent', { type: 'touchMove', touchPoints: point(x, y) });
+  }
+  return {
+    release: async () => {
+      await cdp.send('Input.dispatchTouchEvent', { type: 'touchEnd', touchPoints: [] });
+      await cdp.detach();
+    },
+  };
+}

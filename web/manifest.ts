@@ -1,0 +1,74 @@
+// public/models/manifest.json: the skeleton, the feature layout, the model files and defaults,
+// written by training/export.py. Kept apart from policy.ts so the page can read it (and draw the
+// floor) before the 3.7 MB onnxruntime download finishes.
+
+import type { Manifest } from './types';
+import { DuetError } from './errors';
+
+/** Sizes this page was written for; the manifest must agree. */
+export const MANIFEST_VERSION = 1;
+export const LAYOUT = { input: 660, output: 323, intention: 90 } as const;
+
+/** Fetch and check public/models/manifest.json (relative, so a sub-path deployment works). */
+export async function loadManifest(url = 'models/manifest.json'): Promise<Manifest> {
+  let response: Response;
+  try {
+    response = await fetch(url);
+  } catch (error) {
+    throw new DuetError('Could not load the models', `${url}: ${(error as Error).message}`);
+  }
+  if (!response.ok) {
+    throw new DuetError('The models are missing', `${url} answered ${response.status}. Export models into public/models/ (python -m training.export).`);
+  }
+  let manifest: Manifest;
+  try {
+    manifest = (await response.json()) as Manifest;
+  } catch {
+    // A dev server answers a missing file with index.html, which is not JSON.
+    throw new DuetError('The models are missing', `${url} is not a JSON manifest. Export models into public/models/ (python -m training.export).`);
+  }
+  validateManifest(manifest);
+  return manifest;
+}
+
+export function validateManifest(manifest: Manifest): void {
+  const bad = (detail: string) => new DuetError('The model manifest does not match this page', detail);
+  if (!manifest || typeof manifest !== 'object') throw bad('manifest.json is not an object');
+  if (manifest.version !== MANIFEST_VERSION) {
+    throw bad(`manifest version ${manifest.version}, this page reads version ${MANIFEST_VERSION}`);
+  }
+  const layout = manifest.layout ?? ({} as Manifest['layout']);
+  for (const key of ['input', 'output', 'intention'] as const) {
+    if (layout[key] !== LAYOUT[key]) throw bad(`layout.${key} is ${layout[key]}, this page expects ${LAYOUT[key]}`);
+  }
+  const joints = manifest.skeleton?.parents?.length;
+  if (joints !== 17) throw bad(`skeleton has ${joints} joints, expected 17`);
+  for (const name of ['follower', 'leader']) {
+    if (!manifest.models?.[name]) throw bad(`no "${name}" model listed`);
+  }
+  for (const [name, entry] of Object.entries(manifest.models)) {
+    if (typeof entry.file !== 'string' || !/^[\w.-]+\.onnx$/.test(entry.file)) throw bad(`model "${name}" has a bad file name`);
+    if (!(entry.channels > 0 && entry.classes > 0)) throw bad(`model "${name}" needs channels and classes`);
+  }
+}
+
+
+/** Download one model's bytes and check them against the manifest. Independent of ORT, so the
+ *  downloads run while onnxruntime itself is still loading. */
+export async function fetchModelBytes(manifest: Manifest, name: string): Promise<Uint8Array> {
+  const entry = manifest.models[name];
+  if (!entry) throw new DuetError('Model not found', `"${name}" is not in manifest.json`);
+  const url = `models/${entry.file}`;
+  let bytes: Uint8Array;
+  try {
+    const response = await fetch(url);
+    if (!response.ok) throw new Error(`answered ${response.status}`);
+    bytes = new Uint8Array(await response.arrayBuffer());
+  } catch (error) {
+    throw new DuetError('A model file is missing', `${url}: ${(error as Error).message}`);
+  }
+  if (entry.bytes && bytes.byteLength !== entry.bytes) {
+    throw new DuetError('A model file is corrupt', `${url} has ${bytes.byteLength} bytes, manifest.json says ${entry.bytes}`);
+  }
+  return bytes;
+}

@@ -1,0 +1,350 @@
+// The three.js scene: a floor, two dancers drawn as capsules, translucent ghosts, and line + dot
+// overlays for trajectories and intentions. Everything is created once; per frame we only write
+// instance matrices and vertex positions (no allocation in the draw loop).
+
+import * as THREE from 'three';
+import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+
+export const COLORS = {
+  leader: 0x2f6fe4,
+  follower: 0xe0413a,
+  compare: 0xf0a030,
+  floor: 0xe9e4dc,
+  background: 0xf4f1ec,
+};
+
+const FLOOR_SIZE = 200; // metres; one grid cell per metre
+const JOINT_RADIUS = 0.055;
+const HEAD_RADIUS = 0.11;
+const BONE_RADIUS = 0.045;
+const HEAD = 4;
+const TARGET_HEIGHT = 0.9;
+
+/** Several dancers of one look, drawn with two instanced meshes (joint spheres + bone cylinders):
+ *  a chain of cylinders capped by spheres at the joints is a chain of capsules, and instancing
+ *  keeps it at two draw calls however many ghosts are shown. */
+export class DancerMeshes {
+  readonly group = new THREE.Group();
+  private readonly joints: THREE.InstancedMesh;
+  private readonly bones: THREE.InstancedMesh;
+  private readonly boneChildren: number[];
+  private readonly jointCount: number;
+
+  constructor(
+    private readonly parents: number[],
+    readonly capacity: number,
+    material: THREE.Material,
+    castShadow: boolean,
+  ) {
+    this.jointCount = parents.length;
+    this.boneChildren = parents.flatMap((p, j) => (p >= 0 ? [j] : []));
+    const sphere = new THREE.SphereGeometry(1, 16, 10);
+    // Unit cylinder from y = 0 to y = 1, so scale.y is the bone length.
+    const cylinder = new THREE.CylinderGeometry(1, 1, 1, 12, 1, true).translate(0, 0.5, 0);
+    this.joints = new THREE.InstancedMesh(sphere, material, capacity * this.jointCount);
+    this.bones = new THREE.InstancedMesh(cylinder, material, capacity * this.boneChildren.length);
+    for (const mesh of [this.joints, this.bones]) {
+      mesh.castShadow = castShadow;
+      mesh.receiveShadow = castShadow;
+      // Dancers move anywhere; the instanced bounding sphere would otherwise cull them.
+      mesh.frustumCulled = false;
+      mesh.instanceMatrix.setUsage(THREE.DynamicDrawUsage);
+      this.group.add(mesh);
+    }
+    this.setCount(capacity);
+  }
+
+  /** How many of the `capacity` dancers to draw. */
+  setCount(count: number): void {
+    const n = Math.max(0, Math.min(this.capacity, count));
+    this.joints.count = n * this.jointCount;
+    this.bones.count = n * this.boneChildren.length;
+    this.group.visible = n > 0;
+  }
+
+  /** Pose dancer `index` from 17 world joint positions. */
+  setPose(index: number, positions: Float32Array): void {
+    const m = _matrix;
+    for (let j = 0; j < this.jointCount; j++) {
+      const r = j === HEAD ? HEAD_RADIUS : JOINT_RADIUS;
+      _position.set(positions[3 * j], positions[3 * j + 1], positions[3 * j + 2]);
+      _scale.set(r, r, r);
+      m.compose(_position, _identity, _scale);
+      this.joints.setMatrixAt(index * this.jointCount + j, m);
+    }
+    const bones = this.boneChildren;
+    for (let b = 0; b < bones.length; b++) {
+      const j = bones[b];
+      const p = this.parents[j];
+      _position.set(positions[3 * p], positions[3 * p + 1], positions[3 * p + 2]);
+      _direction.set(positions[3 * j], positions[3 * j + 1], positions[3 * j + 2]).sub(_position);
+      const length = _direction.length();
+      if (length > 1e-6) _direction.divideScalar(length);
+      else _direction.set(0, 1, 0);
+      _rotation.setFromUnitVectors(_up, _direction);
+      _scale.set(BONE_RADIUS, length, BONE_RADIUS);
+      m.compose(_position, _rotation, _scale);
+      this.bones.setMatrixAt(index * bones.length + b, m);
+    }
+    this.joints.instanceMatrix.needsUpdate = true;
+    this.bones.instanceMatrix.needsUpdate = true;
+  }
+}
+
+/** A polyline with a dot at every point, rewritten in place from a Float32Array of world points. */
+export class PathOverlay {
+  readonly group = new THREE.Group();
+  private readonly positions: Float32Array;
+  private readonly line: THREE.Line | THREE.LineSegments;
+  private readonly dots: THREE.Points;
+
+  /** `segments`: draw independent polylines of `pointsPerLine` points (e.g. one per key joint). */
+  constructor(
+    readonly points: number,
+    color: number,
+    readonly pointsPerLine = points,
+  ) {
+    this.positions = new Float32Array(points * 3);
+    const geometry = new THREE.BufferGeometry();
+    const attribute = new THREE.BufferAttribute(this.positions, 3).setUsage(THREE.DynamicDrawUsage);
+    geometry.setAttribute('position', attribute);
+    // Several polylines share one buffer: an index joins consecutive points within each line.
+    const lines = points / pointsPerLine;
+    const index: number[] = [];
+    for (let l = 0; l < lines; l++) {
+      for (let i = 0; i < pointsPerLine - 1; i++) index.push(l * pointsPerLine + i, l * pointsPerLine + i + 1);
+    }
+    geometry.setIndex(index);
+    const lineMaterial = new THREE.LineBasicMaterial({ color, transparent: true, opacity: 0.85, depthTest: false });
+    this.line = new THREE.LineSegments(geometry, lineMaterial);
+    const dotMaterial = new THREE.PointsMaterial({ color, size: 7, sizeAttenuation: false, depthTest: false });
+    const dotGeometry = new THREE.BufferGeometry();
+    dotGeometry.setAttribute('position', attribute);
+    this.dots = new THREE.Points(dotGeometry, dotMaterial);
+    for (const object of [this.line, this.dots]) {
+      object.frustumCulled = false;
+      object.renderOrder = 10; // on top of the dancers' feet
+      this.group.add(object);
+    }
+  }
+
+  /** Floor trajectory: the root then keys of (x, z), drawn slightly above the floor. */
+  setFloorPath(rootX: number, rootZ: number, keys: Float32Array, height = 0.02): void {
+    const p = this.positions;
+    p[0] = rootX;
+    p[1] = height;
+    p[2] = rootZ;
+    for (let k = 1; k < this.points; k++) {
+      p[3 * k] = keys[2 * (k - 1)];
+      p[3 * k + 1] = height;
+      p[3 * k + 2] = keys[2 * (k - 1) + 1];
+    }
+    this.touch();
+  }
+
+  /** Points stored as [key][line][xyz] (the intention layout): regroup them per line. */
+  setKeyMajorPoints(points: Float32Array, keys: number, linesCount: number): void {
+    const p = this.positions;
+    for (let k = 0; k < keys; k++) {
+      for (let l = 0; l < linesCount; l++) {
+        const from = (k * linesCount + l) * 3;
+        const to = (l * keys + k) * 3;
+        p[to] = points[from];
+        p[to + 1] = points[from + 1];
+        p[to + 2] = points[from + 2];
+      }
+    }
+    this.touch();
+  }
+
+  private touch(): void {
+    const attribute = this.line.geometry.getAttribute('position') as THREE.BufferAttribute;
+    attribute.needsUpdate = true;
+  }
+}
+
+export interface CameraOrbit {
+  /** Degrees around the vertical axis; 0 looks along +z (from behind the leader at start). */
+  azimuth: number;
+  /** Degrees down from straight above. */
+  polar: number;
+  /** Metres from the pair's midpoint. */
+  distance: number;
+}
+
+/** A three-quarter view from behind the leader's right shoulder: both dancers visible. */
+export const DEFAULT_ORBIT: CameraOrbit = { azimuth: 35, polar: 70, distance: 5.2 };
+
+export class Stage {
+  readonly renderer: THREE.WebGLRenderer;
+  readonly scene = new THREE.Scene();
+  readonly camera: THREE.PerspectiveCamera;
+  readonly controls: OrbitControls;
+  readonly canvas: HTMLCanvasElement;
+
+  readonly leader: DancerMeshes;
+  /** Ours, and a second (orange) one in compare mode. */
+  readonly followers: DancerMeshes[];
+  readonly ghosts: DancerMeshes;
+  readonly trajectories: PathOverlay[];
+  readonly intentions: PathOverlay[];
+
+  private readonly sun: THREE.DirectionalLight;
+  private readonly floor: THREE.Mesh;
+  private readonly followTarget = new THREE.Vector3(0, TARGET_HEIGHT, 0.4);
+
+  constructor(container: HTMLElement, parents: number[], maxGhosts: number) {
+    this.renderer = new THREE.WebGLRenderer({ antialias: true });
+    // Phones report devicePixelRatio 3; 2 looks the same and costs less than half the pixels.
+    this.renderer.setPixelRatio(Math.min(window.devicePixelRatio, 2));
+    this.renderer.shadowMap.enabled = true;
+    this.renderer.shadowMap.type = THREE.PCFShadowMap;
+    this.canvas = this.renderer.domElement;
+    this.canvas.className = 'stage';
+    container.appendChild(this.canvas);
+
+    this.scene.background = new THREE.Color(COLORS.background);
+    this.scene.fog = new THREE.Fog(COLORS.background, 14, 32);
+
+    this.camera = new THREE.PerspectiveCamera(45, 1, 0.05, 100);
+    this.controls = new OrbitControls(this.camera, this.canvas);
+    this.controls.enableDamping = true;
+    this.controls.enablePan = false; // the camera follows the dancers; panning would fight that
+    this.controls.minDistance = 1.5;
+    this.controls.maxDistance = 20;
+    this.controls.maxPolarAngle = THREE.MathUtils.degToRad(88); // stay above the floor
+    // One finger steers (the joystick in controls.ts); two fingers orbit and zoom.
+    this.controls.touches = { ONE: -1 as THREE.TOUCH, TWO: THREE.TOUCH.DOLLY_ROTATE };
+    this.controls.target.copy(this.followTarget);
+    this.setOrbit(DEFAULT_ORBIT);
+
+    // Light: a soft sky/ground fill plus one shadow-casting sun that travels with the dancers.
+    this.scene.add(new THREE.HemisphereLight(0xffffff, 0xb8a898, 1.6));
+    this.sun = new THREE.DirectionalLight(0xffffff, 2.2);
+    this.sun.castShadow = true;
+    this.sun.shadow.mapSize.set(1024, 1024);
+    this.sun.shadow.radius = 4;
+    this.sun.shadow.bias = -0.0005;
+    const s = this.sun.shadow.camera;
+    [s.left, s.right, s.top, s.bottom, s.near, s.far] = [-4, 4, 4, -4, 0.5, 20];
+    this.scene.add(this.sun, this.sun.target);
+
+    // Grid lines are computed in the floor's fragment shader (see gridFloorMaterial): no line
+    // geometry (lines that pass behind the camera are dropped by some software rasterizers) and
+    // no texture fetches; fwidth() keeps them one pixel wide and free of shimmer at any distance.
+    const floorMaterial = gridFloorMaterial();
+    this.floor = new THREE.Mesh(new THREE.PlaneGeometry(FLOOR_SIZE, FLOOR_SIZE).rotateX(-Math.PI / 2), floorMaterial);
+    this.floor.receiveShadow = true;
+    this.scene.add(this.floor);
+
+    const solid = (color: number) => new THREE.MeshStandardMaterial({ color, roughness: 0.55, metalness: 0.05 });
+    this.leader = new DancerMeshes(parents, 1, solid(COLORS.leader), true);
+    this.followers = [
+      new DancerMeshes(parents, 1, solid(COLORS.follower), true),
+      new DancerMeshes(parents, 1, solid(COLORS.compare), true),
+    ];
+    const ghostMaterial = new THREE.MeshStandardMaterial({
+      color: COLORS.follower,
+      transparent: true,
+      opacity: 0.18,
+      depthWrite: false, // overlapping translucent ghosts should blend, not hide each other
+    });
+    this.ghosts = new DancerMeshes(parents, Math.max(1, maxGhosts), ghostMaterial, false);
+    this.ghosts.setCount(0);
+    this.scene.add(this.leader.group, this.ghosts.group, ...this.followers.map((f) => f.group));
+
+    // Trajectories: root + 6 future keys. Intentions: 5 key joints × 6 keys.
+    this.trajectories = [COLORS.leader, COLORS.follower, COLORS.compare].map((c) => new PathOverlay(7, c));
+    this.intentions = [COLORS.follower, COLORS.compare].map((c) => new PathOverlay(30, c, 6));
+    for (const overlay of [...this.trajectories, ...this.intentions]) this.scene.add(overlay.group);
+
+    this.resize();
+    window.addEventListener('resize', () => this.resize());
+    // Layout changes that are not window resizes (mobile URL bar, panels) also change the size.
+    new ResizeObserver(() => this.resize()).observe(container);
+  }
+
+  resize(): void {
+    const parent = this.canvas.parentElement ?? document.body;
+    const width = Math.max(1, parent.clientWidth);
+    const height = Math.max(1, parent.clientHeight);
+    this.renderer.setSize(width, height, false);
+    this.camera.aspect = width / height;
+    this.camera.updateProjectionMatrix();
+  }
+
+  /** Keep the pair in view: move the orbit target (and the camera with it) toward their midpoint. */
+  follow(midX: number, midZ: number, dt: number, snap = false): void {
+    const blend = snap ? 1 : 1 - Math.exp(-4 * dt);
+    _delta.set(midX, TARGET_HEIGHT, midZ).sub(this.followTarget).multiplyScalar(blend);
+    this.followTarget.add(_delta);
+    this.controls.target.add(_delta);
+    this.camera.position.add(_delta);
+    // The floor jumps by whole grid cells so it looks infinite without visibly moving.
+    this.floor.position.x = Math.round(this.followTarget.x);
+    this.floor.position.z = Math.round(this.followTarget.z);
+    this.sun.target.position.set(this.followTarget.x, 0, this.followTarget.z);
+    this.sun.position.set(this.followTarget.x + 3, 8, this.followTarget.z + 2);
+  }
+
+  getOrbit(): CameraOrbit {
+    _offset.copy(this.camera.position).sub(this.controls.target);
+    _spherical.setFromVector3(_offset);
+    return {
+      azimuth: THREE.MathUtils.radToDeg(_spherical.theta) + 180,
+      polar: THREE.MathUtils.radToDeg(_spherical.phi),
+      distance: _spherical.radius,
+    };
+  }
+
+  /** azimuth 0 puts the camera at -z of the target, looking along +z. */
+  setOrbit(orbit: CameraOrbit): void {
+    _spherical.set(orbit.distance, THREE.MathUtils.degToRad(orbit.polar), THREE.MathUtils.degToRad(orbit.azimuth - 180));
+    _offset.setFromSpherical(_spherical);
+    this.camera.position.copy(this.controls.target).add(_offset);
+    this.camera.lookAt(this.controls.target);
+    this.controls.update();
+  }
+
+  /** The camera's viewing direction projected on the floor, normalized: "forward" for steering. */
+  viewForward(out: { x: number; z: number }): void {
+    this.camera.getWorldDirection(_offset);
+    const length = Math.hypot(_offset.x, _offset.z) || 1;
+    out.x = _offset.x / length;
+    out.z = _offset.z / length;
+  }
+
+  render(): void {
+    this.controls.update();
+    this.renderer.render(this.scene, this.camera);
+  }
+}
+
+/** A Lambert floor with 1 m grid lines (and darker lines every 5 m) drawn by its shader. */
+function gridFloorMaterial(): THREE.MeshLambertMaterial {
+  const material = new THREE.MeshLambertMaterial({ color: COLORS.floor });
+  material.onBeforeCompile = (shader) => {
+    shader.vertexShader = shader.vertexShader
+      .replace('#include <common>', '#include <common>\nvarying vec2 vFloor;')
+      .replace('#include <begin_vertex>', '#include <begin_vertex>\nvFloor = (modelMatrix * vec4(position, 1.0)).xz;');
+    shader.fragmentShader = shader.fragmentShader
+      .replace('#include <common>', '#include <common>\nvarying vec2 vFloor;\nfloat gridLine(vec2 p) { vec2 d = abs(fract(p - 0.5) - 0.5) / fwidth(p); return 1.0 - min(min(d.x, d.y), 1.0); }')
+      .replace(
+        '#include <color_fragment>',
+        '#include <color_fragment>\ndiffuseColor.rgb *= 1.0 - 0.16 * gridLine(vFloor) - 0.14 * gridLine(vFloor / 5.0);',
+      );
+  };
+  return material;
+}
+
+// Scratch objects shared by the per-frame code above.
+const _matrix = new THREE.Matrix4();
+const _position = new THREE.Vector3();
+const _direction = new THREE.Vector3();
+const _scale = new THREE.Vector3();
+const _rotation = new THREE.Quaternion();
+const _identity = new THREE.Quaternion();
+const _up = new THREE.Vector3(0, 1, 0);
+const _delta = new THREE.Vector3();
+const _offset = new THREE.Vector3();
+const _spherical = new THREE.Spherical();

@@ -1,0 +1,113 @@
+// Shared types between the page shell (main, scene, hud, ...) and the simulation (rollout.ts).
+// The shell only ever talks to a `Simulation`; what happens inside one step (features, both
+// models, pose) is the simulation's business.
+
+import type { Policy } from './policy';
+
+/** A 2D steering request on the floor, in world x/z; |(x, z)| is in 0..1. */
+export interface Steer {
+  x: number;
+  z: number;
+  /** true while the user is pressing a key or holding the joystick. */
+  active: boolean;
+}
+
+/** What the shell needs to draw one dancer. All arrays are world space and owned by the
+ *  simulation; the shell copies them after each step and never writes to them. */
+export interface DancerView {
+  /** Root on the floor: [x, z] metres. */
+  root: [number, number];
+  /** Facing angle in radians; forward = (sin θ, 0, cos θ). */
+  heading: number;
+  /** 17 joints × (x, y, z). */
+  positions: Float32Array;
+  /** Future root trajectory: 6 keys × (x, z). */
+  future: Float32Array;
+  /** Predicted partner key joints (intention): 6 keys × 5 key joints × (x, y, z). */
+  intention?: Float32Array;
+}
+
+export interface Simulation {
+  /** Back to the start pose; keeps the models. */
+  reset(): void;
+  /** Advance one 1/30 s step. */
+  step(steer: Steer, temperature: number): Promise<void>;
+  leader: DancerView;
+  /** One follower, or two in compare mode (ours first). */
+  followers: DancerView[];
+  /** k alternative next follower poses sampled from the model, each 17 × (x, y, z) world. */
+  ghosts(k: number): Promise<Float32Array[]>;
+  /** Wall time of step() over the last 300 steps, milliseconds. */
+  stepMs(): { median: number; p95: number };
+}
+
+/** What the shell hands to the simulation factory. */
+export interface SimulationOptions {
+  manifest: Manifest;
+  leader: Policy;
+  /** [ours] or [ccm], or [ours, ccm] in compare mode. */
+  followers: Policy[];
+  /** Seed for anything random the simulation does itself (the policies carry their own PRNG). */
+  seed: number;
+}
+
+/** rollout.ts exports a function of this type named `createSimulation`. */
+export type CreateSimulation = (options: SimulationOptions) => Simulation;
+
+export interface ModelEntry {
+  file: string;
+  bytes: number;
+  /** Codebook channels C and classes D; the noise input is [B, C·D]. */
+  channels: number;
+  classes: number;
+  /** Whether the model has an `intention` output. */
+  intention: boolean;
+}
+
+/** public/models/manifest.json, written by training/export.py. */
+export interface Manifest {
+  version: number;
+  fps: number;
+  skeleton: {
+    names: string[];
+    parents: number[];
+    offsets: { leader: number[][]; follower: number[][] };
+  };
+  keyJoints: number[];
+  layout: { input: number; output: number; intention: number };
+  /** Opaque to the shell; read by rollout.ts. */
+  startPose: unknown;
+  models: Record<string, ModelEntry>;
+  defaultTemperature: number;
+  credit: string;
+}
+
+/** Follower model choices in the panel and the URL. */
+export type FollowerChoice = 'ours' | 'ccm' | 'compare';
+
+/** The test hook on window.duet (DESIGN.md, "Contracts"). Tests read only this. */
+export interface DuetHook {
+  ready: boolean;
+  error: string | null;
+  /** Simulation steps taken since the page loaded (not reset by R). */
+  frame: number;
+  leader: { root: [number, number]; heading: number };
+  follower: { root: [number, number]; heading: number };
+  /** step() wall time over the last 300 steps: features + both models + pose. */
+  stepMs: { median: number; p95: number };
+  /** Follower model in use: 'ours', 'ccm' or 'compare'. */
+  model: string;
+  // Extras for the bench and for debugging (not part of the contract).
+  paused: boolean;
+  threads: number;
+  /** Bytes of the ONNX files loaded so far. */
+  modelBytes: number;
+  /** performance.now() when the first step finished (cold load to a reacting page). */
+  firstFrameMs: number | null;
+}
+
+declare global {
+  interface Window {
+    duet?: DuetHook;
+  }
+}
