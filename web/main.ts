@@ -16,8 +16,8 @@ import { Hud } from './hud';
 import { Panel } from './panel';
 import { LIMITS, copyLink, defaultSettings, readSettings, writeSettings } from './share';
 
-/** The simulation: swap './devsim' for './rollout' once the real leader/follower loop exists. */
-const loadSimulationModule = () => import('./devsim');
+/** The duet loop (features, both models, pose): loaded with the models, not with the page. */
+const loadSimulationModule = () => import('./rollout');
 
 const DT = 1 / 30;
 /** A long stall counts as at most this much time, so the dance never jumps ahead. */
