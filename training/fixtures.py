@@ -471,8 +471,17 @@ def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_o
             "followerIntention": exact(fi), "absurd": absurd,
             "leader": dancer_state(duet.leader), "follower": dancer_state(duet.follower),
         })
+    # The partner guards: a leader 3.3 m from its follower plans its way back; the follower is leashed.
+    apart = ro.start_duet(manifest)
+    shift = np.array([2.1, 2.5])
+    apart.follower.track.root += shift
+    apart.follower.track.positions[..., [0, 2]] += shift
+    ro.return_to_partner(apart.leader, apart.follower)
+    leashed = ro.keep_close(apart.follower, apart.leader)
+    guards = {"shift": exact(shift), "leashed": leashed,
+              "leader": dancer_state(apart.leader), "follower": dancer_state(apart.follower)}
     return {
-        "NOW": ro.NOW, "TRACK_FRAMES": ro.TRACK_FRAMES,
+        "NOW": ro.NOW, "TRACK_FRAMES": ro.TRACK_FRAMES, "guards": guards,
         "rotationsFromVectors": {"forward": exact(vectors_f), "up": exact(vectors_u),
                                  "expected": out7(ro.rotations_from_vectors(vectors_f, vectors_u))},
         "offsets": {"leader": exact(lead_offsets), "follower": exact(follow_offsets)},

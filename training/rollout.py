@@ -18,16 +18,21 @@ import numpy as np
 from . import features as feat
 from .features import (FUTURE_OFFSETS, HISTORY, KEY_STEP, KEYS, Track, follower_input,
                        from_root_space_directions, from_root_space_points, leader_input)
-from .skeleton import FPS, KEY_JOINTS, forward_kinematics_reduced
+from .skeleton import FEET, FPS, KEY_JOINTS, forward_kinematics_reduced
 
 NOW = HISTORY
 TRACK_FRAMES = 2 * HISTORY + 1
 OUT = feat.block_slices(feat.OUTPUT_LAYOUT)
 
-MAX_SPEED = 1.2            # m/s of the steered path at full stick
+MAX_SPEED = 0.8            # m/s of the steered path at full stick (the recorded leaders cover
+                           # 0.49 m in a second at the median and 0.96 m at the 90th percentile)
 STEER_HALFLIFE = 0.25      # s for the steered velocity to get halfway to the stick's
 MAX_JOINT_DISTANCE = 3.0   # m from the root: beyond this the output is absurd
 MAX_ROOT_JUMP = 1.0        # m in one step
+MIN_ANKLE_HEIGHT = 0.04    # m: the lowest ankle height in the recordings
+COMFORT_DISTANCE = 1.2     # m: an unsteered leader plans its way back inside this
+LEASH_DISTANCE = 2.0       # m: beyond this a follower is drawn toward its leader ...
+LEASH_RATE = 0.1           # ... closing this share of the excess every frame
 START_DISTANCE = 0.8       # m between the partners at the start and after a reset
 
 
@@ -47,6 +52,7 @@ class Dancer:
     contacts: np.ndarray = field(default_factory=lambda: np.zeros(2))
     intention: np.ndarray | None = None       # [6, 5, 3] world: what this dancer expects of its partner
     resets: int = 0
+    leashed: int = 0                          # frames the leash moved this dancer
 
     @property
     def root(self):
@@ -106,6 +112,11 @@ def apply_output(d: Dancer, output: np.ndarray) -> None:
     t.rotations[NOW] = rotations_from_vectors(forward, up)
     hip = from_root_space_points(pose[0, :3], root, heading)
     t.positions[NOW] = forward_kinematics_reduced(d.offsets, hip, t.rotations[NOW])
+    # The predicted hip height can sag a few cm below what the legs need; lifting the whole body
+    # keeps the ankles on or above the floor without bending a bone.
+    lift = MIN_ANKLE_HEIGHT - t.positions[NOW][FEET, 1].min()
+    if lift > 0:
+        t.positions[NOW][:, 1] += lift
     # The predicted future root path becomes the plan (the leader's is bent by steering later).
     future = output[OUT["trajectory_future"]].reshape(KEYS, 4)
     keys = NOW + FUTURE_OFFSETS
@@ -151,6 +162,41 @@ def steer_plan(leader: Dancer, steering: Steering, stick: np.ndarray) -> None:
         t.root[NOW + off] += weight * (target - t.root[NOW + off])
 
 
+def return_to_partner(leader: Dancer, partner: Dancer) -> None:
+    """An unsteered leader that has wandered off plans its way back over the next second.
+
+    Fed its own predicted path, the leader model drifts slowly (nothing in a prediction pulls it
+    back); a real leader stays with the partner, so the plan is bent toward the partner by the
+    distance beyond COMFORT_DISTANCE, more for later keys.
+    """
+    d = partner.root - leader.root
+    dist = float(np.linalg.norm(d))
+    if dist <= COMFORT_DISTANCE:
+        return
+    t = leader.track
+    for off in FUTURE_OFFSETS:
+        t.root[NOW + off] += d / dist * (dist - COMFORT_DISTANCE) * off / HISTORY
+
+
+def keep_close(follower: Dancer, leader: Dancer) -> bool:
+    """Draw a follower that fell behind toward its leader (root, pose and plan move together).
+
+    A steered leader can travel faster and straighter than any recorded one; the follower model
+    then lags. The leash only acts beyond LEASH_DISTANCE, where the recordings hardly go (99 % of
+    recorded frames are within 2.74 m), and moves at most a tenth of the excess per frame.
+    """
+    d = leader.root - follower.root
+    dist = float(np.linalg.norm(d))
+    if dist <= LEASH_DISTANCE:
+        return False
+    shift = d / dist * (dist - LEASH_DISTANCE) * LEASH_RATE
+    t = follower.track
+    t.root[NOW] += shift
+    t.root[NOW + FUTURE_OFFSETS] += shift
+    t.positions[NOW][:, [0, 2]] += shift
+    return True
+
+
 @dataclass
 class Duet:
     leader: Dancer
@@ -181,6 +227,8 @@ def finish_step(duet: Duet, leader_output: np.ndarray, follower_output: np.ndarr
             reset_beside(d, partner, duet.start_pose[role])
         else:
             apply_output(d, out)
+    if keep_close(duet.follower, duet.leader):
+        duet.follower.leashed += 1
     if follower_intention is not None:
         f = duet.follower
         keys = follower_intention.reshape(KEYS, len(KEY_JOINTS), 3)
@@ -210,7 +258,10 @@ class OnnxPolicy:
 
 def step(duet: Duet, leader_policy, follower_policy, stick, temperature: float,
          rng: np.random.Generator) -> None:
-    steer_plan(duet.leader, duet.steering, np.asarray(stick, float))
+    stick = np.asarray(stick, float)
+    steer_plan(duet.leader, duet.steering, stick)
+    if not stick.any():
+        return_to_partner(duet.leader, duet.follower)
     xl, xf = step_inputs(duet)
     ol = leader_policy(xl, temperature, rng)
     of = follower_policy(xf, temperature, rng)

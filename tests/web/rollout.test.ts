@@ -103,6 +103,26 @@ describe('the duet loop, step by step', () => {
   });
 });
 
+describe('partner guards', () => {
+  it('returnToPartner bends an idle leader plan back and keepClose leashes a far follower', () => {
+    const g = data.guards;
+    const apart = R.startDuet({ skeleton: { offsets: data.offsets }, startPose: data.startPose });
+    const f = apart.followers[0];
+    for (let i = 0; i < R.TRACK_FRAMES; i++) {
+      f.track.root[2 * i] += g.shift[0];
+      f.track.root[2 * i + 1] += g.shift[1];
+      for (let j = 0; j < 17; j++) {
+        f.track.positions[51 * i + 3 * j] += g.shift[0];
+        f.track.positions[51 * i + 3 * j + 2] += g.shift[1];
+      }
+    }
+    R.returnToPartner(apart.leader, f);
+    expect(R.keepClose(f, apart.leader)).toBe(g.leashed);
+    expectDancer(apart.leader, g.leader, 'leader');
+    expectDancer(f, g.follower, 'follower');
+  });
+});
+
 describe('applyOutput', () => {
   it('reads a batched output at an offset exactly like a single one', () => {
     const step = data.steps[0];
