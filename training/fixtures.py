@@ -471,14 +471,15 @@ def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_o
             "followerIntention": exact(fi), "absurd": absurd,
             "leader": dancer_state(duet.leader), "follower": dancer_state(duet.follower),
         })
-    # The partner guards: a leader 3.3 m from its follower plans its way back; the follower is leashed.
+    # The guards: the leader drawn toward its anchor; a follower 3.3 m away leashed.
     apart = ro.start_duet(manifest)
     shift = np.array([2.1, 2.5])
     apart.follower.track.root += shift
     apart.follower.track.positions[..., [0, 2]] += shift
-    ro.return_to_partner(apart.leader, apart.follower)
+    apart.steering.anchor = np.array([-0.7, 0.4])
+    ro.follow_anchor(apart.leader, apart.steering)
     leashed = ro.keep_close(apart.follower, apart.leader)
-    guards = {"shift": exact(shift), "leashed": leashed,
+    guards = {"shift": exact(shift), "anchor": exact(apart.steering.anchor), "leashed": leashed,
               "leader": dancer_state(apart.leader), "follower": dancer_state(apart.follower)}
     return {
         "NOW": ro.NOW, "TRACK_FRAMES": ro.TRACK_FRAMES, "guards": guards,

@@ -30,7 +30,7 @@ STEER_HALFLIFE = 0.25      # s for the steered velocity to get halfway to the st
 MAX_JOINT_DISTANCE = 3.0   # m from the root: beyond this the output is absurd
 MAX_ROOT_JUMP = 1.0        # m in one step
 MIN_ANKLE_HEIGHT = 0.04    # m: the lowest ankle height in the recordings
-COMFORT_DISTANCE = 1.2     # m: an unsteered leader plans its way back inside this
+ANCHOR_RATE = 0.05         # share of the leader's distance to its anchor closed every frame
 LEASH_DISTANCE = 2.0       # m: beyond this a follower is drawn toward its leader ...
 LEASH_RATE = 0.1           # ... closing this share of the excess every frame
 START_DISTANCE = 0.8       # m between the partners at the start and after a reset
@@ -137,19 +137,22 @@ def reset_beside(d: Dancer, partner: Dancer, start_pose: dict) -> None:
 
 @dataclass
 class Steering:
-    """The user's stick (world x, z; length <= 1) turned into a smooth velocity for the plan."""
+    """The user's stick (world x, z; length <= 1) turned into a smooth velocity, and the anchor
+    that velocity carries: the spot the leader dances around. It moves only while steered."""
     velocity: np.ndarray = field(default_factory=lambda: np.zeros(2))
+    anchor: np.ndarray = field(default_factory=lambda: np.zeros(2))
 
     def update(self, stick: np.ndarray, dt: float = 1 / FPS) -> None:
         target = np.asarray(stick, float) * MAX_SPEED
         self.velocity = target + (self.velocity - target) * 0.5 ** (dt / STEER_HALFLIFE)
+        self.anchor = self.anchor + self.velocity * dt
 
 
 def steer_plan(leader: Dancer, steering: Steering, stick: np.ndarray) -> None:
     """Bend the leader's planned future root path toward the stick.
 
     With no stick, the plan is the leader's own last prediction (it dances on its own). With the
-    stick held, each key moves toward where the smoothed steering velocity would carry the root,
+    stick held, each key moves toward where the smoothed steering velocity carries the anchor,
     in proportion to how far the stick is pushed.
     """
     steering.update(stick)
@@ -158,28 +161,31 @@ def steer_plan(leader: Dancer, steering: Steering, stick: np.ndarray) -> None:
         return
     t = leader.track
     for k, off in enumerate(FUTURE_OFFSETS):
-        target = t.root[NOW] + steering.velocity * off / FPS
+        target = steering.anchor + steering.velocity * off / FPS
         t.root[NOW + off] += weight * (target - t.root[NOW + off])
 
 
-def return_to_partner(leader: Dancer, partner: Dancer) -> None:
-    """An unsteered leader that has wandered off plans its way back over the next second.
+def shift_dancer(d: Dancer, shift: np.ndarray) -> None:
+    """Slide a dancer on the floor: current root, current pose and planned path together."""
+    t = d.track
+    t.root[NOW] += shift
+    t.root[NOW + FUTURE_OFFSETS] += shift
+    t.positions[NOW][:, [0, 2]] += shift
 
-    Fed its own predicted path, the leader model drifts slowly (nothing in a prediction pulls it
-    back); a real leader stays with the partner, so the plan is bent toward the partner by the
-    distance beyond COMFORT_DISTANCE, more for later keys.
+
+def follow_anchor(leader: Dancer, steering: Steering) -> None:
+    """Draw the leader a little toward its anchor every frame.
+
+    The leader model reads the steered plan as an intention, not an order: fed its own predicted
+    path it wanders (about 1.7 m in 3 s here), and steered it answers only in part. Pulling the
+    root toward the anchor (a spring with a 0.7 s time constant at 30 Hz) lets it dance freely
+    around the spot the user left it at and travel where the user steers.
     """
-    d = partner.root - leader.root
-    dist = float(np.linalg.norm(d))
-    if dist <= COMFORT_DISTANCE:
-        return
-    t = leader.track
-    for off in FUTURE_OFFSETS:
-        t.root[NOW + off] += d / dist * (dist - COMFORT_DISTANCE) * off / HISTORY
+    shift_dancer(leader, (steering.anchor - leader.root) * ANCHOR_RATE)
 
 
 def keep_close(follower: Dancer, leader: Dancer) -> bool:
-    """Draw a follower that fell behind toward its leader (root, pose and plan move together).
+    """Draw a follower that fell behind toward its leader.
 
     A steered leader can travel faster and straighter than any recorded one; the follower model
     then lags. The leash only acts beyond LEASH_DISTANCE, where the recordings hardly go (99 % of
@@ -189,11 +195,7 @@ def keep_close(follower: Dancer, leader: Dancer) -> bool:
     dist = float(np.linalg.norm(d))
     if dist <= LEASH_DISTANCE:
         return False
-    shift = d / dist * (dist - LEASH_DISTANCE) * LEASH_RATE
-    t = follower.track
-    t.root[NOW] += shift
-    t.root[NOW + FUTURE_OFFSETS] += shift
-    t.positions[NOW][:, [0, 2]] += shift
+    shift_dancer(follower, d / dist * (dist - LEASH_DISTANCE) * LEASH_RATE)
     return True
 
 
@@ -210,7 +212,7 @@ def start_duet(manifest: dict) -> Duet:
     sk, sp = manifest["skeleton"], manifest["startPose"]
     leader = start_dancer(sk["offsets"]["leader"], sp["leader"], [0.0, 0.0], 0.0)
     follower = start_dancer(sk["offsets"]["follower"], sp["follower"], [0.0, START_DISTANCE], np.pi)
-    return Duet(leader, follower, sp)
+    return Duet(leader, follower, sp, Steering(anchor=leader.root.copy()))
 
 
 def step_inputs(duet: Duet) -> tuple[np.ndarray, np.ndarray]:
@@ -225,8 +227,12 @@ def finish_step(duet: Duet, leader_output: np.ndarray, follower_output: np.ndarr
                                   (duet.follower, duet.leader, follower_output, "follower")):
         if output_is_absurd(d, out):
             reset_beside(d, partner, duet.start_pose[role])
+            if d is duet.leader:
+                duet.steering.anchor = duet.leader.root.copy()
         else:
             apply_output(d, out)
+            if d is duet.leader:
+                follow_anchor(d, duet.steering)
     if keep_close(duet.follower, duet.leader):
         duet.follower.leashed += 1
     if follower_intention is not None:
@@ -258,10 +264,7 @@ class OnnxPolicy:
 
 def step(duet: Duet, leader_policy, follower_policy, stick, temperature: float,
          rng: np.random.Generator) -> None:
-    stick = np.asarray(stick, float)
-    steer_plan(duet.leader, duet.steering, stick)
-    if not stick.any():
-        return_to_partner(duet.leader, duet.follower)
+    steer_plan(duet.leader, duet.steering, np.asarray(stick, float))
     xl, xf = step_inputs(duet)
     ol = leader_policy(xl, temperature, rng)
     of = follower_policy(xf, temperature, rng)

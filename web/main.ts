@@ -15,6 +15,10 @@ import { Controls } from './controls';
 import { Hud } from './hud';
 import { Panel } from './panel';
 import { LIMITS, copyLink, defaultSettings, readSettings, writeSettings } from './share';
+// Record & leader file (record.ts, dropzone.ts).
+import type { Motion } from './skeleton';
+import { MAX_RECORD_FRAMES, type RecordableDuet, RecordPanel, Recorder, formatDuration } from './record';
+import { LeaderFileInput, canPlayLeader, showToast } from './dropzone';
 
 /** The duet loop (features, both models, pose): loaded with the models, not with the page. */
 const loadSimulationModule = () => import('./rollout');
@@ -205,6 +209,7 @@ async function start(): Promise<void> {
       hud.setStatus('loading models…');
       const [leaderPolicy, ...followerPolicies] = await Promise.all([policy('leader'), ...FOLLOWER_MODELS[choice].map(policy)]);
       simulation = createSimulation!({ manifest, leader: leaderPolicy, followers: followerPolicies, seed: settings.seed });
+      applyLeaderFile(); // record & leader file: a new simulation keeps the leader's file
       hook.model = choice;
       accumulator = 0;
       capture(true);
@@ -216,7 +221,7 @@ async function start(): Promise<void> {
     ghostPoses = simulation && settings.ghosts > 0 ? await simulation.ghosts(settings.ghosts) : [];
   };
 
-  new Panel({
+  const panel = new Panel({
     settings,
     models: hasCcm ? ['ours', 'ccm', 'compare'] : ['ours'],
     onModel: (choice) => useModel(choice).catch(fail),
@@ -235,6 +240,42 @@ async function start(): Promise<void> {
     },
   });
 
+  // --- Record & leader file (record.ts, dropzone.ts) --------------------------------------------
+  const recordable = (): RecordableDuet | null =>
+    simulation && 'duet' in simulation ? (simulation as Simulation & { duet: RecordableDuet }).duet : null;
+  const recorder = new Recorder(MAX_RECORD_FRAMES, () =>
+    showToast('Recording stopped', `It reached the ${formatDuration(MAX_RECORD_FRAMES / 30)} limit. Download the take (“download BVH”).`, 'error', 15_000));
+  let leaderFile: { motion: Motion; name: string } | null = null;
+  function applyLeaderFile(): void {
+    if (simulation && canPlayLeader(simulation)) simulation.setLeaderPlayback(leaderFile?.motion ?? null);
+  }
+  const leaderFileInput = new LeaderFileInput({
+    notify: showToast,
+    onMotion: (motion, name) =>
+      exclusive(() => {
+        if (!simulation || !canPlayLeader(simulation)) throw new Error('The dancers are still loading; try again in a moment.');
+        simulation.setLeaderPlayback(motion); // throws (nothing changed) on a motion it cannot play
+        leaderFile = { motion, name };
+        recordPanel.setLeaderFile(name);
+      }),
+  });
+  const recordPanel = new RecordPanel({
+    gui: panel.gui,
+    overlay: document.getElementById('overlay')!,
+    recorder,
+    duet: recordable,
+    between: (task) => exclusive(task),
+    notify: showToast,
+    onOpenLeaderFile: () => leaderFileInput.open(),
+    onLeaderModel: () =>
+      exclusive(() => {
+        leaderFile = null;
+        applyLeaderFile();
+        recordPanel.setLeaderFile(null);
+      }).catch(fail),
+  });
+  // --- end record & leader file ------------------------------------------------------------------
+
   /** Run the steps that real time asks for; called from the animation loop, one call at a time. */
   const advance = async () => {
     const began = performance.now();
@@ -244,6 +285,7 @@ async function start(): Promise<void> {
       accumulator -= DT;
       steps++;
       capture(false);
+      if (recorder.recording && recordable()) recorder.capture(recordable()!); // record & leader file
       hook.frame++;
       if (hook.firstFrameMs === null) hook.firstFrameMs = performance.now();
       hook.ready = true;
@@ -251,6 +293,7 @@ async function start(): Promise<void> {
       if (performance.now() - began > Math.max(MIN_STEP_BUDGET_MS, drawMs)) break;
     }
     if (steps > 0 && settings.ghosts > 0) await refreshGhosts();
+    if (steps > 0) recordPanel.update(); // record & leader file
     steppedMs += performance.now() - began;
   };
 

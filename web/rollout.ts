@@ -35,7 +35,7 @@ export const STEER_HALFLIFE = 0.25; // s for the steered velocity to get halfway
 export const MAX_JOINT_DISTANCE = 3.0; // m from the root: beyond this the output is absurd
 export const MAX_ROOT_JUMP = 1.0; // m in one step
 export const MIN_ANKLE_HEIGHT = 0.04; // m: the lowest ankle height in the recordings
-export const COMFORT_DISTANCE = 1.2; // m: an unsteered leader plans its way back inside this
+export const ANCHOR_RATE = 0.05; // share of the leader's distance to its anchor closed every frame
 export const LEASH_DISTANCE = 2.0; // m: beyond this a follower is drawn toward its leader ...
 export const LEASH_RATE = 0.1; // ... closing this share of the excess every frame
 export const START_DISTANCE = 0.8; // m between the partners at the start and after a reset
@@ -246,8 +246,13 @@ export function resetBeside(d: Dancer, partner: Dancer, startPose: StartPose): v
 }
 
 /** The user's stick (world x, z; length <= 1) turned into a smooth velocity for the plan. */
+/**
+ * The user's stick (world x, z; length <= 1) turned into a smooth velocity, and the anchor that
+ * velocity carries: the spot the leader dances around. It moves only while steered.
+ */
 export class Steering {
   readonly velocity = new Float64Array(2);
+  readonly anchor = new Float64Array(2);
 
   update(stickX: number, stickZ: number, dt = 1 / FPS): void {
     const decay = 0.5 ** (dt / STEER_HALFLIFE);
@@ -255,6 +260,8 @@ export class Steering {
     const tz = stickZ * MAX_SPEED;
     this.velocity[0] = tx + (this.velocity[0] - tx) * decay;
     this.velocity[1] = tz + (this.velocity[1] - tz) * decay;
+    this.anchor[0] += this.velocity[0] * dt;
+    this.anchor[1] += this.velocity[1] * dt;
   }
 }
 
@@ -262,7 +269,7 @@ export class Steering {
  * Bend the leader's planned future root path toward the stick.
  *
  * With no stick, the plan is the leader's own last prediction (it dances on its own). With the
- * stick held, each key moves toward where the smoothed steering velocity would carry the root,
+ * stick held, each key moves toward where the smoothed steering velocity carries the anchor,
  * in proportion to how far the stick is pushed.
  */
 export function steerPlan(leader: Dancer, steering: Steering, stickX: number, stickZ: number): void {
@@ -272,48 +279,16 @@ export function steerPlan(leader: Dancer, steering: Steering, stickX: number, st
   const root = leader.track.root;
   for (const off of FUTURE_OFFSETS) {
     const k = 2 * (NOW + off);
-    const targetX = root[2 * NOW] + (steering.velocity[0] * off) / FPS;
-    const targetZ = root[2 * NOW + 1] + (steering.velocity[1] * off) / FPS;
+    const targetX = steering.anchor[0] + (steering.velocity[0] * off) / FPS;
+    const targetZ = steering.anchor[1] + (steering.velocity[1] * off) / FPS;
     root[k] += weight * (targetX - root[k]);
     root[k + 1] += weight * (targetZ - root[k + 1]);
   }
 }
 
-/**
- * An unsteered leader that has wandered off plans its way back over the next second.
- *
- * Fed its own predicted path, the leader model drifts slowly (nothing in a prediction pulls it
- * back); a real leader stays with the partner, so the plan is bent toward the partner by the
- * distance beyond COMFORT_DISTANCE, more for later keys.
- */
-export function returnToPartner(leader: Dancer, partner: Dancer): void {
-  const dx = partner.rootX - leader.rootX;
-  const dz = partner.rootZ - leader.rootZ;
-  const dist = Math.hypot(dx, dz);
-  if (dist <= COMFORT_DISTANCE) return;
-  const root = leader.track.root;
-  for (const off of FUTURE_OFFSETS) {
-    const k = 2 * (NOW + off);
-    root[k] += ((dx / dist) * (dist - COMFORT_DISTANCE) * off) / HISTORY;
-    root[k + 1] += ((dz / dist) * (dist - COMFORT_DISTANCE) * off) / HISTORY;
-  }
-}
-
-/**
- * Draw a follower that fell behind toward its leader (root, pose and plan move together).
- *
- * A steered leader can travel faster and straighter than any recorded one; the follower model
- * then lags. The leash only acts beyond LEASH_DISTANCE, where the recordings hardly go (99 % of
- * recorded frames are within 2.74 m), and moves at most a tenth of the excess per frame.
- */
-export function keepClose(follower: Dancer, leader: Dancer): boolean {
-  const dx = leader.rootX - follower.rootX;
-  const dz = leader.rootZ - follower.rootZ;
-  const dist = Math.hypot(dx, dz);
-  if (dist <= LEASH_DISTANCE) return false;
-  const sx = (dx / dist) * (dist - LEASH_DISTANCE) * LEASH_RATE;
-  const sz = (dz / dist) * (dist - LEASH_DISTANCE) * LEASH_RATE;
-  const t = follower.track;
+/** Slide a dancer on the floor: current root, current pose and planned path together. */
+export function shiftDancer(d: Dancer, sx: number, sz: number): void {
+  const t = d.track;
   t.root[2 * NOW] += sx;
   t.root[2 * NOW + 1] += sz;
   for (const off of FUTURE_OFFSETS) {
@@ -324,6 +299,33 @@ export function keepClose(follower: Dancer, leader: Dancer): boolean {
     t.positions[NOW * 51 + 3 * j] += sx;
     t.positions[NOW * 51 + 3 * j + 2] += sz;
   }
+}
+
+/**
+ * Draw the leader a little toward its anchor every frame.
+ *
+ * The leader model reads the steered plan as an intention, not an order: fed its own predicted
+ * path it wanders (about 1.7 m in 3 s here), and steered it answers only in part. Pulling the
+ * root toward the anchor (a spring with a 0.7 s time constant at 30 Hz) lets it dance freely
+ * around the spot the user left it at and travel where the user steers.
+ */
+export function followAnchor(leader: Dancer, steering: Steering): void {
+  shiftDancer(leader, (steering.anchor[0] - leader.rootX) * ANCHOR_RATE, (steering.anchor[1] - leader.rootZ) * ANCHOR_RATE);
+}
+
+/**
+ * Draw a follower that fell behind toward its leader.
+ *
+ * A steered leader can travel faster and straighter than any recorded one; the follower model
+ * then lags. The leash only acts beyond LEASH_DISTANCE, where the recordings hardly go (99 % of
+ * recorded frames are within 2.74 m), and moves at most a tenth of the excess per frame.
+ */
+export function keepClose(follower: Dancer, leader: Dancer): boolean {
+  const dx = leader.rootX - follower.rootX;
+  const dz = leader.rootZ - follower.rootZ;
+  const dist = Math.hypot(dx, dz);
+  if (dist <= LEASH_DISTANCE) return false;
+  shiftDancer(follower, (dx / dist) * (dist - LEASH_DISTANCE) * LEASH_RATE, (dz / dist) * (dist - LEASH_DISTANCE) * LEASH_RATE);
   return true;
 }
 
@@ -374,7 +376,9 @@ export function startDuet(manifest: DuetManifest, followerCount = 1): Duet {
   const leader = startDancer(offsets.leader.flat(), startPose.leader, 0, 0, 0);
   const followers = Array.from({ length: followerCount }, () =>
     startDancer(offsets.follower.flat(), startPose.follower, 0, START_DISTANCE, Math.PI));
-  return { leader, followers, startPose, steering: new Steering(), frame: 0 };
+  const duet: Duet = { leader, followers, startPose, steering: new Steering(), frame: 0 };
+  setAnchor(duet);
+  return duet;
 }
 
 /** Both models' inputs at NOW: the leader's (partner = first follower) and each follower's. */
@@ -389,13 +393,26 @@ const intentionLocal = new Float64Array(INTENTION_SIZE);
  * Move everyone one frame on. A null leader output means the leader was moved already (playback).
  * Each absurd output resets its dancer beside its partner instead.
  */
+/** Put the anchor under the leader (start, reset, recorded leader). */
+export function setAnchor(duet: Duet): void {
+  duet.steering.anchor[0] = duet.leader.rootX;
+  duet.steering.anchor[1] = duet.leader.rootZ;
+}
+
 export function finishStep(
   duet: Duet, leaderOutput: ArrayLike<number> | null, followerOutputs: ArrayLike<number>[],
   followerIntentions: (ArrayLike<number> | null)[] = [],
 ): void {
   if (leaderOutput) {
-    if (outputIsAbsurd(duet.leader, leaderOutput)) resetBeside(duet.leader, duet.followers[0], duet.startPose.leader);
-    else applyOutput(duet.leader, leaderOutput);
+    if (outputIsAbsurd(duet.leader, leaderOutput)) {
+      resetBeside(duet.leader, duet.followers[0], duet.startPose.leader);
+      setAnchor(duet);
+    } else {
+      applyOutput(duet.leader, leaderOutput);
+      followAnchor(duet.leader, duet.steering);
+    }
+  } else {
+    setAnchor(duet); // a recording leads: the anchor waits where the model will take over
   }
   duet.followers.forEach((f, i) => {
     if (outputIsAbsurd(f, followerOutputs[i])) resetBeside(f, duet.leader, duet.startPose.follower);
@@ -499,7 +516,6 @@ export class DuetSimulation implements Simulation {
       const sx = steer.active ? steer.x : 0;
       const sz = steer.active ? steer.z : 0;
       steerPlan(duet.leader, duet.steering, sx, sz);
-      if (sx === 0 && sz === 0) returnToPartner(duet.leader, duet.followers[0]);
     }
     stepInputs(duet, playing ? null : this.leaderPolicy.input, this.followerInputs);
     if (!playing) {

@@ -189,7 +189,9 @@ def test_steering_bends_the_leader_plan(duet_and_output):
         R.steer_plan(leader, duet.steering, np.array([1.0, 0.0]))
     # 2 s are 8 half-lives of the smoothing: 1/256 of the way is left.
     np.testing.assert_allclose(duet.steering.velocity, [R.MAX_SPEED * (1 - 0.5 ** (2.0 / R.STEER_HALFLIFE)), 0], atol=1e-12)
-    expect = leader.root + np.outer(feat.FUTURE_OFFSETS / FPS, duet.steering.velocity)
+    # The plan leads from the anchor, which the steering velocity carried along the way.
+    assert duet.steering.anchor[0] > 0.5
+    expect = duet.steering.anchor + np.outer(feat.FUTURE_OFFSETS / FPS, duet.steering.velocity)
     np.testing.assert_allclose(leader.track.root[keys], expect, atol=1e-9)
 
 

@@ -104,7 +104,7 @@ describe('the duet loop, step by step', () => {
 });
 
 describe('partner guards', () => {
-  it('returnToPartner bends an idle leader plan back and keepClose leashes a far follower', () => {
+  it('followAnchor draws the leader toward its anchor and keepClose leashes a far follower', () => {
     const g = data.guards;
     const apart = R.startDuet({ skeleton: { offsets: data.offsets }, startPose: data.startPose });
     const f = apart.followers[0];
@@ -116,7 +116,8 @@ describe('partner guards', () => {
         f.track.positions[51 * i + 3 * j + 2] += g.shift[1];
       }
     }
-    R.returnToPartner(apart.leader, f);
+    apart.steering.anchor.set(g.anchor);
+    R.followAnchor(apart.leader, apart.steering);
     expect(R.keepClose(f, apart.leader)).toBe(g.leashed);
     expectDancer(apart.leader, g.leader, 'leader');
     expectDancer(f, g.follower, 'follower');

@@ -4,7 +4,7 @@
 
 import { describe, expect, it } from 'vitest';
 import { FOLLOWER_INPUT_LAYOUT, INPUT_SIZE, LEADER_INPUT_LAYOUT, OUTPUT_LAYOUT, OUTPUT_SIZE, Track, blockSlices } from '../../web/features';
-import { NOW, type DuetSimulation, createDuetSimulation, createSimulation } from '../../web/rollout';
+import { ANCHOR_RATE, NOW, type DuetSimulation, createDuetSimulation, createSimulation } from '../../web/rollout';
 import type { Motion } from '../../web/skeleton';
 import type { Policy } from '../../web/policy';
 import type { Manifest } from '../../web/types';
@@ -139,9 +139,13 @@ describe('createSimulation', () => {
   it('moves the drawn future and root with the model output', async () => {
     const { sim } = simulation([{ role: 'follower', step: 0.02 }], { role: 'leader', step: 0.02 });
     for (let i = 0; i < 10; i++) await sim.step(steer, 0.5);
-    expect(sim.leader.root[1]).toBeCloseTo(0.2, 6); // leader faces +Z
+    // The leader faces +Z and steps 2 cm a frame, while its anchor (nobody steers) stays at the
+    // origin and draws it back by ANCHOR_RATE of the distance each frame.
+    let lead = 0;
+    for (let i = 0; i < 10; i++) lead = (lead + 0.02) * (1 - ANCHOR_RATE);
+    expect(sim.leader.root[1]).toBeCloseTo(lead, 6);
     expect(sim.followers[0].root[1]).toBeCloseTo(0.6, 6); // follower faces -Z
-    expect(sim.leader.future[11]).toBeCloseTo(0.2 + 0.02 * 30, 5);
+    expect(sim.leader.future[11]).toBeCloseTo(lead + 0.02 * 30, 5);
   });
 
   it('steering bends the leader plan toward the stick', async () => {
