@@ -1,0 +1,47 @@
+"""The soak tool: its steering script and a short soak of the shipped models (CI's version of
+the full 100 x 10 min run documented in docs/reliability.md)."""
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from training import soak
+from training.skeleton import FPS
+
+MODELS = Path(__file__).resolve().parents[2] / "public" / "models"
+
+
+def test_steering_script_has_idles_holds_and_reversals():
+    sticks = soak.steering_script(np.random.default_rng(3), 20 * 60 * FPS)
+    assert np.all(np.linalg.norm(sticks, axis=1) <= 1 + 1e-9)
+    idle = ~sticks.any(1)
+    assert 0.05 < idle.mean() < 0.6
+    changes = np.flatnonzero(np.any(np.diff(sticks, axis=0) != 0, axis=1))
+    gaps = np.diff(changes) / FPS
+    assert gaps.min() >= 0.5 - 1e-9 and gaps.max() > 3.0          # 0.5-3 s segments, long holds
+    before, after = sticks[changes], sticks[changes + 1]
+    reversals = np.all(np.isclose(after, -before), axis=1) & before.any(1)
+    assert reversals.sum() > 10
+
+
+def test_failures_name_each_broken_limit():
+    ok = {"nonfinite": 0, "max_distance": 1.0, "bone_error": 0.0, "min_foot": 0.04,
+          "frozen_leader": 0.0, "frozen_follower": 0.0, "resets": 0}
+    assert soak.failures(ok) == []
+    bad = dict(ok, nonfinite=3, max_distance=3.5, min_foot=-0.05, frozen_follower=0.9, resets=1)
+    assert len(soak.failures(bad)) == 5
+
+
+@pytest.mark.skipif(not (MODELS / "manifest.json").exists(), reason="no shipped models")
+def test_short_soak_of_the_shipped_models_passes(tmp_path, capsys):
+    out = tmp_path / "soak.json"
+    assert soak.main(["--models", str(MODELS), "--rollouts", "2", "--minutes", "1", "--out", str(out)]) == 0
+    summary = json.loads(out.read_text())["summary"]
+    assert summary["nonfinite"] == 0 and summary["max_distance"] < 3.0
+    assert "summary: 0 of 2 rollouts failed" in capsys.readouterr().out
+
+
+def test_missing_models_is_a_clear_error(tmp_path, capsys):
+    assert soak.main(["--models", str(tmp_path)]) == 2
+    assert "manifest.json not found" in capsys.readouterr().err
