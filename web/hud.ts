@@ -7,6 +7,8 @@ export interface HudStats {
   fps: number;
   threads: number;
   modelBytes: number;
+  /** Guard counts (resets after absurd output, leashed frames); shown only once one acted. */
+  guards: { resets: number; leashed: number };
 }
 
 export class Hud {
@@ -34,7 +36,10 @@ export class Hud {
     const { median, p95 } = stats.stepMs;
     this.element.textContent =
       `step ${median.toFixed(1)} ms (p95 ${p95.toFixed(1)})  ·  ${Math.round(stats.fps)} fps  ·  ` +
-      `${stats.threads} thread${stats.threads === 1 ? '' : 's'}  ·  models ${formatBytes(stats.modelBytes)}`;
+      `${stats.threads} thread${stats.threads === 1 ? '' : 's'}  ·  models ${formatBytes(stats.modelBytes)}` +
+      (stats.guards.resets || stats.guards.leashed
+        ? `  ·  guards: ${stats.guards.resets} reset${stats.guards.resets === 1 ? '' : 's'}, ${stats.guards.leashed} leashed frames`
+        : '');
   }
 }
 

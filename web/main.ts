@@ -24,6 +24,7 @@ import { LeaderFileInput, canPlayLeader, showToast } from './dropzone';
 const loadSimulationModule = () => import('./rollout');
 
 const DT = 1 / 30;
+const NO_GUARDS = { resets: 0, leashed: 0 };
 /** A long stall counts as at most this much time, so the dance never jumps ahead. */
 const MAX_FRAME_SECONDS = 0.5;
 /** Simulation time the loop may fall behind before it gives up on catching up (slow motion). */
@@ -332,7 +333,8 @@ async function start(): Promise<void> {
       lastIdleDraw = now;
       draw(Math.min(1, accumulator / DT), elapsed);
     }
-    hud.update(now, { stepMs: hook.stepMs, fps, threads: hook.threads, modelBytes: hook.modelBytes });
+    const guards = simulation ? simulation.guards() : NO_GUARDS;
+    hud.update(now, { stepMs: hook.stepMs, fps, threads: hook.threads, modelBytes: hook.modelBytes, guards });
   };
 
   const draw = (alpha: number, elapsed: number) => {

@@ -555,6 +555,11 @@ export class DuetSimulation implements Simulation {
     return this.ghostPoses.slice(0, k);
   }
 
+  guards(): { resets: number; leashed: number } {
+    const all = [this.duet.leader, ...this.duet.followers];
+    return { resets: all.reduce((n, d) => n + d.resets, 0), leashed: all.reduce((n, d) => n + d.leashed, 0) };
+  }
+
   stepMs(): { median: number; p95: number } {
     return this.timer.summary();
   }

@@ -39,6 +39,9 @@ export interface Simulation {
   ghosts(k: number): Promise<Float32Array[]>;
   /** Wall time of step() over the last 300 steps, milliseconds. */
   stepMs(): { median: number; p95: number };
+  /** Guard counts since the start: dancers reset after absurd model output, and frames the
+   *  leash drew a follower toward the leader (see rollout.ts). */
+  guards(): { resets: number; leashed: number };
 }
 
 /** What the shell hands to the simulation factory. */
