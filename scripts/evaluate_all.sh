@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Regenerates docs/results.md's numbers and plots from the shipped models plus the
+# evaluation-only models (train those first: bash scripts/train_ablations.sh).
+#   bash scripts/evaluate_all.sh [DATA]      (DATA defaults to ../shared/data/cmu-salsa)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+PY=.venv/bin/python
+DATA=${1:-../shared/data/cmu-salsa}
+MODELS=runs/eval_models
+rm -rf "$MODELS" && mkdir -p "$MODELS"
+
+# Every finished follower variant, exported like the shipped ones (the manifest comes along).
+names=()
+for m in follower follower_ccm leader follower_small follower_ccm_large follower_no_gan \
+         follower_noisy_intention follower_end_to_end follower_end_to_end_no_ss; do
+  [ -f "runs/models/$m/checkpoint.pt" ] && names+=(--model "$m")
+done
+$PY -m training.export "${names[@]}" --out "$MODELS" --fp32 runs/eval_fp32 --data "$DATA"
+# The λG sweep lives in runs/sweep/lgG/follower: export each under its own name.
+for dir in runs/sweep/lg*; do
+  [ -f "$dir/follower/checkpoint.pt" ] || continue
+  g=$(basename "$dir")
+  $PY -m training.export --runs "$dir" --model follower --out "runs/sweep_export/$g" --fp32 "runs/sweep_export/$g/fp32" --data "$DATA"
+  cp "runs/sweep_export/$g/follower.onnx" "$MODELS/follower_$g.onnx"
+  ln -sfn "../sweep/$g/follower" "runs/models/follower_$g"     # codebook error reads the checkpoint
+done
+
+$PY -m training.evaluate --data "$DATA" --takes 02,13 --models "$MODELS" --out runs/eval_all \
+    --seeds 0,1,2 --temperatures 0.5,1 --quiet
+$PY -m training.plots --out docs
