@@ -12,7 +12,7 @@ rm -rf "$MODELS" && mkdir -p "$MODELS"
 # Every finished follower variant, exported like the shipped ones (the manifest comes along).
 names=()
 for m in follower follower_ccm leader follower_small follower_ccm_large follower_no_gan \
-         follower_noisy_intention follower_end_to_end follower_end_to_end_no_ss; do
+         follower_no_intention_noise follower_end_to_end follower_end_to_end_no_ss; do
   [ -f "runs/models/$m/checkpoint.pt" ] && names+=(--model "$m")
 done
 $PY -m training.export "${names[@]}" --out "$MODELS" --fp32 runs/eval_fp32 --data "$DATA"
