@@ -8,17 +8,20 @@ PY=.venv/bin/python
 DATA=${1:-../shared/data/cmu-salsa}
 MODELS=runs/eval_models
 rm -rf "$MODELS" && mkdir -p "$MODELS"
+finished() {   # a run whose training reached the end (export refuses the others)
+  [ -f "$1/checkpoint.pt" ] && $PY -c "import sys, torch; sys.exit(torch.load('$1/checkpoint.pt', weights_only=False)['stage'] != 'done')"
+}
 
 # Every finished follower variant, exported like the shipped ones (the manifest comes along).
 names=()
 for m in follower follower_ccm leader follower_small follower_ccm_large follower_no_gan \
          follower_no_intention_noise follower_end_to_end follower_end_to_end_no_ss; do
-  [ -f "runs/models/$m/checkpoint.pt" ] && names+=(--model "$m")
+  if finished "runs/models/$m"; then names+=(--model "$m"); fi
 done
 $PY -m training.export "${names[@]}" --out "$MODELS" --fp32 runs/eval_fp32 --data "$DATA"
 # The λG sweep lives in runs/sweep/lgG/follower: export each under its own name.
 for dir in runs/sweep/lg*; do
-  [ -f "$dir/follower/checkpoint.pt" ] || continue
+  finished "$dir/follower" || continue
   g=$(basename "$dir")
   $PY -m training.export --runs "$dir" --model follower --out "runs/sweep_export/$g" --fp32 "runs/sweep_export/$g/fp32" --data "$DATA"
   cp "runs/sweep_export/$g/follower.onnx" "$MODELS/follower_$g.onnx"
