@@ -134,7 +134,13 @@ export async function createPolicy(manifest: Manifest, name: string, bytes: Uint
       graphOptimizationLevel: 'all',
     });
   } catch (error) {
-    throw new DuetError('A model file is corrupt', `models/${entry.file}: ${(error as Error).message ?? error}`);
+    // onnxruntime's own message can be empty ("ERROR_MESSAGE: "): say what it means in any case.
+    const detail = String((error as Error)?.message ?? error).trim();
+    throw new DuetError(
+      'A model file is corrupt',
+      `models/${entry.file} is not a readable ONNX model (damaged or half downloaded; a reload fetches it again)` +
+        (detail ? `. onnxruntime: ${detail}` : ''),
+    );
   }
   checkSession(name, entry, session);
   return new Policy(name, entry, session, seed);
