@@ -12,7 +12,9 @@ import { createReadStream, mkdtempSync, rmSync, statSync } from 'node:fs';
 import { createServer } from 'node:http';
 import { tmpdir } from 'node:os';
 import { extname, join, normalize, sep } from 'node:path';
-import { build, distance, duet, launch, pixelVariance, sleep, startServer, waitReady, waitSteps } from './harness.mjs';
+import {
+  CHROMIUM_ARGS, build, distance, duet, launch, pixelVariance, sleep, startServer, waitReady, waitSteps,
+} from './harness.mjs';
 
 /**
  * How long the tab stays hidden. A real minute (DUET_HIDDEN_SECONDS=60) behaves exactly like the
@@ -22,18 +24,6 @@ import { build, distance, duet, launch, pixelVariance, sleep, startServer, waitR
 const HIDDEN_SECONDS = Number(process.env.DUET_HIDDEN_SECONDS ?? 20);
 /** Luminance variance of a screenshot above which it is not blank (a flat page is ~0). */
 const MIN_VARIANCE = 5;
-
-// The harness's Chromium flags; launch({ args }) replaces them, so the WebGL test repeats them.
-const CHROMIUM_ARGS = [
-  '--headless',
-  '--no-sandbox',
-  '--disable-gpu',
-  '--disable-quic',
-  '--no-first-run',
-  '--disable-background-networking',
-  '--disable-component-update',
-  '--disable-sync',
-];
 
 /** Installed before any page script: collect CSP violations, dialogs cannot be seen from here. */
 function watchViolations() {
