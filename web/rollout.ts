@@ -474,6 +474,7 @@ export class DuetSimulation implements Simulation {
   private readonly followerInputs: Float32Array[];
   // Own copies of each model's result: two roles may never share a Policy's result arrays.
   private readonly leaderOutput = new Float32Array(OUTPUT_SIZE);
+  private readonly guardCounts = { resets: 0, leashed: 0 };
   private readonly followerOutputs: Float32Array[];
   private readonly followerIntentions: (Float32Array | null)[];
   private readonly timer = new StepTimer(300);
@@ -555,9 +556,16 @@ export class DuetSimulation implements Simulation {
     return this.ghostPoses.slice(0, k);
   }
 
+  /** Called every animation frame by the HUD: sums into one reused object, allocates nothing. */
   guards(): { resets: number; leashed: number } {
-    const all = [this.duet.leader, ...this.duet.followers];
-    return { resets: all.reduce((n, d) => n + d.resets, 0), leashed: all.reduce((n, d) => n + d.leashed, 0) };
+    const g = this.guardCounts;
+    g.resets = this.duet.leader.resets;
+    g.leashed = this.duet.leader.leashed;
+    for (const f of this.duet.followers) {
+      g.resets += f.resets;
+      g.leashed += f.leashed;
+    }
+    return g;
   }
 
   stepMs(): { median: number; p95: number } {
