@@ -236,3 +236,15 @@ def test_shipped_models_dance_five_minutes():
         slow, fast = windows[:, k].min(), windows[:, k].max()
         assert slow > MIN_WINDOW_SPEED, f"{role} nearly stops: mean joint speed {slow:.2f} m/s in a 10 s window"
         assert fast < MAX_WINDOW_SPEED, f"{role} jitters: mean joint speed {fast:.2f} m/s in a 10 s window"
+
+
+@pytest.mark.skipif(not (SHIPPED / "manifest.json").exists(), reason="public/models/manifest.json is absent")
+def test_shipped_models_fit_the_size_budget():
+    """The page downloads these: all three models ≤ 6 MB, and the manifest's byte counts are the
+    files' (the page shows them and the export writes them)."""
+    manifest = json.loads((SHIPPED / "manifest.json").read_text())
+    sizes = {name: (SHIPPED / f"{name}.onnx").stat().st_size for name in manifest["models"]}
+    assert set(sizes) == {"follower", "follower_ccm", "leader"}
+    for name, entry in manifest["models"].items():
+        assert entry["bytes"] == sizes[name], name
+    assert sum(sizes.values()) <= 6_000_000, sizes

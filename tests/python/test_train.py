@@ -219,3 +219,44 @@ def test_ddp_two_cpu_processes(prepared3, tmp_path):
     assert len(h["val_mse"]) == 2 and all(math.isfinite(v) for v in h["val_mse"])
     ck = torch.load(tmp_path / "follower" / "checkpoint.pt", map_location="cpu", weights_only=False)
     assert ck["stage"] == "done"
+
+
+# ---------------------------------------------------------------- validation table
+
+def test_validation_table_of_smoke_runs(smoke_runs, prepared3, capsys):
+    """training.validation: one row per run; the target-code MPJPE equals train.validate's when
+    the estimated code is replaced by the target one, and both are in a plausible range."""
+    from training import validation as V
+    runs = [smoke_runs / "follower", smoke_runs / "follower_ccm"]
+    assert V.main([str(r) for r in runs] + ["--data", str(prepared3)]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert len(out) == 4 and out[2].startswith(f"| {runs[0]} | yes | 2 |") and "| no | 2 |" in out[3]
+    row = V.measure(runs[0], str(prepared3))
+    assert 0 < row["mpjpe_target_cm"] < 100 and 0 < row["mpjpe_cm"] < 100
+    assert 0 <= row["wrong_channels"] <= 2
+    # codebook error = 2 x wrong channels / (C x D): the two ways of counting agree.
+    assert math.isclose(row["codebook"], 2 * row["wrong_channels"] / 8, rel_tol=1e-5)
+    # train.validate's MPJPE is the estimated-code one.
+    import torch as _t
+    from training.models import CodebookMatching, IntentionPredictor, ModelConfig
+    ck = _t.load(runs[0] / "checkpoint.pt", map_location="cpu", weights_only=False)
+    cfg = ModelConfig(**ck["config"]["model"])
+    p, m = IntentionPredictor(cfg), CodebookMatching(cfg)
+    p.load_state_dict(ck["predictor"]); m.load_state_dict(ck["matching"])
+    stats, val = T.load_stats(prepared3, "follower"), T.load_split(prepared3, "validation", "follower")
+    norm = lambda a, k: ((_t.from_numpy(a) - stats[f"{k}_mean"]) / stats[f"{k}_std"]).float()
+    _, cb, mpjpe = T.validate(p, m, cfg, norm(val["input"], "input"), norm(val["output"], "output"), "cpu", stats)
+    assert math.isclose(mpjpe, row["mpjpe_cm"], rel_tol=1e-4) and math.isclose(cb, row["codebook"], rel_tol=1e-4)
+
+
+def test_validation_refuses_unfinished_and_missing_runs(smoke_runs, prepared3, tmp_path, capsys):
+    from training import validation as V
+    assert V.main([str(tmp_path / "none"), "--data", str(prepared3)]) == 2
+    assert "checkpoint.pt not found" in capsys.readouterr().err
+    run = tmp_path / "half"
+    run.mkdir()
+    ck = torch.load(smoke_runs / "follower" / "checkpoint.pt", map_location="cpu", weights_only=False)
+    ck["stage"] = "matching"
+    torch.save(ck, run / "checkpoint.pt")
+    assert V.main([str(run), "--data", str(prepared3)]) == 2
+    assert "has not finished" in capsys.readouterr().err

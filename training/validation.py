@@ -1,0 +1,84 @@
+"""python -m training.validation RUN [RUN ...]: teacher-forced numbers of trained checkpoints on
+the prepared validation take, as a markdown table (the latent-size study of docs/results.md).
+
+    python -m training.validation runs/latent/*/*
+
+Each RUN is a folder holding checkpoint.pt (training.train's output). MPJPE is split in two:
+"target code" decodes the code the output encoder picks when it sees the answer (what the
+autoencoder can reconstruct at all), "estimated code" decodes the input encoder's argmax (what
+the model delivers). Their difference is what wrong codes cost, the part that matching, and so
+the intention, can win back.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import torch
+
+from . import features as feat
+from .models import CodebookMatching, IntentionPredictor, ModelConfig, sample_codes
+from .train import DEFAULT_DATA, TrainError, load_checkpoint, load_split, load_stats
+
+
+@torch.no_grad()
+def measure(run: Path, data: str) -> dict:
+    ck = load_checkpoint(run / "checkpoint.pt")
+    if ck.get("stage") != "done":
+        raise TrainError(f"{run}: training has not finished (stage {ck.get('stage')})")
+    cfg = ModelConfig(**ck["config"]["model"])
+    predictor, matching = IntentionPredictor(cfg), CodebookMatching(cfg)
+    predictor.load_state_dict(ck["predictor"]); matching.load_state_dict(ck["matching"])
+    predictor.eval(); matching.eval()
+    stats, val = load_stats(data, cfg.role), load_split(data, "validation", cfg.role)
+
+    def norm(a, k):
+        return ((torch.from_numpy(a) - stats[f"{k}_mean"]) / stats[f"{k}_std"]).float()
+
+    x, y = norm(val["input"], "input"), norm(val["output"], "output")
+    intention = predictor(x) if cfg.intention else None
+    target = sample_codes(matching.target_logits(x, y, intention), cfg.channels, 0.0)
+    estimate = sample_codes(matching.estimate_logits(x, intention), cfg.channels, 0.0)
+    pose = feat.block_slices(feat.OUTPUT_LAYOUT)["pose"]
+
+    def mpjpe(code):
+        a, b = ((t * stats["output_std"] + stats["output_mean"])[:, pose].reshape(len(x), feat.N_JOINTS, 12)[..., :3]
+                for t in (matching.decoder(code), y))
+        return float((a - b).norm(dim=-1).mean()) * 100
+
+    wrong = (target.reshape(len(x), cfg.channels, -1).argmax(-1) != estimate.reshape(len(x), cfg.channels, -1).argmax(-1))
+    return {"run": str(run), "intention": cfg.intention, "channels": cfg.channels, "seed": ck["config"]["seed"],
+            "codebook": float(((target - estimate) ** 2).mean()), "wrong_channels": float(wrong.sum(1).float().mean()),
+            "mpjpe_target_cm": mpjpe(target), "mpjpe_cm": mpjpe(estimate)}
+
+
+def table(rows: list[dict]) -> str:
+    lines = ["| run | intention | C | seed | MPJPE cm | MPJPE target code cm | wrong channels | codebook |",
+             "|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        lines.append(f"| {r['run']} | {'yes' if r['intention'] else 'no'} | {r['channels']} | {r['seed']} | "
+                     f"{r['mpjpe_cm']:.3f} | {r['mpjpe_target_cm']:.3f} | {r['wrong_channels']:.2f} | {r['codebook']:.4f} |")
+    return "\n".join(lines)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m training.validation", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("runs", nargs="+", type=Path, help="folders with checkpoint.pt")
+    ap.add_argument("--data", default=DEFAULT_DATA, help="prepared data the runs were trained on")
+    args = ap.parse_args(argv)
+    try:
+        for run in args.runs:
+            if not (run / "checkpoint.pt").exists():
+                raise TrainError(f"{run}/checkpoint.pt not found")
+        rows = [measure(r, args.data) for r in args.runs]
+    except TrainError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+    print(table(rows))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
