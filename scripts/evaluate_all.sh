@@ -30,4 +30,4 @@ done
 
 $PY -m training.evaluate --data "$DATA" --takes 02,13 --models "$MODELS" --out runs/eval_all \
     --seeds 0,1,2 --temperatures 0.5,1 --quiet
-$PY -m training.plots --out docs
+$PY -m training.plots --out docs --eval runs/eval_all/metrics.json

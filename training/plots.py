@@ -251,7 +251,7 @@ def figure_tsne(args, out: Path) -> list[str]:
 
     plt = _plt()
     fig, axes = plt.subplots(1, 2, figsize=(11, 5.4))
-    lines = [f"t-SNE of the logits (C*D = 256), {len(idx)} test frames -> {2 * len(idx)} points, "
+    lines = [f"t-SNE of the logits (C*D = {tgt.shape[1]}), {len(idx)} test frames -> {2 * len(idx)} points, "
              f"random_state 0; mixing = k-NN (k=10) share of the other set / chance (1 = overlap, 0 = apart)"]
     for ax, (name, title, res, note) in zip(axes, panels):
         ax.set_title(title)
@@ -402,8 +402,8 @@ def figure_codebook(args, out: Path) -> list[str]:
         lines.append(f"  cross-check with {args.eval} (teacher-forced codebook error): " + ", ".join(
             f"{k} {tf[k]['codebook_error']:.4f} (here {errors[m][0.0].mean():.4f})" for m, k in pairs))
     lines += [f"  note: {n}" for n in notes]
-    lines.append("  note: CCM large has 24 channels, so one wrong channel costs 1/3 of what it does for the "
-                 "8-channel models")
+    lines.append("  note: CCM large has 3x the channels, so one wrong channel costs 1/3 of what it does for "
+                 "the others")
     return lines
 
 
@@ -636,7 +636,7 @@ def figure_curves(args, out: Path) -> list[str]:
     plt.close(fig)
     if missing:
         lines.append(f"  not available yet: {', '.join(missing)}")
-    lines.append("  note: CCM large has 24 channels: its codebook error per wrong channel is 1/3 of the others'")
+    lines.append("  note: CCM large has 3x the channels: its codebook error per wrong channel is 1/3 of the others'")
     return lines
 
 
