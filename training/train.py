@@ -55,7 +55,8 @@ class TrainConfig:
 # The follower's network. 24 code channels: at 8 the decoder's reconstruction from even the
 # target code is the bulk of the error (5.7 of 5.8 cm validation MPJPE for ours and CCM alike),
 # so better matching has nothing to win; at 24 the reconstruction drops to 4.6 cm and the wrong
-# channels cost 0.3-0.5 cm, which is what the intention reduces (docs/results.md, "Latent size").
+# channels cost 0.3-0.5 cm, the part the intention can reduce (it does on the validation take
+# for three seeds; on the test takes ours and CCM tie: docs/results.md, "Latent size").
 FOLLOWER = ModelConfig(channels=24)
 
 # The models `--all` trains (shipped), and the ones evaluation adds (ablations, larger CCM).
