@@ -114,6 +114,20 @@ def load_stats(data: str, role: str) -> dict[str, torch.Tensor]:
                          f"({e.__class__.__name__}); re-run training.prepare") from None
 
 
+def normalize(a: np.ndarray, stats: dict[str, torch.Tensor], key: str) -> torch.Tensor:
+    """Raw features -> normalized float32 tensor with the prepared mean/std of `key`."""
+    return ((torch.from_numpy(a) - stats[f"{key}_mean"]) / stats[f"{key}_std"]).float()
+
+
+def pose_error_cm(y_hat: torch.Tensor, y: torch.Tensor, stats: dict[str, torch.Tensor]) -> torch.Tensor:
+    """Per-sample MPJPE in cm between two normalized outputs [B, 323]: the pose block's joint
+    positions (dancer's root space), de-normalized."""
+    pose = feat.block_slices(feat.OUTPUT_LAYOUT)["pose"]
+    mean, std = stats["output_mean"].to(y.device), stats["output_std"].to(y.device)
+    p, q = ((t * std + mean)[:, pose].reshape(len(t), feat.N_JOINTS, 12)[..., :3] for t in (y_hat, y))
+    return (p - q).norm(dim=-1).mean(-1) * 100
+
+
 def augment_control(x: torch.Tensor, cfg: TrainConfig, gen: torch.Generator) -> torch.Tensor:
     """Leader only: turn and jitter the control path (raw features) so that a steered path that
     the recording never took still reads as a plausible intention."""
@@ -223,12 +237,9 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
     run.mkdir(parents=True, exist_ok=True)
     ckpt_path = run / "checkpoint.pt"
 
-    def norm(a, k):
-        return ((torch.from_numpy(a) - stats[f"{k}_mean"]) / stats[f"{k}_std"]).float()
-
     xr = torch.from_numpy(train["input"]).float()          # raw, for leader augmentation
-    y, j = norm(train["output"], "output"), norm(train["intention"], "intention")
-    xv, yv, jv = norm(val["input"], "input"), norm(val["output"], "output"), norm(val["intention"], "intention")
+    y, j = normalize(train["output"], stats, "output"), normalize(train["intention"], stats, "intention")
+    xv, yv, jv = (normalize(val[k], stats, k) for k in ("input", "output", "intention"))
     mcfg = cfg.model
     predictor = IntentionPredictor(mcfg).to(device)
     matching = CodebookMatching(mcfg).to(device)
@@ -400,8 +411,6 @@ def validate(predictor, matching, mcfg, xv, yv, device, stats, batch=4096):
     codes) and the pose MPJPE in cm (joint positions in the dancer's root space, the number
     evaluation reports on the test takes)."""
     predictor.eval(); matching.eval()
-    pose = feat.block_slices(feat.OUTPUT_LAYOUT)["pose"]
-    mean, std = stats["output_mean"].to(device), stats["output_std"].to(device)
     se, cb, pe, n = 0.0, 0.0, 0.0, 0
     for s in range(0, len(xv), batch):
         x, yb = xv[s:s + batch].to(device), yv[s:s + batch].to(device)
@@ -410,8 +419,7 @@ def validate(predictor, matching, mcfg, xv, yv, device, stats, batch=4096):
         code = sample_codes(matching.target_logits(x, yb, intention), mcfg.channels, 0.0)
         se += F.mse_loss(y_hat, yb, reduction="sum").item() / yb.shape[1]
         cb += F.mse_loss(code, code_hat, reduction="sum").item() / code.shape[1]
-        p, q = ((t * std + mean)[:, pose].reshape(len(x), feat.N_JOINTS, 12)[..., :3] for t in (y_hat, yb))
-        pe += (p - q).norm(dim=-1).mean(-1).sum().item() * 100
+        pe += pose_error_cm(y_hat, yb, stats).sum().item()
         n += len(x)
     return se / n, cb / n, pe / n
 

@@ -17,9 +17,9 @@ from pathlib import Path
 
 import torch
 
-from . import features as feat
 from .models import CodebookMatching, IntentionPredictor, ModelConfig, sample_codes
-from .train import DEFAULT_DATA, TrainError, load_checkpoint, load_split, load_stats
+from .train import (DEFAULT_DATA, TrainError, load_checkpoint, load_split, load_stats, normalize,
+                    pose_error_cm, validate)
 
 
 @torch.no_grad()
@@ -30,27 +30,15 @@ def measure(run: Path, data: str) -> dict:
     cfg = ModelConfig(**ck["config"]["model"])
     predictor, matching = IntentionPredictor(cfg), CodebookMatching(cfg)
     predictor.load_state_dict(ck["predictor"]); matching.load_state_dict(ck["matching"])
-    predictor.eval(); matching.eval()
     stats, val = load_stats(data, cfg.role), load_split(data, "validation", cfg.role)
-
-    def norm(a, k):
-        return ((torch.from_numpy(a) - stats[f"{k}_mean"]) / stats[f"{k}_std"]).float()
-
-    x, y = norm(val["input"], "input"), norm(val["output"], "output")
+    x, y = normalize(val["input"], stats, "input"), normalize(val["output"], stats, "output")
+    _, codebook, mpjpe = validate(predictor, matching, cfg, x, y, "cpu", stats)
     intention = predictor(x) if cfg.intention else None
     target = sample_codes(matching.target_logits(x, y, intention), cfg.channels, 0.0)
-    estimate = sample_codes(matching.estimate_logits(x, intention), cfg.channels, 0.0)
-    pose = feat.block_slices(feat.OUTPUT_LAYOUT)["pose"]
-
-    def mpjpe(code):
-        a, b = ((t * stats["output_std"] + stats["output_mean"])[:, pose].reshape(len(x), feat.N_JOINTS, 12)[..., :3]
-                for t in (matching.decoder(code), y))
-        return float((a - b).norm(dim=-1).mean()) * 100
-
-    wrong = (target.reshape(len(x), cfg.channels, -1).argmax(-1) != estimate.reshape(len(x), cfg.channels, -1).argmax(-1))
     return {"run": str(run), "intention": cfg.intention, "channels": cfg.channels, "seed": ck["config"]["seed"],
-            "codebook": float(((target - estimate) ** 2).mean()), "wrong_channels": float(wrong.sum(1).float().mean()),
-            "mpjpe_target_cm": mpjpe(target), "mpjpe_cm": mpjpe(estimate)}
+            # A wrong channel puts two mismatched ones in a row's C·D one-hot entries.
+            "codebook": codebook, "wrong_channels": codebook * cfg.latent / 2,
+            "mpjpe_target_cm": float(pose_error_cm(matching.decoder(target), y, stats).mean()), "mpjpe_cm": mpjpe}
 
 
 def table(rows: list[dict]) -> str:
