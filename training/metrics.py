@@ -65,6 +65,94 @@ def hand_distance(a: np.ndarray, b: np.ndarray) -> float:
     return float(d.reshape(len(d), -1).min(1).mean())
 
 
+# ---------------------------------------------------------------- the two dancers together
+
+# The torso as a chain of capsules hip -> abdomen -> chest -> neck. 14 cm is about half a
+# torso's depth and width at the chest: two torsos whose spines come closer than twice that
+# pass through each other.
+SPINE = [0, 1, 2, 3]
+TORSO_RADIUS = 0.14
+HAND_HOLD_DISTANCE = 0.20   # m between a hand of each dancer: holding, or about to
+
+
+def segment_distance(p0: np.ndarray, p1: np.ndarray, q0: np.ndarray, q1: np.ndarray) -> np.ndarray:
+    """Closest distance between segments p0-p1 and q0-q1 ([..., 3] each, broadcast) -> [...].
+    Exact: the clamped closest-point parameters of two segments, degenerate ones included."""
+    d1, d2, r = p1 - p0, q1 - q0, p0 - q0
+    a, e = (d1 * d1).sum(-1), (d2 * d2).sum(-1)
+    b, c, f = (d1 * d2).sum(-1), (d1 * r).sum(-1), (d2 * r).sum(-1)
+    denom = a * e - b * b
+    eps = 1e-12
+    # Parallel (or degenerate) segments: any s works; take p0's end.
+    s = np.where(denom > eps, np.clip((b * f - c * e) / np.maximum(denom, eps), 0, 1), 0.0)
+    t = np.where(e > eps, (b * s + f) / np.maximum(e, eps), 0.0)
+    # Where t leaves [0, 1] (or q is a point), fix t at that end of q and recompute s for it.
+    t_clamped = np.clip(t, 0, 1)
+    redo = (t != t_clamped) | (e <= eps)
+    s = np.where(redo, np.where(a > eps, np.clip((b * t_clamped - c) / np.maximum(a, eps), 0, 1), 0.0), s)
+    closest = (p0 + d1 * s[..., None]) - (q0 + d2 * t_clamped[..., None])
+    return np.linalg.norm(closest, axis=-1)
+
+
+def torso_distance(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Per frame, the closest distance (m) between the spine segments of two dancers' world
+    positions [T, J, 3] -> [T]."""
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    pa0, pa1 = a[:, SPINE[:-1]][:, :, None], a[:, SPINE[1:]][:, :, None]        # [T, 3, 1, 3]
+    pb0, pb1 = b[:, SPINE[:-1]][:, None], b[:, SPINE[1:]][:, None]              # [T, 1, 3, 3]
+    return segment_distance(pa0, pa1, pb0, pb1).reshape(len(a), -1).min(1)
+
+
+def closest_hand_distance(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Per frame, the smallest of the 4 hand-to-hand distances (m) [T]."""
+    ha, hb = np.asarray(a)[:, HANDS], np.asarray(b)[:, HANDS]
+    return np.linalg.norm(ha[:, :, None] - hb[:, None, :], axis=-1).reshape(len(ha), -1).min(1)
+
+
+def interaction(leader: np.ndarray, follower: np.ndarray, leader_contacts: np.ndarray | None = None,
+                follower_contacts: np.ndarray | None = None) -> dict:
+    """How two dancers' world positions [T, J, 3] read as a couple.
+
+    interpenetration: share of frames whose torsos pass through each other (spines closer than
+    2 x TORSO_RADIUS); hand_hold: share of frames with some hand pair within HAND_HOLD_DISTANCE;
+    closest_hand_m: the mean of that closest pair's distance; foot skate of each dancer while the
+    ankle is low (`foot_skate_cm`'s default) and, where per-frame contact labels [T, 2] are
+    given, while labelled in contact at both ends of the step."""
+    leader, follower = np.asarray(leader, float), np.asarray(follower, float)
+    hands = closest_hand_distance(leader, follower)
+    out = {"interpenetration": float((torso_distance(leader, follower) < 2 * TORSO_RADIUS).mean()),
+           "hand_hold": float((hands < HAND_HOLD_DISTANCE).mean()),
+           "closest_hand_m": float(hands.mean()),
+           "skate_leader_cm": foot_skate_cm(leader), "skate_follower_cm": foot_skate_cm(follower)}
+    for name, pos, c in (("leader", leader, leader_contacts), ("follower", follower, follower_contacts)):
+        if c is not None:
+            c = np.asarray(c) > 0.5
+            out[f"contact_skate_{name}_cm"] = foot_skate_cm(pos, c[1:] & c[:-1])
+    return out
+
+
+def ratio_to(reference: dict, values: dict) -> dict:
+    """values / reference for every key both have (None where the reference is 0)."""
+    return {k: (values[k] / reference[k] if reference[k] else None)
+            for k in values if k in reference and isinstance(values[k], float)}
+
+
+def steering_response(root: np.ndarray, turn_frame: int, direction: np.ndarray, fps: float = FPS,
+                      within_degrees: float = 30.0, smooth_frames: int = 10) -> dict:
+    """After the stick turns to `direction` (world x, z) at `turn_frame`: seconds until the
+    dancer's root velocity, averaged over the last `smooth_frames` (a dancer sways within a
+    step), is within `within_degrees` of it (None if never), and the mean speed (m/s) over the
+    last second of the record."""
+    root = np.asarray(root, float)
+    d = np.asarray(direction, float) / np.linalg.norm(direction)
+    vel = (root[smooth_frames:] - root[:-smooth_frames]) * fps / smooth_frames      # ends at frame i+smooth
+    cos = (vel @ d) / np.maximum(np.linalg.norm(vel, axis=-1), 1e-9)
+    ok = np.nonzero(cos[max(turn_frame - smooth_frames, 0):] >= np.cos(np.radians(within_degrees)))[0]
+    last = root[-int(fps):]
+    speed = float(np.linalg.norm(last[-1] - last[0]) * fps / (len(last) - 1))
+    return {"seconds": float(ok[0] / fps) if len(ok) else None, "speed": speed}
+
+
 def codebook_error(target: np.ndarray, estimate: np.ndarray) -> float:
     """MSE between one-hot codes [B, C*D] (target from the output encoder, estimate from the
     input encoder), as train.validate measures it: 2k/(C*D) for k wrong channels of a row."""

@@ -65,6 +65,10 @@ def prepare(data: str, out: str, validation: list[str], test: list[str], leader:
         for kind in ("input", "output", "intention"):
             mean, std = F.normalization(arrays["train"][f"{role}_{kind}"])
             stats[f"{role}_{kind}_mean"], stats[f"{role}_{kind}_std"] = mean, std
+    # Bone offsets of each role (the first take's, as export ships them): the training terms on
+    # the decoded body (partner_losses) run forward kinematics with them.
+    lead, follow = load_pair(takes[0])
+    stats["leader_offsets"], stats["follower_offsets"] = lead.offsets, follow.offsets
     np.savez(outdir / "stats.npz", **stats)
     summary["sizes"] = {"input": F.INPUT_SIZE, "output": F.OUTPUT_SIZE, "intention": F.INTENTION_SIZE}
     return summary

@@ -21,6 +21,7 @@ import numpy as np
 from tqdm import tqdm
 
 from .rollout import NOW, OnnxPolicy, start_duet, step
+from . import metrics as M
 from .skeleton import FEET, FPS, PARENTS
 
 MAX_DISTANCE = 3.0        # m between the partners
@@ -57,14 +58,28 @@ def bone_error(positions: np.ndarray, offsets: np.ndarray) -> float:
     return float(np.abs(lengths - np.linalg.norm(offsets[1:], axis=-1)).max())
 
 
-def soak_one(manifest, leader, follower, seed: int, frames: int, temperature: float) -> dict:
+def soak_one(manifest, leader, follower, seed: int, frames: int, temperature: float,
+             record: dict | None = None) -> dict:
+    """One steered duet. With `record` (a dict), every frame's world positions and foot contacts
+    of both dancers are stored there: `leader`, `follower` [frames, 17, 3] as the networks left
+    them, `leader_shown`, `follower_shown` after the contact layer, `leader_contacts`, `follower_contacts` [frames, 2]."""
     rng = np.random.default_rng(seed)
     sticks = steering_script(rng, frames)
     duet = start_duet(manifest)
     worst = {"nonfinite": 0, "max_distance": 0.0, "bone_error": 0.0, "min_foot": np.inf}
     speeds = np.zeros((frames, 2))
+    if record is not None:
+        for k in ("leader", "follower"):
+            record[k] = np.zeros((frames, 17, 3))
+            record[f"{k}_shown"] = np.zeros((frames, 17, 3))
+            record[f"{k}_contacts"] = np.zeros((frames, 2))
     for f in range(frames):
         step(duet, leader, follower, sticks[f], temperature, rng)
+        if record is not None:
+            for i, (k, d) in enumerate((("leader", duet.leader), ("follower", duet.follower))):
+                record[k][f] = d.track.positions[NOW]
+                record[f"{k}_shown"][f] = duet.shown[i]
+                record[f"{k}_contacts"][f] = d.contacts
         for i, d in enumerate((duet.leader, duet.follower)):
             p = d.track.positions
             if not np.all(np.isfinite(p[NOW])):
@@ -78,6 +93,36 @@ def soak_one(manifest, leader, follower, seed: int, frames: int, temperature: fl
     frozen = (speeds[FPS:] < FROZEN_SPEED).mean(0)
     return {"seed": seed, **worst, "frozen_leader": float(frozen[0]), "frozen_follower": float(frozen[1]),
             "resets": duet.leader.resets + duet.follower.resets}
+
+
+TURN_HOLD_SECONDS = 4.0    # each steering trial: hold one direction, then the one 90 degrees off
+
+
+def steering_trial(manifest, leader, follower, angle: float, turn: float, temperature: float,
+                   seed: int) -> dict:
+    """Hold the stick fully at `angle` (radians, world) for TURN_HOLD_SECONDS, then turn it by
+    `turn` and hold again: metrics.steering_response of the leader's root after the turn."""
+    rng = np.random.default_rng(seed)
+    duet = start_duet(manifest)
+    hold = int(TURN_HOLD_SECONDS * FPS)
+    first = np.array([np.sin(angle), np.cos(angle)])
+    second = np.array([np.sin(angle + turn), np.cos(angle + turn)])
+    root = np.zeros((2 * hold, 2))
+    for f in range(2 * hold):
+        step(duet, leader, follower, first if f < hold else second, temperature, rng)
+        root[f] = duet.leader.root
+    return M.steering_response(root, hold, second)
+
+
+def steering_trials(manifest, leader, follower, temperature: float, trials: int = 8) -> dict:
+    """`trials` turns of 90 degrees (alternately left and right, from evenly spread headings):
+    mean seconds until the leader moves within 30 degrees of the new direction (and how many
+    never did within TURN_HOLD_SECONDS), and the mean speed reached."""
+    res = [steering_trial(manifest, leader, follower, 2 * np.pi * i / trials, (-1) ** i * np.pi / 2,
+                          temperature, seed=i) for i in range(trials)]
+    reached = [r["seconds"] for r in res if r["seconds"] is not None]
+    return {"trials": trials, "turn_seconds": float(np.mean(reached)) if reached else None,
+            "turn_missed": trials - len(reached), "speed": float(np.mean([r["speed"] for r in res]))}
 
 
 def failures(r: dict) -> list[str]:

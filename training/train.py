@@ -28,6 +28,8 @@ from tqdm import tqdm
 
 from . import features as feat
 from .models import CodebookMatching, Discriminator, IntentionPredictor, ModelConfig, sample_codes
+from .partner_losses import partner_terms
+from .skeleton import MIRROR
 
 DEFAULT_DATA = "runs/data"
 DEFAULT_OUT = "runs/models"
@@ -49,6 +51,12 @@ class TrainConfig:
     scheduled_sampling: bool = True       # ... feeding its prediction with probability epoch/E
     control_noise: float = 0.05           # leader: metres of noise on the 1 s control key
     control_rotation: float = 15.0        # leader: degrees of random turn of the control path
+    # Terms on the decoded body (training/partner_losses.py), in m^2 against normalized MSE.
+    # Sizes: a 5 cm slide of a planted foot costs 30 * 0.0025 = 0.075, about half the final
+    # reconstruction loss; penetration is rare in the recording, so its weight is larger.
+    lambda_penetration: float = 0.0
+    lambda_foot_contact: float = 0.0
+    lambda_interaction: float = 0.0
     seed: int = 1
 
 
@@ -58,15 +66,22 @@ class TrainConfig:
 # channels cost 0.3-0.5 cm, the part the intention can reduce (it does on the validation take
 # for three seeds; on the test takes ours and CCM tie: docs/results.md, "Latent size").
 FOLLOWER = ModelConfig(channels=24)
+# Weights of the terms on the decoded body (partner_losses.py); ablation rows switch one off.
+PARTNER = dict(lambda_penetration=100.0, lambda_foot_contact=30.0, lambda_interaction=10.0)
 
 # The models `--all` trains (shipped), and the ones evaluation adds (ablations, larger CCM).
 MODELS = {
     # The predictor fits training frames better than new ones (MSE 0.14 vs 0.23): noise of the
     # size of that gap keeps the encoders from trusting its training-set accuracy, which buys
     # FID and Diversity on the test takes (docs/results.md, w/o intention noise).
-    "follower": TrainConfig(model=FOLLOWER, intention_noise=0.3),
-    "follower_ccm": TrainConfig(model=replace(FOLLOWER, intention=False)),
-    "leader": TrainConfig(model=ModelConfig(role="leader")),
+    "follower": TrainConfig(model=FOLLOWER, intention_noise=0.3, **PARTNER),
+    "follower_ccm": TrainConfig(model=replace(FOLLOWER, intention=False), **PARTNER),
+    # The leader's partner is the follower: it gets the foot-contact term, and the body terms too.
+    "leader": TrainConfig(model=ModelConfig(role="leader"), **PARTNER),
+    "follower_no_penetration": TrainConfig(model=FOLLOWER, intention_noise=0.3, **{**PARTNER, "lambda_penetration": 0.0}),
+    "follower_no_foot_contact": TrainConfig(model=FOLLOWER, intention_noise=0.3, **{**PARTNER, "lambda_foot_contact": 0.0}),
+    "follower_no_interaction": TrainConfig(model=FOLLOWER, intention_noise=0.3, **{**PARTNER, "lambda_interaction": 0.0}),
+    "follower_no_partner_terms": TrainConfig(model=FOLLOWER, intention_noise=0.3),
     "follower_small": TrainConfig(model=replace(FOLLOWER, hidden=256, intention_hidden=128), intention_noise=0.3),
     "follower_ccm_large": TrainConfig(model=replace(FOLLOWER, intention=False, channels=3 * FOLLOWER.channels)),
     "follower_no_gan": TrainConfig(model=FOLLOWER, lambda_generator=0.0, intention_noise=0.3),
@@ -112,6 +127,22 @@ def load_stats(data: str, role: str) -> dict[str, torch.Tensor]:
     except Exception as e:
         raise TrainError(f"{path}: unreadable or not written by training.prepare "
                          f"({e.__class__.__name__}); re-run training.prepare") from None
+
+
+def load_offsets(data: str, role: str, device) -> torch.Tensor:
+    """[2, 17, 3] bone offsets of the role: as recorded, and mirrored (prepare's mirrored samples)."""
+    with np.load(Path(data) / "stats.npz") as z:
+        if f"{role}_offsets" not in z:
+            raise TrainError(f"{data}/stats.npz has no bone offsets (written by an older training.prepare); "
+                             f"re-run training.prepare")
+        off = z[f"{role}_offsets"]
+    return torch.tensor(np.stack([off, off[MIRROR] @ np.diag([-1.0, 1.0, 1.0])]), dtype=torch.float32, device=device)
+
+
+def load_mirror_flags(data: str) -> np.ndarray:
+    """Per training sample: True where it is a mirrored copy (its skeleton is mirrored too)."""
+    with np.load(Path(data) / "train.npz") as z:
+        return z["mirror"].astype(bool)
 
 
 def normalize(a: np.ndarray, stats: dict[str, torch.Tensor], key: str) -> torch.Tensor:
@@ -238,6 +269,11 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
     ckpt_path = run / "checkpoint.pt"
 
     xr = torch.from_numpy(train["input"]).float()          # raw, for leader augmentation
+    partner_weights = {"penetration": cfg.lambda_penetration, "foot_contact": cfg.lambda_foot_contact,
+                       "interaction": cfg.lambda_interaction}
+    if any(partner_weights.values()):
+        offsets = load_offsets(data, role, device)
+        mirrored = torch.from_numpy(load_mirror_flags(data)).long()
     y, j = normalize(train["output"], stats, "output"), normalize(train["intention"], stats, "intention")
     xv, yv, jv = (normalize(val[k], stats, k) for k in ("input", "output", "intention"))
     mcfg = cfg.model
@@ -250,7 +286,7 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
     opt_d = torch.optim.AdamW(disc.parameters(), lr=cfg.lr, weight_decay=cfg.weight_decay)
     history = {"intention_train": [], "intention_val": [], "reconstruction": [], "codebook": [],
                "generator": [], "discriminator": [], "val_mse": [], "val_codebook": [],
-               "val_mpjpe_cm": []}
+               "val_mpjpe_cm": [], **{k: [] for k, w in partner_weights.items() if w}}
     stage, epoch, seconds = "intention", 0, 0.0
     if resume and ckpt_path.exists():
         ck = load_checkpoint(ckpt_path)
@@ -337,7 +373,8 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
             predictor.train()
         bar = tqdm(batches(10_000 + epoch), total=steps_per_epoch, disable=quiet or rank > 0,
                    desc=f"{name} matching {epoch + 1}/{cfg.epochs}", leave=False)
-        sums = {"reconstruction": [], "codebook": [], "generator": [], "discriminator": []}
+        sums = {"reconstruction": [], "codebook": [], "generator": [], "discriminator": [],
+                **{k: [] for k, w in partner_weights.items() if w}}
         p_pred = epoch / cfg.epochs   # scheduled sampling: share of predicted intentions
         for i, idx in enumerate(bar):
             lr = cosine(epoch * steps_per_epoch + i, total, cfg.lr)
@@ -365,6 +402,14 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
             l_r = F.mse_loss(recon, yb)
             l_c = F.mse_loss(code, code_hat)
             loss = cfg.lambda_reconstruction * l_r + cfg.lambda_codebook * l_c + extra
+            if any(partner_weights.values()):
+                raw = lambda t, k: t * stats[f"{k}_std"].to(device).float() + stats[f"{k}_mean"].to(device).float()
+                terms = partner_terms(raw(recon, "output"), raw(yb, "output"), raw(x, "input"),
+                                      offsets[mirrored[idx]], role)
+                for k, w in partner_weights.items():
+                    if w:
+                        loss = loss + w * terms[k]
+                        sums[k].append(terms[k].item())
             l_g = torch.zeros(())
             if cfg.lambda_generator > 0:
                 # Discriminator step on detached logits, then the generator term for the encoders.
@@ -394,6 +439,7 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
             print(f"{name} matching {epoch}/{cfg.epochs}  rec {history['reconstruction'][-1]:.4f}  "
                   f"cb {history['codebook'][-1]:.4f}  G {history['generator'][-1]:.3f}  "
                   f"val mse {val_mse:.4f}  val cb {val_cb:.4f}  val mpjpe {val_mpjpe:.2f} cm  "
+                  + "".join(f"{k} {history[k][-1]:.2e}  " for k, w in partner_weights.items() if w) +
                   f"({time.time() - t0:.1f} s)")
         save("matching", epoch)
     stage = "done"

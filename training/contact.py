@@ -1,0 +1,132 @@
+"""The run-time contact layer: what is shown of the duet (web/contact.ts mirrors it name for name).
+
+The networks place each dancer on its own; three things they do not guarantee are fixed here, on
+copies of the current poses, never on the Track the features read (so the networks' own motion
+stays what they made, and every metric can be read with and without this layer):
+
+1. bodies do not pass through each other: where the two spines come closer than 2 x TORSO_RADIUS
+   (metrics.interaction's test), both bodies are moved apart horizontally, half the shortfall each;
+2. hands meet when the model brings them within reach: the closest pair of hands of the two
+   dancers, once closer than HAND_REACH, is drawn toward a grip around its midpoint by two-bone IK
+   of both arms, fully at HAND_FULL and closer, with a weight that rises and falls smoothly;
+3. planted feet stay planted: footik.FootLock on both dancers, last, so that a body moved by 1.
+   keeps its feet where they were.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .footik import FootLock, two_bone_ik
+from .metrics import HANDS, SPINE, TORSO_RADIUS
+from .skeleton import PARENTS
+
+SEPARATION = 2 * TORSO_RADIUS + 0.01   # m between the spines after the push (1 cm to spare)
+HAND_REACH = 0.45      # m: a hand pair closer than this starts to meet (a forearm's length)
+HAND_FULL = 0.25       # m: at or below this the hands meet fully
+GRIP = 0.06            # m between the two hands' joints when they meet (palm to palm)
+HOLD_RATE = 0.3        # share of the way the hold weight moves to its target every step
+ELBOW_POLE = (0.0, -1.0, 0.0)   # a straight arm bends its elbow downward
+
+
+def closest_on_segments(p0, p1, q0, q1) -> tuple[float, float]:
+    """Parameters (s, t) in [0, 1] of the closest points p0 + s (p1 - p0), q0 + t (q1 - q0)."""
+    d1, d2, r = p1 - p0, q1 - q0, p0 - q0
+    a, e, b = float(d1 @ d1), float(d2 @ d2), float(d1 @ d2)
+    c, f = float(d1 @ r), float(d2 @ r)
+    denom = a * e - b * b
+    s = min(max((b * f - c * e) / denom, 0.0), 1.0) if denom > 1e-12 else 0.0
+    t = (b * s + f) / e if e > 1e-12 else 0.0
+    if t < 0.0 or t > 1.0 or e <= 1e-12:
+        t = min(max(t, 0.0), 1.0)
+        s = min(max((b * t - c) / a, 0.0), 1.0) if a > 1e-12 else 0.0
+    return s, t
+
+
+def spine_gap(a: np.ndarray, b: np.ndarray) -> tuple[float, np.ndarray]:
+    """Closest distance between the two spines (positions [17, 3]) and the horizontal unit
+    direction from b's closest point to a's (the way to push a; b goes the other way)."""
+    best, away = np.inf, np.zeros(3)
+    for i in range(len(SPINE) - 1):
+        for j in range(len(SPINE) - 1):
+            p0, p1 = a[SPINE[i]], a[SPINE[i + 1]]
+            q0, q1 = b[SPINE[j]], b[SPINE[j + 1]]
+            s, t = closest_on_segments(p0, p1, q0, q1)
+            diff = (p0 + s * (p1 - p0)) - (q0 + t * (q1 - q0))
+            dist = float(np.linalg.norm(diff))
+            if dist < best:
+                best, away = dist, diff
+    away = np.array([away[0], 0.0, away[2]])
+    n = float(np.linalg.norm(away))
+    if n < 1e-6:   # one spine right above the other: push along the line between the hips
+        away = np.array([a[0, 0] - b[0, 0], 0.0, a[0, 2] - b[0, 2]])
+        n = float(np.linalg.norm(away))
+        if n < 1e-6:
+            away, n = np.array([1.0, 0.0, 0.0]), 1.0
+    return best, away / n
+
+
+def separate(a: np.ndarray, b: np.ndarray) -> float:
+    """Move both bodies apart (in place) until their spines are SEPARATION apart; returns the
+    distance each moved (0 when they were apart already)."""
+    gap, away = spine_gap(a, b)
+    if gap >= SEPARATION:
+        return 0.0
+    push = (SEPARATION - gap) / 2
+    a += away * push
+    b -= away * push
+    return push
+
+
+def closest_hands(a: np.ndarray, b: np.ndarray) -> tuple[int, int, float]:
+    """Indices into HANDS of the closest hand pair of the two dancers, and its distance."""
+    best = (0, 0, np.inf)
+    for i in range(len(HANDS)):
+        for j in range(len(HANDS)):
+            d = float(np.linalg.norm(a[HANDS[i]] - b[HANDS[j]]))
+            if d < best[2]:
+                best = (i, j, d)
+    return best
+
+
+def reach_weight(distance: float) -> float:
+    """1 at HAND_FULL and closer, 0 at HAND_REACH and beyond, linear between."""
+    return min(max((HAND_REACH - distance) / (HAND_REACH - HAND_FULL), 0.0), 1.0)
+
+
+def move_hand(positions: np.ndarray, hand: int, target: np.ndarray) -> None:
+    """Two-bone IK of the arm (shoulder - forearm - hand) that ends at `hand`."""
+    elbow = PARENTS[hand]
+    two_bone_ik(positions, PARENTS[elbow], elbow, hand, target, ELBOW_POLE)
+
+
+class ContactLayer:
+    """State kept between steps: both dancers' foot locks and the hand hold."""
+
+    def __init__(self):
+        self.leader_feet = FootLock()
+        self.follower_feet = FootLock()
+        self.hold = 0.0                 # 0..1: how far the closest hands are drawn together
+        self.hands = (0, 0)             # the pair held (indices into HANDS: leader's, follower's)
+        self.pushed = 0.0               # m each body was moved apart this step
+
+    def clear(self) -> None:
+        """Forget every lock and the hold (after a reset or a jump of either dancer)."""
+        self.leader_feet.clear()
+        self.follower_feet.clear()
+        self.hold = 0.0
+
+    def apply(self, leader: np.ndarray, follower: np.ndarray, leader_contacts, follower_contacts,
+              leader_heading: float, follower_heading: float) -> None:
+        """Make the shown poses leader, follower [17, 3] (world, copies: changed in place) read
+        as partner dancing."""
+        self.pushed = separate(leader, follower)
+        i, j, d = closest_hands(leader, follower)
+        self.hold += (reach_weight(d) - self.hold) * HOLD_RATE
+        self.hands = (i, j)
+        if self.hold > 1e-3 and d > 1e-6:
+            hl, hf = leader[HANDS[i]].copy(), follower[HANDS[j]].copy()
+            mid, u = (hl + hf) / 2, (hl - hf) / d
+            move_hand(leader, HANDS[i], hl + (mid + u * GRIP / 2 - hl) * self.hold)
+            move_hand(follower, HANDS[j], hf + (mid - u * GRIP / 2 - hf) * self.hold)
+        self.leader_feet.apply(leader, leader_contacts, leader_heading)
+        self.follower_feet.apply(follower, follower_contacts, follower_heading)
