@@ -64,6 +64,12 @@ class DancerTrack {
   readonly future = new Float32Array(12);
   readonly intention = new Float32Array(90);
   hasIntention = false;
+  // Joint rotations (for the hands, feet and face) interpolate like the positions; contacts do not.
+  readonly previousRotations = new Float32Array(153);
+  readonly currentRotations = new Float32Array(153);
+  readonly drawnRotations = new Float32Array(153);
+  readonly contacts = new Float32Array(2);
+  hasRotations = false;
 
   capture(view: DancerView, snap: boolean): void {
     this.previous.set(snap ? view.positions : this.current);
@@ -75,6 +81,21 @@ class DancerTrack {
     this.future.set(view.future);
     this.hasIntention = view.intention !== undefined;
     if (view.intention) this.intention.set(view.intention);
+    this.hasRotations = view.rotations !== undefined;
+    if (view.rotations) {
+      this.previousRotations.set(snap ? view.rotations : this.currentRotations);
+      this.currentRotations.set(view.rotations);
+    }
+    if (view.contacts) this.contacts.set(view.contacts);
+    else this.contacts.fill(0);
+  }
+
+  /** Rotations between the last two steps, or null when the simulation gives none. */
+  interpolateRotations(alpha: number): Float32Array | null {
+    if (!this.hasRotations) return null;
+    const a = this.previousRotations, b = this.currentRotations, out = this.drawnRotations;
+    for (let i = 0; i < 153; i++) out[i] = a[i] + (b[i] - a[i]) * alpha;
+    return out;
   }
 
   interpolate(alpha: number): Float32Array {
@@ -340,10 +361,10 @@ async function start(): Promise<void> {
   const draw = (alpha: number, elapsed: number) => {
     const count = simulation ? simulation.followers.length : 0;
     stage.leader.setCount(simulation ? 1 : 0);
-    if (simulation) stage.leader.setPose(0, leader.interpolate(alpha));
+    if (simulation) stage.leader.setPose(0, leader.interpolate(alpha), leader.interpolateRotations(alpha), leader.contacts);
     for (let i = 0; i < stage.followers.length; i++) {
       stage.followers[i].setCount(i < count ? 1 : 0);
-      if (i < count) stage.followers[i].setPose(0, followers[i].interpolate(alpha));
+      if (i < count) stage.followers[i].setPose(0, followers[i].interpolate(alpha), followers[i].interpolateRotations(alpha), followers[i].contacts);
     }
 
     // Overlays: the leader's and each follower's future root path; the followers' intentions.

@@ -438,6 +438,8 @@ class View implements DancerView {
   readonly positions = new Float32Array(N_JOINTS * 3);
   readonly future = new Float32Array(KEYS * 2);
   intention?: Float32Array;
+  readonly rotations = new Float32Array(N_JOINTS * 9);
+  readonly contacts = new Float32Array(2);
   readonly feet = new FootLock();
   private resets = -1;
 
@@ -451,6 +453,9 @@ class View implements DancerView {
     this.heading = d.heading;
     const t = d.track;
     for (let i = 0; i < 51; i++) this.positions[i] = t.positions[NOW * 51 + i];
+    for (let i = 0; i < 153; i++) this.rotations[i] = t.rotations[NOW * 153 + i];
+    this.contacts[0] = d.contacts[0];
+    this.contacts[1] = d.contacts[1];
     for (let k = 0; k < KEYS; k++) {
       this.future[2 * k] = t.root[2 * (NOW + FUTURE_OFFSETS[k])];
       this.future[2 * k + 1] = t.root[2 * (NOW + FUTURE_OFFSETS[k]) + 1];

@@ -1,9 +1,13 @@
-// The three.js scene: a floor, two dancers drawn as capsules, translucent ghosts, and line + dot
-// overlays for trajectories and intentions. Everything is created once; per frame we only write
-// instance matrices and vertex positions (no allocation in the draw loop).
+// The three.js scene: a floor, two dancers (capsules with hands, feet and a face: body.ts) and the
+// contact marks under their feet, translucent ghosts, and line + dot overlays for trajectories and
+// intentions. Everything is created once; per frame we only write instance matrices and vertex
+// positions (no allocation in the draw loop).
 
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+import { ContactMarks, DancerMeshes } from './body';
+
+export { DancerMeshes } from './body';
 
 export const COLORS = {
   leader: 0x2f6fe4,
@@ -14,82 +18,7 @@ export const COLORS = {
 };
 
 const FLOOR_SIZE = 200; // metres; one grid cell per metre
-const JOINT_RADIUS = 0.055;
-const HEAD_RADIUS = 0.11;
-const BONE_RADIUS = 0.045;
-const HEAD = 4;
 const TARGET_HEIGHT = 0.9;
-
-/** Several dancers of one look, drawn with two instanced meshes (joint spheres + bone cylinders):
- *  a chain of cylinders capped by spheres at the joints is a chain of capsules, and instancing
- *  keeps it at two draw calls however many ghosts are shown. */
-export class DancerMeshes {
-  readonly group = new THREE.Group();
-  private readonly joints: THREE.InstancedMesh;
-  private readonly bones: THREE.InstancedMesh;
-  private readonly boneChildren: number[];
-  private readonly jointCount: number;
-
-  constructor(
-    private readonly parents: number[],
-    readonly capacity: number,
-    material: THREE.Material,
-    castShadow: boolean,
-  ) {
-    this.jointCount = parents.length;
-    this.boneChildren = parents.flatMap((p, j) => (p >= 0 ? [j] : []));
-    const sphere = new THREE.SphereGeometry(1, 16, 10);
-    // Unit cylinder from y = 0 to y = 1, so scale.y is the bone length.
-    const cylinder = new THREE.CylinderGeometry(1, 1, 1, 12, 1, true).translate(0, 0.5, 0);
-    this.joints = new THREE.InstancedMesh(sphere, material, capacity * this.jointCount);
-    this.bones = new THREE.InstancedMesh(cylinder, material, capacity * this.boneChildren.length);
-    for (const mesh of [this.joints, this.bones]) {
-      mesh.castShadow = castShadow;
-      mesh.receiveShadow = castShadow;
-      // Dancers move anywhere; the instanced bounding sphere would otherwise cull them.
-      mesh.frustumCulled = false;
-      mesh.instanceMatrix.setUsage(THREE.DynamicDrawUsage);
-      this.group.add(mesh);
-    }
-    this.setCount(capacity);
-  }
-
-  /** How many of the `capacity` dancers to draw. */
-  setCount(count: number): void {
-    const n = Math.max(0, Math.min(this.capacity, count));
-    this.joints.count = n * this.jointCount;
-    this.bones.count = n * this.boneChildren.length;
-    this.group.visible = n > 0;
-  }
-
-  /** Pose dancer `index` from 17 world joint positions. */
-  setPose(index: number, positions: Float32Array): void {
-    const m = _matrix;
-    for (let j = 0; j < this.jointCount; j++) {
-      const r = j === HEAD ? HEAD_RADIUS : JOINT_RADIUS;
-      _position.set(positions[3 * j], positions[3 * j + 1], positions[3 * j + 2]);
-      _scale.set(r, r, r);
-      m.compose(_position, _identity, _scale);
-      this.joints.setMatrixAt(index * this.jointCount + j, m);
-    }
-    const bones = this.boneChildren;
-    for (let b = 0; b < bones.length; b++) {
-      const j = bones[b];
-      const p = this.parents[j];
-      _position.set(positions[3 * p], positions[3 * p + 1], positions[3 * p + 2]);
-      _direction.set(positions[3 * j], positions[3 * j + 1], positions[3 * j + 2]).sub(_position);
-      const length = _direction.length();
-      if (length > 1e-6) _direction.divideScalar(length);
-      else _direction.set(0, 1, 0);
-      _rotation.setFromUnitVectors(_up, _direction);
-      _scale.set(BONE_RADIUS, length, BONE_RADIUS);
-      m.compose(_position, _rotation, _scale);
-      this.bones.setMatrixAt(index * bones.length + b, m);
-    }
-    this.joints.instanceMatrix.needsUpdate = true;
-    this.bones.instanceMatrix.needsUpdate = true;
-  }
-}
 
 /** A polyline with a dot at every point, rewritten in place from a Float32Array of world points. */
 export class PathOverlay {
@@ -188,6 +117,9 @@ export class Stage {
   readonly ghosts: DancerMeshes;
   readonly trajectories: PathOverlay[];
   readonly intentions: PathOverlay[];
+  /** Leader, follower, compare follower: the indices of setHandContact. */
+  readonly dancers: DancerMeshes[];
+  readonly contacts: ContactMarks;
 
   private readonly sun: THREE.DirectionalLight;
   private readonly floor: THREE.Mesh;
@@ -238,11 +170,11 @@ export class Stage {
     this.scene.add(this.floor);
 
     const solid = (color: number) => new THREE.MeshStandardMaterial({ color, roughness: 0.55, metalness: 0.05 });
-    this.leader = new DancerMeshes(parents, 1, solid(COLORS.leader), true);
-    this.followers = [
-      new DancerMeshes(parents, 1, solid(COLORS.follower), true),
-      new DancerMeshes(parents, 1, solid(COLORS.compare), true),
-    ];
+    const dancer = (color: number) => new DancerMeshes(parents, 1, solid(color), true);
+    this.leader = dancer(COLORS.leader);
+    this.followers = [dancer(COLORS.follower), dancer(COLORS.compare)];
+    this.dancers = [this.leader, ...this.followers];
+    this.contacts = new ContactMarks(this.dancers.length);
     const ghostMaterial = new THREE.MeshStandardMaterial({
       color: COLORS.follower,
       transparent: true,
@@ -251,7 +183,7 @@ export class Stage {
     });
     this.ghosts = new DancerMeshes(parents, Math.max(1, maxGhosts), ghostMaterial, false);
     this.ghosts.setCount(0);
-    this.scene.add(this.leader.group, this.ghosts.group, ...this.followers.map((f) => f.group));
+    this.scene.add(this.leader.group, this.ghosts.group, ...this.followers.map((f) => f.group), this.contacts.group);
 
     // Trajectories: root + 6 future keys. Intentions: 5 key joints × 6 keys.
     this.trajectories = [COLORS.leader, COLORS.follower, COLORS.compare].map((c) => new PathOverlay(7, c));
@@ -314,7 +246,18 @@ export class Stage {
     out.z = _offset.z / length;
   }
 
+  /**
+   * How much hand `hand` (0 left, 1 right) of dancer `dancer` (0 leader, 1 follower, 2 compare
+   * follower) is in contact, 0..1: above 0 a soft glow shows at that hand. Holds until set again;
+   * call it every frame (or whenever the contact layer's weights change), before render().
+   */
+  setHandContact(dancer: number, hand: number, weight: number): void {
+    const d = this.dancers[dancer];
+    if (d && (hand === 0 || hand === 1)) d.handContact[hand] = Number.isFinite(weight) ? Math.min(1, Math.max(0, weight)) : 0;
+  }
+
   render(): void {
+    this.contacts.update(this.dancers);
     this.controls.update();
     this.renderer.render(this.scene, this.camera);
   }
@@ -338,13 +281,6 @@ function gridFloorMaterial(): THREE.MeshLambertMaterial {
 }
 
 // Scratch objects shared by the per-frame code above.
-const _matrix = new THREE.Matrix4();
-const _position = new THREE.Vector3();
-const _direction = new THREE.Vector3();
-const _scale = new THREE.Vector3();
-const _rotation = new THREE.Quaternion();
-const _identity = new THREE.Quaternion();
-const _up = new THREE.Vector3(0, 1, 0);
 const _delta = new THREE.Vector3();
 const _offset = new THREE.Vector3();
 const _spherical = new THREE.Spherical();

@@ -25,6 +25,11 @@ export interface DancerView {
   future: Float32Array;
   /** Predicted partner key joints (intention): 6 keys × 5 key joints × (x, y, z). */
   intention?: Float32Array;
+  /** Optional, for drawing hands, feet and the face: 17 joints × world rotation (row-major 3×3)
+   *  of the same frame as `positions`. */
+  rotations?: Float32Array;
+  /** Optional, for the floor marks under planted feet: foot contact [left, right] in 0..1. */
+  contacts?: Float32Array;
 }
 
 export interface Simulation {

@@ -1,0 +1,103 @@
+// web/body.ts: hands, feet and face follow the joint rotations (or the body's facing without
+// them), shoes stay above the floor, and contact marks appear only for contacts.
+
+import * as THREE from 'three';
+import { describe, expect, it } from 'vitest';
+import { ContactMarks, DancerMeshes } from '../../web/body';
+import { PARENTS } from '../../web/skeleton';
+
+/** A standing dancer facing +z (left side at +x), arms hanging, ankles 8 cm up. */
+function standing(): Float32Array {
+  const p = new Float32Array(51);
+  const set = (j: number, x: number, y: number, z: number) => p.set([x, y, z], 3 * j);
+  set(0, 0, 0.95, 0); set(1, 0, 1.15, 0); set(2, 0, 1.3, 0); set(3, 0, 1.55, 0); set(4, 0, 1.65, 0);
+  set(5, 0.18, 1.5, 0); set(6, 0.2, 1.22, 0); set(7, 0.2, 0.95, 0.05);
+  set(8, -0.18, 1.5, 0); set(9, -0.2, 1.22, 0); set(10, -0.2, 0.95, 0.05);
+  set(11, 0.1, 0.95, 0); set(12, 0.1, 0.52, 0.03); set(13, 0.1, 0.08, 0);
+  set(14, -0.1, 0.95, 0); set(15, -0.1, 0.52, 0.03); set(16, -0.1, 0.08, 0);
+  return p;
+}
+
+/** Rotate positions (and optionally row-major rotations) by `angle` about +y. */
+function turned(p: Float32Array, angle: number): Float32Array {
+  const out = new Float32Array(p.length);
+  const c = Math.cos(angle), s = Math.sin(angle);
+  for (let j = 0; j < p.length / 3; j++) {
+    out[3 * j] = c * p[3 * j] + s * p[3 * j + 2];
+    out[3 * j + 1] = p[3 * j + 1];
+    out[3 * j + 2] = -s * p[3 * j] + c * p[3 * j + 2];
+  }
+  return out;
+}
+
+function identityRotations(angle = 0): Float32Array {
+  const r = new Float32Array(17 * 9);
+  const c = Math.cos(angle), s = Math.sin(angle);
+  for (let j = 0; j < 17; j++) r.set([c, 0, s, 0, 1, 0, -s, 0, c], 9 * j);
+  return r;
+}
+
+const material = () => new THREE.MeshStandardMaterial({ color: 0x2f6fe4 });
+/** Extra instance i (0 l-hand, 1 r-hand, 2 l-foot, 3 r-foot, 4 nose, 5 visor): centre and main axis. */
+function extra(d: DancerMeshes, i: number): { centre: THREE.Vector3; axis: THREE.Vector3; matrix: THREE.Matrix4 } {
+  const mesh = d.group.children[0] as THREE.InstancedMesh;
+  const matrix = new THREE.Matrix4();
+  mesh.getMatrixAt(17 + i, matrix);
+  const e = matrix.elements;
+  return { centre: new THREE.Vector3(e[12], e[13], e[14]), axis: new THREE.Vector3(e[0], e[1], e[2]).normalize(), matrix };
+}
+
+describe('DancerMeshes', () => {
+  for (const [label, rotations] of [['joint rotations', identityRotations()], ['positions only', null]] as const) {
+    it(`points feet and face forward and hands along the forearm (${label})`, () => {
+      const d = new DancerMeshes(PARENTS, 1, material(), false);
+      for (const angle of [0, 1.2, -2.5]) {
+        d.setPose(0, turned(standing(), angle), rotations && identityRotations(angle));
+        const forward = new THREE.Vector3(Math.sin(angle), 0, Math.cos(angle));
+        for (const foot of [2, 3]) {
+          const { axis, centre } = extra(d, foot);
+          expect(axis.dot(forward)).toBeGreaterThan(0.99);
+          expect(centre.y).toBeGreaterThan(0);
+        }
+        const head = new THREE.Vector3(...turned(standing(), angle).slice(12, 15));
+        expect(extra(d, 4).centre.sub(head).dot(forward)).toBeGreaterThan(0.08); // the nose is in front
+        expect(extra(d, 4).axis.dot(forward)).toBeGreaterThan(0.99);
+        // Hands hang down: the mitten runs downward from the wrist (arm straight along -y, so the
+        // rotations' +x / -x convention must agree with the forearm).
+        if (!rotations) for (const hand of [0, 1]) expect(extra(d, hand).axis.y).toBeLessThan(-0.9);
+        for (let i = 0; i < 6; i++) expect(extra(d, i).matrix.determinant()).toBeGreaterThan(0); // no mirrored shape
+      }
+    });
+  }
+
+  it('keeps a shoe above the floor when the ankle is low and the toe points down', () => {
+    const d = new DancerMeshes(PARENTS, 1, material(), false);
+    const p = standing();
+    p[40] = 0.06; // left ankle at its lowest
+    const r = identityRotations();
+    // Left foot pitched 40° toe-down: forward (col z) tilts to -y.
+    const a = (40 * Math.PI) / 180;
+    r.set([1, 0, 0, 0, Math.cos(a), Math.sin(a), 0, -Math.sin(a), Math.cos(a)], 9 * 13);
+    d.setPose(0, p, r);
+    const { matrix } = extra(d, 2);
+    // Lowest point of the ellipsoid x^T x <= 1 mapped by the matrix: centre.y - |row y|.
+    const e = matrix.elements;
+    expect(e[13] - Math.hypot(e[1], e[5], e[9])).toBeGreaterThan(0);
+  });
+
+  it('shows rings for planted feet and glows for hands in contact only', () => {
+    const dancers = [new DancerMeshes(PARENTS, 1, material(), false), new DancerMeshes(PARENTS, 1, material(), false)];
+    const marks = new ContactMarks(3);
+    dancers.forEach((d) => d.setPose(0, standing(), null, [0, 0]));
+    marks.update(dancers);
+    expect(marks.counts).toEqual({ rings: 0, glows: 0 });
+    dancers[0].setPose(0, standing(), null, [1, 0.1]);
+    dancers[1].setPose(0, standing(), null, [0.9, 0.95]);
+    dancers[1].handContact[1] = 0.5;
+    marks.update(dancers);
+    expect(marks.counts).toEqual({ rings: 3, glows: 1 });
+    dancers[1].setCount(0); // hidden dancers leave no marks
+    marks.update(dancers);
+    expect(marks.counts).toEqual({ rings: 1, glows: 0 });
+  });
+});
