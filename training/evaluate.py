@@ -282,7 +282,7 @@ def rollout(take: EvalTake, follower_policy, temperature: float, seed: int, star
     n = HISTORY + steps + 1
     rec = {"positions": np.empty((n, feat.N_JOINTS, 3)), "rotations": np.empty((n, feat.N_JOINTS, 3, 3)),
            "root": np.empty((n, 2)), "heading": np.empty(n), "leader_positions": np.empty((n, feat.N_JOINTS, 3)),
-           "leader_root": np.empty((n, 2))}
+           "leader_root": np.empty((n, 2)), "contacts": np.zeros((n, 2))}
 
     def record(i0, i1, src_lo):
         ft, lt = follower.track, leader.track
@@ -290,6 +290,7 @@ def rollout(take: EvalTake, follower_policy, temperature: float, seed: int, star
             rec[k][i0:i1] = getattr(ft, k)[src_lo:NOW + 1]
         rec["leader_positions"][i0:i1] = lt.positions[src_lo:NOW + 1]
         rec["leader_root"][i0:i1] = lt.root[src_lo:NOW + 1]
+        rec["contacts"][i1 - 1] = follower.contacts     # the follower's foot contacts, as it says
 
     record(0, HISTORY + 1, 0)
     for i in range(steps):

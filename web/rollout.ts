@@ -35,7 +35,7 @@ export const STEER_HALFLIFE = 0.25; // s for the steered velocity to get halfway
 export const MAX_JOINT_DISTANCE = 3.0; // m from the root: beyond this the output is absurd
 export const MAX_ROOT_JUMP = 1.0; // m in one step
 export const MIN_ANKLE_HEIGHT = 0.04; // m: the lowest ankle height in the recordings
-export const ANCHOR_RATE = 0.05; // share of the leader's distance to its anchor closed every frame
+export const ANCHOR_RATE = 0.15; // share of the leader's distance to its anchor closed every free frame
 export const LEASH_DISTANCE = 2.0; // m: beyond this a follower is drawn toward its leader ...
 export const LEASH_RATE = 0.1; // ... closing this share of the excess every frame
 export const START_DISTANCE = 0.8; // m between the partners at the start and after a reset
@@ -302,15 +302,18 @@ export function shiftDancer(d: Dancer, sx: number, sz: number): void {
 }
 
 /**
- * Draw the leader a little toward its anchor every frame.
+ * Draw the leader a little toward its anchor in the frames where its feet are free.
  *
  * The leader model reads the steered plan as an intention, not an order: fed its own predicted
  * path it wanders (about 1.7 m in 3 s here), and steered it answers only in part. Pulling the
- * root toward the anchor (a spring with a 0.7 s time constant at 30 Hz) lets it dance freely
- * around the spot the user left it at and travel where the user steers.
+ * root toward the anchor lets it dance freely around the spot the user left it at and travel
+ * where the user steers. The pull moves the whole body, so it acts only as far as no foot is
+ * planted (1 - the larger contact): a planted foot is never slid by it.
  */
 export function followAnchor(leader: Dancer, steering: Steering): void {
-  shiftDancer(leader, (steering.anchor[0] - leader.rootX) * ANCHOR_RATE, (steering.anchor[1] - leader.rootZ) * ANCHOR_RATE);
+  const free = 1 - Math.max(leader.contacts[0], leader.contacts[1]);
+  const rate = ANCHOR_RATE * free;
+  shiftDancer(leader, (steering.anchor[0] - leader.rootX) * rate, (steering.anchor[1] - leader.rootZ) * rate);
 }
 
 /**
