@@ -129,7 +129,7 @@ export interface LeaderFileOptions {
   notify?: (title: string, detail: string, kind: ToastKind) => void;
 }
 
-/** The simulation side of leader playback (rollout.ts DuetSimulation). */
+/** The simulation side of leader playback (simulation.ts DuetSimulation). */
 export interface LeaderPlayable {
   setLeaderPlayback(motion: Motion | null): void;
 }

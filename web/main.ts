@@ -21,7 +21,7 @@ import { MAX_RECORD_FRAMES, type RecordableDuet, RecordPanel, Recorder, formatDu
 import { LeaderFileInput, canPlayLeader, showToast } from './dropzone';
 
 /** The duet loop (features, both models, pose): loaded with the models, not with the page. */
-const loadSimulationModule = () => import('./rollout');
+const loadSimulationModule = () => import('./simulation');
 
 const DT = 1 / 30;
 const NO_GUARDS = { resets: 0, leashed: 0 };

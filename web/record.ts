@@ -28,7 +28,7 @@ export interface RecordableDancer {
   readonly track: { readonly positions: ArrayLike<number>; readonly rotations: ArrayLike<number> };
 }
 
-/** What the recorder reads of a rollout.ts Duet (DuetSimulation.duet). */
+/** What the recorder reads of a rollout.ts Duet (simulation.ts DuetSimulation.duet). */
 export interface RecordableDuet {
   readonly leader: RecordableDancer;
   readonly followers: readonly RecordableDancer[];

@@ -1,4 +1,4 @@
-// Shared types between the page shell (main, scene, hud, ...) and the simulation (rollout.ts).
+// Shared types between the page shell (main, scene, hud, ...) and the simulation (simulation.ts).
 // The shell only ever talks to a `Simulation`; what happens inside one step (features, both
 // models, pose) is the simulation's business.
 
@@ -54,7 +54,7 @@ export interface SimulationOptions {
   seed: number;
 }
 
-/** rollout.ts exports a function of this type named `createSimulation`. */
+/** simulation.ts exports a function of this type named `createSimulation`. */
 export type CreateSimulation = (options: SimulationOptions) => Simulation;
 
 export interface ModelEntry {
@@ -78,7 +78,7 @@ export interface Manifest {
   };
   keyJoints: number[];
   layout: { input: number; output: number; intention: number };
-  /** Opaque to the shell; read by rollout.ts. */
+  /** Opaque to the shell; read by rollout.ts (startDuet). */
   startPose: unknown;
   models: Record<string, ModelEntry>;
   defaultTemperature: number;

@@ -1,10 +1,11 @@
-// The page's Simulation (createSimulation in web/rollout.ts) on fake policies: views in world
+// The page's Simulation (createSimulation in web/simulation.ts) on fake policies: views in world
 // space, compare mode, ghosts that leave the real state alone, resets on absurd output, leader
 // playback from a recording, foot locking on the drawn pose only, step timing.
 
 import { describe, expect, it } from 'vitest';
 import { FOLLOWER_INPUT_LAYOUT, INPUT_SIZE, LEADER_INPUT_LAYOUT, OUTPUT_LAYOUT, OUTPUT_SIZE, Track, blockSlices } from '../../web/features';
-import { ANCHOR_RATE, NOW, type DuetSimulation, createDuetSimulation, createSimulation } from '../../web/rollout';
+import { ANCHOR_RATE, NOW } from '../../web/rollout';
+import { type DuetSimulation, createSimulation } from '../../web/simulation';
 import type { Motion } from '../../web/skeleton';
 import type { Policy } from '../../web/policy';
 import type { Manifest } from '../../web/types';
@@ -100,7 +101,7 @@ function simulation(followers: FakeOptions[] = [{ role: 'follower', intention: t
   const lead = new FakePolicy(leader);
   const follow = followers.map((o) => new FakePolicy(o));
   const asPolicy = (p: FakePolicy) => p as unknown as Policy;
-  const sim = createDuetSimulation({ manifest, leader: asPolicy(lead), followers: follow.map(asPolicy), seed: 1 });
+  const sim = createSimulation({ manifest, leader: asPolicy(lead), followers: follow.map(asPolicy), seed: 1 });
   return { sim, lead, follow };
 }
 

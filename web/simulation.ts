@@ -1,0 +1,199 @@
+// The page's Simulation: policies in, DancerViews out. One step runs the duet loop of rollout.ts
+// (the mirror of training/rollout.py) with the page's policies, then refreshes what the page draws
+// (foot-locked poses, planned paths, intentions). Also here: sampled ghosts and leader playback
+// from a recording. Nothing in this file changes a number the models see.
+
+import { FUTURE_OFFSETS, INPUT_SIZE, INTENTION_SIZE, KEYS, N_JOINTS, OUTPUT_SIZE, followerInput } from './features';
+import { KEY_JOINTS, type Motion } from './skeleton';
+import { FootLock } from './footik';
+import { LeaderPlayback } from './playback';
+import { StepTimer } from './timing';
+import {
+  Dancer, type Duet, NOW, applyOutput, finishStep, outputIsAbsurd, startDuet, steerPlan, stepInputs,
+} from './rollout';
+import type { Policy } from './policy';
+import type { DancerView, Simulation, SimulationOptions, Steer } from './types';
+
+/** Per dancer: what the page draws, kept up to date from the dancer after every step. */
+class View implements DancerView {
+  root: [number, number] = [0, 0];
+  heading = 0;
+  readonly positions = new Float32Array(N_JOINTS * 3);
+  readonly future = new Float32Array(KEYS * 2);
+  intention?: Float32Array;
+  readonly feet = new FootLock();
+  private resets = -1;
+
+  constructor(withIntention: boolean) {
+    if (withIntention) this.intention = new Float32Array(INTENTION_SIZE);
+  }
+
+  update(d: Dancer, jumped = false): void {
+    this.root[0] = d.rootX;
+    this.root[1] = d.rootZ;
+    this.heading = d.heading;
+    const t = d.track;
+    for (let i = 0; i < 51; i++) this.positions[i] = t.positions[NOW * 51 + i];
+    for (let k = 0; k < KEYS; k++) {
+      this.future[2 * k] = t.root[2 * (NOW + FUTURE_OFFSETS[k])];
+      this.future[2 * k + 1] = t.root[2 * (NOW + FUTURE_OFFSETS[k]) + 1];
+    }
+    if (this.intention && d.intention) this.intention.set(d.intention);
+    // A dancer that was just placed anew must not drag its old foot locks along.
+    if (jumped || d.resets !== this.resets) this.feet.clear();
+    this.resets = d.resets;
+    this.feet.apply(this.positions, d.contacts, d.heading);
+  }
+}
+
+export class DuetSimulation implements Simulation {
+  readonly leader: DancerView;
+  readonly followers: DancerView[];
+  duet: Duet;
+  private readonly leaderView: View;
+  private readonly followerViews: View[];
+  private readonly leaderPolicy: Policy;
+  private readonly followerPolicies: Policy[];
+  private readonly followerInputs: Float32Array[];
+  // Own copies of each model's result: two roles may never share a Policy's result arrays.
+  private readonly leaderOutput = new Float32Array(OUTPUT_SIZE);
+  private readonly guardCounts = { resets: 0, leashed: 0 };
+  private readonly followerOutputs: Float32Array[];
+  private readonly followerIntentions: (Float32Array | null)[];
+  private readonly timer = new StepTimer(300);
+  private playback: LeaderPlayback | null = null;
+  private temperature: number;
+  private readonly ghost: Dancer;
+  private readonly ghostPoses: Float32Array[] = [];
+
+  constructor(private readonly options: SimulationOptions) {
+    const { manifest, leader, followers } = options;
+    if (followers.length < 1) throw new RangeError('a duet needs at least one follower');
+    this.leaderPolicy = leader;
+    this.followerPolicies = followers;
+    this.followerInputs = followers.map((p) => p.input);
+    this.temperature = manifest.defaultTemperature ?? 0.5;
+    this.duet = startDuet(manifest, followers.length);
+    this.leaderView = new View(false);
+    this.followerViews = followers.map((p) => new View(p.hasIntention));
+    this.leader = this.leaderView;
+    this.followers = this.followerViews;
+    this.followerOutputs = followers.map(() => new Float32Array(OUTPUT_SIZE));
+    this.followerIntentions = followers.map((p) => (p.hasIntention ? new Float32Array(INTENTION_SIZE) : null));
+    this.ghost = new Dancer(this.duet.followers[0].offsets);
+    this.updateViews(true);
+  }
+
+  reset(): void {
+    this.duet = startDuet(this.options.manifest, this.followerPolicies.length);
+    this.playback?.start(this.duet.leader.track);
+    this.timer.clear();
+    this.updateViews(true);
+  }
+
+  async step(steer: Steer, temperature: number): Promise<void> {
+    const started = performance.now();
+    this.temperature = temperature;
+    const duet = this.duet;
+    const playing = this.playback !== null;
+    if (!playing) {
+      const sx = steer.active ? steer.x : 0;
+      const sz = steer.active ? steer.z : 0;
+      steerPlan(duet.leader, duet.steering, sx, sz);
+    }
+    stepInputs(duet, playing ? null : this.leaderPolicy.input, this.followerInputs);
+    if (!playing) {
+      const result = await this.leaderPolicy.run(temperature);
+      this.leaderOutput.set(result.output);
+    }
+    for (let i = 0; i < this.followerPolicies.length; i++) {
+      const result = await this.followerPolicies[i].run(temperature);
+      this.followerOutputs[i].set(result.output);
+      if (result.intention) this.followerIntentions[i]?.set(result.intention);
+    }
+    if (this.playback) this.playback.advance(duet.leader.track, duet.leader.contacts);
+    finishStep(duet, playing ? null : this.leaderOutput, this.followerOutputs, this.followerIntentions);
+    this.updateViews(false);
+    this.timer.add(performance.now() - started);
+  }
+
+  /**
+   * k alternative next poses of the first follower: its model run once on k copies of its current
+   * input (each sample draws its own noise), each output applied to a scratch copy of the dancer.
+   */
+  async ghosts(k: number): Promise<Float32Array[]> {
+    if (k <= 0) return [];
+    const policy = this.followerPolicies[0];
+    const follower = this.duet.followers[0];
+    const input = policy.batchInput(k);
+    followerInput(this.duet.leader.track, follower.track, NOW, input, 0);
+    for (let i = 1; i < k; i++) input.copyWithin(i * INPUT_SIZE, 0, INPUT_SIZE);
+    const { output } = await policy.runBatch(k, this.temperature);
+    while (this.ghostPoses.length < k) this.ghostPoses.push(new Float32Array(N_JOINTS * 3));
+    for (let i = 0; i < k; i++) {
+      this.ghost.copyFrom(follower);
+      if (!outputIsAbsurd(this.ghost, output, i * OUTPUT_SIZE)) applyOutput(this.ghost, output, i * OUTPUT_SIZE);
+      const p = this.ghost.track.positions;
+      for (let n = 0; n < 51; n++) this.ghostPoses[i][n] = p[NOW * 51 + n];
+    }
+    return this.ghostPoses.slice(0, k);
+  }
+
+  /** Called every animation frame by the HUD: sums into one reused object, allocates nothing. */
+  guards(): { resets: number; leashed: number } {
+    const g = this.guardCounts;
+    g.resets = this.duet.leader.resets;
+    g.leashed = this.duet.leader.leashed;
+    for (const f of this.duet.followers) {
+      g.resets += f.resets;
+      g.leashed += f.leashed;
+    }
+    return g;
+  }
+
+  stepMs(): { median: number; p95: number } {
+    return this.timer.summary();
+  }
+
+  /**
+   * Drive the leader from a recorded motion (30 fps, e.g. motionFromBvhText) instead of the leader
+   * model, or go back to the model with null. The recording starts where the leader stands now,
+   * facing where it faces, and loops.
+   */
+  setLeaderPlayback(motion: Motion | null): void {
+    if (!motion) {
+      this.playback = null;
+      return;
+    }
+    const playback = new LeaderPlayback(motion);
+    playback.takeOver(this.duet.leader.track);
+    this.playback = playback;
+  }
+
+  /** Whether the leader follows a recording; the recording's current frame and length. */
+  get leaderPlayback(): { frame: number; frames: number } | null {
+    return this.playback ? { frame: this.playback.frame, frames: this.playback.frames } : null;
+  }
+
+  private updateViews(jumped: boolean): void {
+    const leader = this.duet.leader;
+    this.leaderView.update(leader, jumped);
+    this.duet.followers.forEach((f, i) => {
+      const view = this.followerViews[i];
+      view.update(f, jumped);
+      // Before the first prediction: the leader's key joints where they are now, at every key.
+      if (view.intention && !f.intention) {
+        for (let k = 0; k < KEYS; k++) {
+          KEY_JOINTS.forEach((j, n) => {
+            for (let a = 0; a < 3; a++) view.intention![(k * KEY_JOINTS.length + n) * 3 + a] = leader.track.positions[NOW * 51 + 3 * j + a];
+          });
+        }
+      }
+    });
+  }
+}
+
+/** The page's factory (see CreateSimulation in types.ts). */
+export function createSimulation(options: SimulationOptions): DuetSimulation {
+  return new DuetSimulation(options);
+}
