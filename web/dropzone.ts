@@ -129,15 +129,6 @@ export interface LeaderFileOptions {
   notify?: (title: string, detail: string, kind: ToastKind) => void;
 }
 
-/** The simulation side of leader playback (simulation.ts DuetSimulation). */
-export interface LeaderPlayable {
-  setLeaderPlayback(motion: Motion | null): void;
-}
-
-export function canPlayLeader(simulation: object): simulation is LeaderPlayable {
-  return typeof (simulation as Partial<LeaderPlayable>).setLeaderPlayback === 'function';
-}
-
 export class LeaderFileInput {
   readonly input: HTMLInputElement;
   private readonly hint: HTMLElement;

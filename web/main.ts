@@ -18,7 +18,7 @@ import { LIMITS, copyLink, defaultSettings, readSettings, writeSettings } from '
 // Record & leader file (record.ts, dropzone.ts).
 import type { Motion } from './skeleton';
 import { MAX_RECORD_FRAMES, type RecordableDuet, RecordPanel, Recorder, formatDuration } from './record';
-import { LeaderFileInput, canPlayLeader, showToast } from './dropzone';
+import { LeaderFileInput, showToast } from './dropzone';
 
 /** The duet loop (features, both models, pose): loaded with the models, not with the page. */
 const loadSimulationModule = () => import('./simulation');
@@ -242,19 +242,18 @@ async function start(): Promise<void> {
   });
 
   // --- Record & leader file (record.ts, dropzone.ts) --------------------------------------------
-  const recordable = (): RecordableDuet | null =>
-    simulation && 'duet' in simulation ? (simulation as Simulation & { duet: RecordableDuet }).duet : null;
+  const recordable = (): RecordableDuet | null => simulation?.duet ?? null;
   const recorder = new Recorder(MAX_RECORD_FRAMES, () =>
     showToast('Recording stopped', `It reached the ${formatDuration(MAX_RECORD_FRAMES / 30)} limit. Download the take (“download BVH”).`, 'error', 15_000));
   let leaderFile: { motion: Motion; name: string } | null = null;
   function applyLeaderFile(): void {
-    if (simulation && canPlayLeader(simulation)) simulation.setLeaderPlayback(leaderFile?.motion ?? null);
+    if (simulation) simulation.setLeaderPlayback(leaderFile?.motion ?? null);
   }
   const leaderFileInput = new LeaderFileInput({
     notify: showToast,
     onMotion: (motion, name) =>
       exclusive(() => {
-        if (!simulation || !canPlayLeader(simulation)) throw new Error('The dancers are still loading; try again in a moment.');
+        if (!simulation) throw new Error('The dancers are still loading; try again in a moment.');
         simulation.setLeaderPlayback(motion); // throws (nothing changed) on a motion it cannot play
         leaderFile = { motion, name };
         recordPanel.setLeaderFile(name);

@@ -4,10 +4,11 @@
 
 import type { Manifest } from './types';
 import { DuetError } from './errors';
+import { INPUT_SIZE, INTENTION_SIZE, OUTPUT_SIZE } from './features';
 
 /** Sizes this page was written for; the manifest must agree. */
 export const MANIFEST_VERSION = 1;
-export const LAYOUT = { input: 660, output: 323, intention: 90 } as const;
+export const LAYOUT = { input: INPUT_SIZE, output: OUTPUT_SIZE, intention: INTENTION_SIZE } as const;
 
 /** Fetch and check public/models/manifest.json (relative, so a sub-path deployment works). */
 export async function loadManifest(url = 'models/manifest.json'): Promise<Manifest> {

@@ -11,8 +11,7 @@ import { StepTimer } from './timing';
 import {
   Dancer, type Duet, NOW, applyOutput, finishStep, outputIsAbsurd, startDuet, steerPlan, stepInputs,
 } from './rollout';
-import type { Policy } from './policy';
-import type { DancerView, Simulation, SimulationOptions, Steer } from './types';
+import type { DancerView, Simulation, SimulationOptions, StepPolicy, Steer } from './types';
 
 /** Per dancer: what the page draws, kept up to date from the dancer after every step. */
 class View implements DancerView {
@@ -52,10 +51,10 @@ export class DuetSimulation implements Simulation {
   duet: Duet;
   private readonly leaderView: View;
   private readonly followerViews: View[];
-  private readonly leaderPolicy: Policy;
-  private readonly followerPolicies: Policy[];
+  private readonly leaderPolicy: StepPolicy;
+  private readonly followerPolicies: StepPolicy[];
   private readonly followerInputs: Float32Array[];
-  // Own copies of each model's result: two roles may never share a Policy's result arrays.
+  // Own copies of each model's result: two roles may never share a policy's result arrays.
   private readonly leaderOutput = new Float32Array(OUTPUT_SIZE);
   private readonly guardCounts = { resets: 0, leashed: 0 };
   private readonly followerOutputs: Float32Array[];

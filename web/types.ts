@@ -2,7 +2,8 @@
 // The shell only ever talks to a `Simulation`; what happens inside one step (features, both
 // models, pose) is the simulation's business.
 
-import type { Policy } from './policy';
+import type { Motion } from './skeleton';
+import type { RecordableDuet } from './record';
 
 /** A 2D steering request on the floor, in world x/z; |(x, z)| is in 0..1. */
 export interface Steer {
@@ -42,14 +43,43 @@ export interface Simulation {
   /** Guard counts since the start: dancers reset after absurd model output, and frames the
    *  leash drew a follower toward the leader (see rollout.ts). */
   guards(): { resets: number; leashed: number };
+  /**
+   * Drive the leader from a recorded motion (30 fps) instead of the leader model, or go back to
+   * the model with null. Throws, changing nothing, on a motion it cannot play.
+   */
+  setLeaderPlayback(motion: Motion | null): void;
+  /** The dancers as they are now, for the recorder (a new object after reset). */
+  readonly duet: RecordableDuet;
+}
+
+/** What one model returns; the arrays are the policy's own and overwritten by its next run. */
+export interface PolicyResult {
+  /** [B × 323] raw model output (root update, trajectory, key joints, pose, contacts). */
+  output: Float32Array;
+  /** [B × 90] predicted partner key joints, or null for models without an intention predictor. */
+  intention: Float32Array | null;
+}
+
+/** What the simulation needs of one model (policy.ts Policy; fakes in the tests). */
+export interface StepPolicy {
+  /** Write the [660] input features here before run(). */
+  readonly input: Float32Array;
+  /** Whether run() returns an intention. */
+  readonly hasIntention: boolean;
+  /** One step for one character: reads `input`. */
+  run(temperature: number): Promise<PolicyResult>;
+  /** The [k × 660] input block for a batched run (e.g. k ghost samples); write rows here. */
+  batchInput(k: number): Float32Array;
+  /** k samples at once, each with its own noise: reads batchInput(k), returns [k × ...] results. */
+  runBatch(k: number, temperature: number): Promise<PolicyResult>;
 }
 
 /** What the shell hands to the simulation factory. */
 export interface SimulationOptions {
   manifest: Manifest;
-  leader: Policy;
+  leader: StepPolicy;
   /** [ours] or [ccm], or [ours, ccm] in compare mode. */
-  followers: Policy[];
+  followers: StepPolicy[];
   /** Seed for anything random the simulation does itself (the policies carry their own PRNG). */
   seed: number;
 }

@@ -7,8 +7,7 @@ import { FOLLOWER_INPUT_LAYOUT, INPUT_SIZE, LEADER_INPUT_LAYOUT, OUTPUT_LAYOUT, 
 import { ANCHOR_RATE, NOW } from '../../web/rollout';
 import { type DuetSimulation, createSimulation } from '../../web/simulation';
 import type { Motion } from '../../web/skeleton';
-import type { Policy } from '../../web/policy';
-import type { Manifest } from '../../web/types';
+import type { Manifest, StepPolicy } from '../../web/types';
 import { ANKLE_FLOOR } from '../../web/footik';
 import { fixture, trackOf } from './fixture';
 
@@ -40,7 +39,7 @@ interface FakeOptions {
 }
 
 /** A stand-in for Policy: "keep the current pose, move `step` forward", built from its own input. */
-class FakePolicy {
+class FakePolicy implements StepPolicy {
   readonly input = new Float32Array(INPUT_SIZE);
   readonly result = { output: new Float32Array(OUTPUT_SIZE), intention: null as Float32Array | null };
   readonly entry = { intention: false };
@@ -94,14 +93,13 @@ class FakePolicy {
   }
 }
 
-const policy = (o: FakeOptions) => new FakePolicy(o) as unknown as Policy;
+const policy = (o: FakeOptions) => new FakePolicy(o);
 const steer = { x: 0, z: 0, active: false };
 
 function simulation(followers: FakeOptions[] = [{ role: 'follower', intention: true }], leader: FakeOptions = { role: 'leader' }) {
   const lead = new FakePolicy(leader);
   const follow = followers.map((o) => new FakePolicy(o));
-  const asPolicy = (p: FakePolicy) => p as unknown as Policy;
-  const sim = createSimulation({ manifest, leader: asPolicy(lead), followers: follow.map(asPolicy), seed: 1 });
+  const sim = createSimulation({ manifest, leader: lead, followers: follow, seed: 1 });
   return { sim, lead, follow };
 }
 
