@@ -15,10 +15,11 @@ import { Controls } from './controls';
 import { Hud } from './hud';
 import { Panel } from './panel';
 import { LIMITS, copyLink, defaultSettings, readSettings, writeSettings } from './share';
-// Record & leader file (record.ts, dropzone.ts).
 import type { Motion } from './skeleton';
-import { MAX_RECORD_FRAMES, type RecordableDuet, RecordPanel, Recorder, formatDuration } from './record';
-import { LeaderFileInput, showToast } from './dropzone';
+import { MAX_RECORD_FRAMES, type RecordableDuet, Recorder, formatDuration } from './record';
+import { RecordPanel } from './recordpanel';
+import { LeaderFileInput } from './dropzone';
+import { showToast } from './toast';
 
 /** The duet loop (features, both models, pose): loaded with the models, not with the page. */
 const loadSimulationModule = () => import('./simulation');
