@@ -7,7 +7,7 @@
 
 import { BvhError } from './bvh';
 import { DuetError } from './errors';
-import { JOINT_NAMES, type Motion, motionFromBvhText } from './skeleton';
+import { FPS, JOINT_NAMES, type Motion, motionFromBvhText } from './skeleton';
 import { type ToastKind, showToast } from './toast';
 
 /** Bigger files are refused before reading (a 10-minute 120 fps take is ~30 MB). */
@@ -162,7 +162,7 @@ export class LeaderFileInput {
     try {
       const motion = await readLeaderFile(file);
       await this.options.onMotion(motion, displayName(file.name));
-      this.notify('The leader dances a file', `${displayName(file.name)}: ${(motion.frames / 30).toFixed(1)} s, looping. “leader back to model” ends it.`, 'info');
+      this.notify('The leader dances a file', `${displayName(file.name)}: ${(motion.frames / FPS).toFixed(1)} s, looping. “leader back to model” ends it.`, 'info');
     } catch (error) {
       if (error instanceof DuetError) this.notify(error.title, error.detail, 'error');
       else this.notify(`Cannot dance ${displayName(file.name)}`, error instanceof Error ? error.message : String(error), 'error');

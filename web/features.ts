@@ -8,7 +8,7 @@
 // path allocates nothing. Module-level scratch arrays hold gathered inputs (JS is single-threaded
 // and none of these functions re-enters another while its scratch is live).
 
-import { FEET, FPS, KEY_JOINTS, type Motion, N_JOINTS, rootFromMotion } from './skeleton';
+import { FEET, FPS, KEY_JOINTS, type Motion, N_JOINTS, POSITIONS_SIZE, ROTATIONS_SIZE, rootFromMotion } from './skeleton';
 
 /** Any float array a feature can be written into (policy inputs are float32, tests use float64). */
 export type Out = Float32Array | Float64Array;
@@ -254,7 +254,7 @@ export class Track {
 
   /** F frames of zeros (the rollout fills them). */
   static empty(frames: number): Track {
-    return new Track(new Float64Array(frames * 51), new Float64Array(frames * 153), new Float64Array(frames * 2), new Float64Array(frames));
+    return new Track(new Float64Array(frames * POSITIONS_SIZE), new Float64Array(frames * ROTATIONS_SIZE), new Float64Array(frames * 2), new Float64Array(frames));
   }
 
   get frames(): number {
@@ -263,8 +263,8 @@ export class Track {
 
   /** Move frames 1..now one slot back (the rollout's step): frame `now` is then free for the new one. */
   shiftPast(now: number): void {
-    this.positions.copyWithin(0, 51, 51 * (now + 1));
-    this.rotations.copyWithin(0, 153, 153 * (now + 1));
+    this.positions.copyWithin(0, POSITIONS_SIZE, POSITIONS_SIZE * (now + 1));
+    this.rotations.copyWithin(0, ROTATIONS_SIZE, ROTATIONS_SIZE * (now + 1));
     this.root.copyWithin(0, 2, 2 * (now + 1));
     this.heading.copyWithin(0, 1, now + 1);
   }
@@ -312,9 +312,9 @@ function keyJointsAt(track: Track, t: number, offsets: readonly number[], rootX:
 }
 
 function poseAt(track: Track, t: number, rootX: number, rootZ: number, heading: number, out: Out, at: number): void {
-  copyFrame(track.positions, 51, t, gatherPositions);
-  copyFrame(track.positions, 51, t - 1, gatherPrevious);
-  copyFrame(track.rotations, 153, t, gatherRotations);
+  copyFrame(track.positions, POSITIONS_SIZE, t, gatherPositions);
+  copyFrame(track.positions, POSITIONS_SIZE, t - 1, gatherPrevious);
+  copyFrame(track.rotations, ROTATIONS_SIZE, t, gatherRotations);
   poseBlock(gatherPositions, gatherPrevious, gatherRotations, rootX, rootZ, heading, out, at);
 }
 
@@ -364,8 +364,8 @@ export function outputFeatures(me: Track, t: number, out: Out, at = 0): void {
   trajectoryAt(me, n, FUTURE_OFFSETS, x, z, h, out, at + b.trajectory_future.start);
   keyJointsAt(me, n, FUTURE_OFFSETS, x, z, h, out, at + b.key_joints_future.start);
   poseAt(me, n, x, z, h, out, at + b.pose.start);
-  copyFrame(me.positions, 51, n, gatherPositions);
-  copyFrame(me.positions, 51, t, gatherPrevious);
+  copyFrame(me.positions, POSITIONS_SIZE, n, gatherPositions);
+  copyFrame(me.positions, POSITIONS_SIZE, t, gatherPrevious);
   footContacts(gatherPositions, gatherPrevious, out, at + b.contacts.start);
 }
 

@@ -2,13 +2,14 @@
 // the simulation at 30 Hz, and drawing interpolates between the last two steps.
 
 import { INTENTION_SIZE, KEYS } from './features';
+import { POSITIONS_SIZE } from './skeleton';
 import type { DancerView } from './types';
 
 /** Last two simulation states of one dancer, copied so drawing can interpolate between them. */
 export class DancerTrack {
-  readonly previous = new Float32Array(51);
-  readonly current = new Float32Array(51);
-  readonly drawn = new Float32Array(51);
+  readonly previous = new Float32Array(POSITIONS_SIZE);
+  readonly current = new Float32Array(POSITIONS_SIZE);
+  readonly drawn = new Float32Array(POSITIONS_SIZE);
   readonly root = new Float32Array(4); // previous x, z, current x, z
   readonly future = new Float32Array(KEYS * 2);
   readonly intention = new Float32Array(INTENTION_SIZE);
@@ -27,7 +28,7 @@ export class DancerTrack {
   }
 
   interpolate(alpha: number): Float32Array {
-    for (let i = 0; i < 51; i++) this.drawn[i] = this.previous[i] + (this.current[i] - this.previous[i]) * alpha;
+    for (let i = 0; i < POSITIONS_SIZE; i++) this.drawn[i] = this.previous[i] + (this.current[i] - this.previous[i]) * alpha;
     return this.drawn;
   }
 

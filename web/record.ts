@@ -10,15 +10,13 @@
 // goes on). At MAX_RECORD_FRAMES the recording stops and says so; no frame is ever dropped silently.
 // The panel folder and the recording indicator are recordpanel.ts.
 
-import { HISTORY } from './features';
 import { CHANNELS_PER_FRAME, frameChannels, writeBvh } from './bvhwriter';
-import { FPS } from './skeleton';
+import { FPS, POSITIONS_SIZE, ROTATIONS_SIZE } from './skeleton';
+import { NOW } from './rollout';
 
 /** 10 minutes at 30 fps. */
 export const MAX_RECORD_FRAMES = 10 * 60 * FPS;
-/** The current frame of a rollout Track (rollout.ts NOW). */
-const NOW = HISTORY;
-const CHUNK_FRAMES = 900; // 30 s per chunk
+const CHUNK_FRAMES = 30 * FPS; // 30 s per chunk
 
 /** What the recorder reads of a rollout.ts Dancer. */
 export interface RecordableDancer {
@@ -56,7 +54,7 @@ class DancerTake {
       prevAt = ((f - 1) % CHUNK_FRAMES) * CHANNELS_PER_FRAME;
     }
     const t = dancer.track;
-    frameChannels(t.positions, NOW * 51, t.rotations, NOW * 153, this.chunks[chunk], at, previous, prevAt);
+    frameChannels(t.positions, NOW * POSITIONS_SIZE, t.rotations, NOW * ROTATIONS_SIZE, this.chunks[chunk], at, previous, prevAt);
     this.frames++;
   }
 

@@ -18,7 +18,7 @@ import {
   FUTURE_OFFSETS, HISTORY, INTENTION_SIZE, KEYS, N_JOINTS, OUTPUT_LAYOUT, OUTPUT_SIZE, type Out, Track,
   blockSlices, followerInput, fromRootSpaceDirections, fromRootSpacePoints, leaderInput, wrapAngle,
 } from './features';
-import { FEET, FPS, KEY_JOINTS, PARENTS, forwardKinematicsReduced } from './skeleton';
+import { FEET, FPS, KEY_JOINTS, PARENTS, POSITIONS_SIZE, ROTATIONS_SIZE, forwardKinematicsReduced } from './skeleton';
 
 export const NOW = HISTORY;
 export const TRACK_FRAMES = 2 * HISTORY + 1;
@@ -96,7 +96,7 @@ export class Dancer {
 
   /** The current joint positions [17 × 3] (a view into the track). */
   get positions(): Float64Array {
-    return this.track.positions.subarray(NOW * 51, NOW * 51 + 51);
+    return this.track.positions.subarray(NOW * POSITIONS_SIZE, NOW * POSITIONS_SIZE + POSITIONS_SIZE);
   }
 
   /** Make this dancer an exact copy of `other` (same offsets assumed): for trying outputs out. */
@@ -109,9 +109,11 @@ export class Dancer {
   }
 }
 
+/** Forward vectors [17 × 3], then up vectors from UP_AT on. */
 const poseVectors = new Float64Array(N_JOINTS * 3 * 2);
-const poseRotations = new Float64Array(N_JOINTS * 9);
-const turnedRotations = new Float64Array(N_JOINTS * 9);
+const UP_AT = N_JOINTS * 3;
+const poseRotations = new Float64Array(ROTATIONS_SIZE);
+const turnedRotations = new Float64Array(ROTATIONS_SIZE);
 const hipScratch = new Float64Array(3);
 const hipWorld = new Float64Array(3);
 
@@ -120,10 +122,10 @@ function standStill(d: Dancer, pose: StartPose, rootX: number, rootZ: number, he
   for (let j = 0; j < N_JOINTS; j++) {
     for (let k = 0; k < 3; k++) {
       poseVectors[3 * j + k] = pose.forward[j][k];
-      poseVectors[51 + 3 * j + k] = pose.up[j][k];
+      poseVectors[UP_AT + 3 * j + k] = pose.up[j][k];
     }
   }
-  rotationsFromVectors(poseVectors, poseVectors.subarray(51), N_JOINTS, poseRotations);
+  rotationsFromVectors(poseVectors, poseVectors.subarray(UP_AT), N_JOINTS, poseRotations);
   // R_y(heading) · R, column by column (rotation_y in Python).
   const c = Math.cos(heading);
   const s = Math.sin(heading);
@@ -141,9 +143,9 @@ function standStill(d: Dancer, pose: StartPose, rootX: number, rootZ: number, he
   fromRootSpacePoints(hipScratch, 0, 1, rootX, rootZ, heading, hipWorld, 0);
   const t = d.track;
   forwardKinematicsReduced(d.offsets, hipWorld, 0, turnedRotations, 0, t.positions, 0);
-  for (let f = 1; f < TRACK_FRAMES; f++) t.positions.copyWithin(f * 51, 0, 51);
+  for (let f = 1; f < TRACK_FRAMES; f++) t.positions.copyWithin(f * POSITIONS_SIZE, 0, POSITIONS_SIZE);
   for (let f = 0; f < TRACK_FRAMES; f++) {
-    t.rotations.set(turnedRotations, f * 153);
+    t.rotations.set(turnedRotations, f * ROTATIONS_SIZE);
     t.root[2 * f] = rootX;
     t.root[2 * f + 1] = rootZ;
     t.heading[f] = heading;
@@ -195,19 +197,19 @@ export function applyOutput(d: Dancer, output: ArrayLike<number>, at = 0): void 
   for (let j = 0; j < N_JOINTS; j++) {
     for (let k = 0; k < 3; k++) {
       poseVectors[3 * j + k] = output[pose + 12 * j + 6 + k];
-      poseVectors[51 + 3 * j + k] = output[pose + 12 * j + 9 + k];
+      poseVectors[UP_AT + 3 * j + k] = output[pose + 12 * j + 9 + k];
     }
   }
   fromRootSpaceDirections(poseVectors, 0, 2 * N_JOINTS, heading, poseVectors, 0); // forward and up, in place
-  rotationsFromVectors(poseVectors, poseVectors.subarray(51), N_JOINTS, t.rotations, NOW * 153);
+  rotationsFromVectors(poseVectors, poseVectors.subarray(UP_AT), N_JOINTS, t.rotations, NOW * ROTATIONS_SIZE);
   hipScratch[0] = output[pose];
   hipScratch[1] = output[pose + 1];
   hipScratch[2] = output[pose + 2];
   fromRootSpacePoints(hipScratch, 0, 1, rootX, rootZ, heading, hipWorld, 0);
-  forwardKinematicsReduced(d.offsets, hipWorld, 0, t.rotations, NOW * 153, t.positions, NOW * 51);
+  forwardKinematicsReduced(d.offsets, hipWorld, 0, t.rotations, NOW * ROTATIONS_SIZE, t.positions, NOW * POSITIONS_SIZE);
   // The predicted hip height can sag a few cm below what the legs need; lifting the whole body
   // keeps the ankles on or above the floor without bending a bone.
-  const p = NOW * 51;
+  const p = NOW * POSITIONS_SIZE;
   const lift = MIN_ANKLE_HEIGHT - Math.min(t.positions[p + 3 * FEET[0] + 1], t.positions[p + 3 * FEET[1] + 1]);
   if (lift > 0) for (let j = 0; j < N_JOINTS; j++) t.positions[p + 3 * j + 1] += lift;
   // The predicted future root path becomes the plan (the leader's is bent by steering later).
@@ -291,8 +293,8 @@ export function shiftDancer(d: Dancer, sx: number, sz: number): void {
     t.root[2 * (NOW + off) + 1] += sz;
   }
   for (let j = 0; j < N_JOINTS; j++) {
-    t.positions[NOW * 51 + 3 * j] += sx;
-    t.positions[NOW * 51 + 3 * j + 2] += sz;
+    t.positions[NOW * POSITIONS_SIZE + 3 * j] += sx;
+    t.positions[NOW * POSITIONS_SIZE + 3 * j + 2] += sz;
   }
 }
 

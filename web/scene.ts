@@ -4,6 +4,7 @@
 
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+import { HEAD } from './skeleton';
 
 export const COLORS = {
   leader: 0x2f6fe4,
@@ -17,7 +18,6 @@ const FLOOR_SIZE = 200; // metres; one grid cell per metre
 const JOINT_RADIUS = 0.055;
 const HEAD_RADIUS = 0.11;
 const BONE_RADIUS = 0.045;
-const HEAD = 4;
 const TARGET_HEIGHT = 0.9;
 
 /** Several dancers of one look, drawn with two instanced meshes (joint spheres + bone cylinders):

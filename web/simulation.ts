@@ -3,8 +3,8 @@
 // (foot-locked poses, planned paths, intentions). Also here: sampled ghosts and leader playback
 // from a recording. Nothing in this file changes a number the models see.
 
-import { FUTURE_OFFSETS, INPUT_SIZE, INTENTION_SIZE, KEYS, N_JOINTS, OUTPUT_SIZE, followerInput } from './features';
-import { KEY_JOINTS, type Motion } from './skeleton';
+import { FUTURE_OFFSETS, INPUT_SIZE, INTENTION_SIZE, KEYS, OUTPUT_SIZE, followerInput } from './features';
+import { KEY_JOINTS, type Motion, POSITIONS_SIZE } from './skeleton';
 import { FootLock } from './footik';
 import { LeaderPlayback } from './playback';
 import { StepTimer } from './timing';
@@ -17,7 +17,7 @@ import type { DancerView, Simulation, SimulationOptions, StepPolicy, Steer } fro
 class View implements DancerView {
   root: [number, number] = [0, 0];
   heading = 0;
-  readonly positions = new Float32Array(N_JOINTS * 3);
+  readonly positions = new Float32Array(POSITIONS_SIZE);
   readonly future = new Float32Array(KEYS * 2);
   intention?: Float32Array;
   readonly feet = new FootLock();
@@ -32,7 +32,7 @@ class View implements DancerView {
     this.root[1] = d.rootZ;
     this.heading = d.heading;
     const t = d.track;
-    for (let i = 0; i < 51; i++) this.positions[i] = t.positions[NOW * 51 + i];
+    for (let i = 0; i < POSITIONS_SIZE; i++) this.positions[i] = t.positions[NOW * POSITIONS_SIZE + i];
     for (let k = 0; k < KEYS; k++) {
       this.future[2 * k] = t.root[2 * (NOW + FUTURE_OFFSETS[k])];
       this.future[2 * k + 1] = t.root[2 * (NOW + FUTURE_OFFSETS[k]) + 1];
@@ -128,12 +128,12 @@ export class DuetSimulation implements Simulation {
     followerInput(this.duet.leader.track, follower.track, NOW, input, 0);
     for (let i = 1; i < k; i++) input.copyWithin(i * INPUT_SIZE, 0, INPUT_SIZE);
     const { output } = await policy.runBatch(k, this.temperature);
-    while (this.ghostPoses.length < k) this.ghostPoses.push(new Float32Array(N_JOINTS * 3));
+    while (this.ghostPoses.length < k) this.ghostPoses.push(new Float32Array(POSITIONS_SIZE));
     for (let i = 0; i < k; i++) {
       this.ghost.copyFrom(follower);
       if (!outputIsAbsurd(this.ghost, output, i * OUTPUT_SIZE)) applyOutput(this.ghost, output, i * OUTPUT_SIZE);
       const p = this.ghost.track.positions;
-      for (let n = 0; n < 51; n++) this.ghostPoses[i][n] = p[NOW * 51 + n];
+      for (let n = 0; n < POSITIONS_SIZE; n++) this.ghostPoses[i][n] = p[NOW * POSITIONS_SIZE + n];
     }
     return this.ghostPoses.slice(0, k);
   }
@@ -184,7 +184,7 @@ export class DuetSimulation implements Simulation {
       if (view.intention && !f.intention) {
         for (let k = 0; k < KEYS; k++) {
           KEY_JOINTS.forEach((j, n) => {
-            for (let a = 0; a < 3; a++) view.intention![(k * KEY_JOINTS.length + n) * 3 + a] = leader.track.positions[NOW * 51 + 3 * j + a];
+            for (let a = 0; a < 3; a++) view.intention![(k * KEY_JOINTS.length + n) * 3 + a] = leader.track.positions[NOW * POSITIONS_SIZE + 3 * j + a];
           });
         }
       }
