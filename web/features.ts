@@ -318,39 +318,51 @@ function poseAt(track: Track, t: number, rootX: number, rootZ: number, heading: 
   poseBlock(gatherPositions, gatherPrevious, gatherRotations, rootX, rootZ, heading, out, at);
 }
 
-// Where each block starts (Python concatenates; here every block writes at its offset).
-const FOLLOWER_BLOCKS = blockSlices(FOLLOWER_INPUT_LAYOUT);
-const LEADER_BLOCKS = blockSlices(LEADER_INPUT_LAYOUT);
+/** Writes one input block at out[at..]: read from `partner` or `me` at frame t, in the root space (x, z, h). */
+type InputBlock = (partner: Track, me: Track, t: number, x: number, z: number, h: number, out: Out, at: number) => void;
+
+// What each input block name means; the layout tables above give the order and the sizes.
+const INPUT_BLOCKS: Record<string, InputBlock> = {
+  partner_trajectory_past: (partner, _me, t, x, z, h, out, at) => trajectoryAt(partner, t, PAST_OFFSETS, x, z, h, out, at),
+  partner_trajectory_future: (partner, _me, t, x, z, h, out, at) => trajectoryAt(partner, t, FUTURE_OFFSETS, x, z, h, out, at),
+  partner_key_joints_past: (partner, _me, t, x, z, h, out, at) => keyJointsAt(partner, t, PAST_OFFSETS, x, z, h, out, at),
+  partner_pose: (partner, _me, t, x, z, h, out, at) => poseAt(partner, t, x, z, h, out, at),
+  self_trajectory_past: (_partner, me, t, x, z, h, out, at) => trajectoryAt(me, t, PAST_OFFSETS, x, z, h, out, at),
+  self_key_joints_past: (_partner, me, t, x, z, h, out, at) => keyJointsAt(me, t, PAST_OFFSETS, x, z, h, out, at),
+  self_pose: (_partner, me, t, x, z, h, out, at) => poseAt(me, t, x, z, h, out, at),
+  // The leader's control is its own planned (steered) future trajectory.
+  control: (_partner, me, t, x, z, h, out, at) => trajectoryAt(me, t, FUTURE_OFFSETS, x, z, h, out, at),
+};
+
+/** A layout table as (writer, start) pairs in its order (Python concatenates; here every block writes at its offset). */
+function inputPlan(layout: Layout): { write: InputBlock; start: number }[] {
+  const slices = blockSlices(layout);
+  return layout.map(([name]) => {
+    const write = INPUT_BLOCKS[name];
+    if (!write) throw new Error(`no features for input block "${name}"`);
+    return { write, start: slices[name].start };
+  });
+}
+
+const FOLLOWER_PLAN = inputPlan(FOLLOWER_INPUT_LAYOUT);
+const LEADER_PLAN = inputPlan(LEADER_INPUT_LAYOUT);
 const OUTPUT_BLOCKS = blockSlices(OUTPUT_LAYOUT);
 
-/** Input I [660] for the follower at frame t (partner = leader, whose future is steered). */
-export function followerInput(partner: Track, me: Track, t: number, out: Out, at = 0): void {
+function writeInput(plan: { write: InputBlock; start: number }[], partner: Track, me: Track, t: number, out: Out, at: number): void {
   const x = me.root[2 * t];
   const z = me.root[2 * t + 1];
   const h = me.heading[t];
-  const b = FOLLOWER_BLOCKS;
-  trajectoryAt(partner, t, PAST_OFFSETS, x, z, h, out, at + b.partner_trajectory_past.start);
-  trajectoryAt(partner, t, FUTURE_OFFSETS, x, z, h, out, at + b.partner_trajectory_future.start);
-  keyJointsAt(partner, t, PAST_OFFSETS, x, z, h, out, at + b.partner_key_joints_past.start);
-  poseAt(partner, t, x, z, h, out, at + b.partner_pose.start);
-  trajectoryAt(me, t, PAST_OFFSETS, x, z, h, out, at + b.self_trajectory_past.start);
-  keyJointsAt(me, t, PAST_OFFSETS, x, z, h, out, at + b.self_key_joints_past.start);
-  poseAt(me, t, x, z, h, out, at + b.self_pose.start);
+  for (const block of plan) block.write(partner, me, t, x, z, h, out, at + block.start);
+}
+
+/** Input I [660] for the follower at frame t (partner = leader, whose future is steered). */
+export function followerInput(partner: Track, me: Track, t: number, out: Out, at = 0): void {
+  writeInput(FOLLOWER_PLAN, partner, me, t, out, at);
 }
 
 /** Input I [660] for the leader (partner = follower, control = own future trajectory). */
 export function leaderInput(partner: Track, me: Track, t: number, out: Out, at = 0): void {
-  const x = me.root[2 * t];
-  const z = me.root[2 * t + 1];
-  const h = me.heading[t];
-  const b = LEADER_BLOCKS;
-  trajectoryAt(partner, t, PAST_OFFSETS, x, z, h, out, at + b.partner_trajectory_past.start);
-  keyJointsAt(partner, t, PAST_OFFSETS, x, z, h, out, at + b.partner_key_joints_past.start);
-  poseAt(partner, t, x, z, h, out, at + b.partner_pose.start);
-  trajectoryAt(me, t, PAST_OFFSETS, x, z, h, out, at + b.self_trajectory_past.start);
-  keyJointsAt(me, t, PAST_OFFSETS, x, z, h, out, at + b.self_key_joints_past.start);
-  poseAt(me, t, x, z, h, out, at + b.self_pose.start);
-  trajectoryAt(me, t, FUTURE_OFFSETS, x, z, h, out, at + b.control.start);
+  writeInput(LEADER_PLAN, partner, me, t, out, at);
 }
 
 /** Output O [323]: the self at t+1, in the root space of t+1 (root update in t's). */

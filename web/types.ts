@@ -107,7 +107,15 @@ export interface Manifest {
     offsets: { leader: number[][]; follower: number[][] };
   };
   keyJoints: number[];
-  layout: { input: number; output: number; intention: number };
+  layout: {
+    input: number;
+    output: number;
+    intention: number;
+    /** (block name, size) in order, as training/features.py lays them out (web/features.ts too). */
+    followerInput: [string, number][];
+    leaderInput: [string, number][];
+    outputBlocks: [string, number][];
+  };
   /** Opaque to the shell; read by rollout.ts (startDuet). */
   startPose: unknown;
   models: Record<string, ModelEntry>;
