@@ -1,5 +1,5 @@
-// Feature vectors of the paper, in the root space of the character being predicted ("self").
-// TypeScript mirror of training/features.py: same names in camelCase, same order of numbers;
+// Mirror of training/features.py: feature vectors of the paper, in the root space of the
+// character being predicted ("self"). Same names in camelCase, same order of numbers;
 // tests/web/features.test.ts pins both to the fixtures that training/fixtures.py writes.
 // Layout and conventions: docs/features.md.
 //
@@ -268,11 +268,6 @@ export class Track {
     this.root.copyWithin(0, 2, 2 * (now + 1));
     this.heading.copyWithin(0, 1, now + 1);
   }
-}
-
-/** Frames t with a full second of past and a full second of future after t+1: [first, end). */
-export function validFrames(frames: number): { first: number; end: number } {
-  return { first: HISTORY, end: Math.max(HISTORY, frames - HISTORY - 1) };
 }
 
 const gatherRoots = new Float64Array(KEYS * 2);

@@ -160,7 +160,7 @@ export function startDancer(offsets: ArrayLike<number>, startPose: StartPose, ro
 }
 
 /** Output O (raw, 323, read at output[at..]) a dancer must not take: non-finite, a joint too far, a jump. */
-export function outputIsAbsurd(_d: Dancer, output: ArrayLike<number>, at = 0): boolean {
+export function outputIsAbsurd(output: ArrayLike<number>, at = 0): boolean {
   for (let i = 0; i < OUTPUT_SIZE; i++) if (!Number.isFinite(output[at + i])) return true;
   let farthest = 0;
   for (let j = 0; j < N_JOINTS; j++) {
@@ -401,7 +401,7 @@ export function finishStep(
   followerIntentions: (ArrayLike<number> | null)[] = [],
 ): void {
   if (leaderOutput) {
-    if (outputIsAbsurd(duet.leader, leaderOutput)) {
+    if (outputIsAbsurd(leaderOutput)) {
       resetBeside(duet.leader, duet.followers[0], duet.startPose.leader);
       setAnchor(duet);
     } else {
@@ -412,7 +412,7 @@ export function finishStep(
     setAnchor(duet); // a recording leads: the anchor waits where the model will take over
   }
   duet.followers.forEach((f, i) => {
-    if (outputIsAbsurd(f, followerOutputs[i])) resetBeside(f, duet.leader, duet.startPose.follower);
+    if (outputIsAbsurd(followerOutputs[i])) resetBeside(f, duet.leader, duet.startPose.follower);
     else applyOutput(f, followerOutputs[i]);
     if (keepClose(f, duet.leader)) f.leashed += 1;
     const intention = followerIntentions[i];

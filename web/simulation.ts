@@ -131,7 +131,7 @@ export class DuetSimulation implements Simulation {
     while (this.ghostPoses.length < k) this.ghostPoses.push(new Float32Array(POSITIONS_SIZE));
     for (let i = 0; i < k; i++) {
       this.ghost.copyFrom(follower);
-      if (!outputIsAbsurd(this.ghost, output, i * OUTPUT_SIZE)) applyOutput(this.ghost, output, i * OUTPUT_SIZE);
+      if (!outputIsAbsurd(output, i * OUTPUT_SIZE)) applyOutput(this.ghost, output, i * OUTPUT_SIZE);
       const p = this.ghost.track.positions;
       for (let n = 0; n < POSITIONS_SIZE; n++) this.ghostPoses[i][n] = p[NOW * POSITIONS_SIZE + n];
     }

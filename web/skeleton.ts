@@ -1,5 +1,5 @@
-// The 17-joint duet skeleton: reduction from BVH, metres, resampling, root, mirroring.
-// TypeScript mirror of training/skeleton.py (same names in camelCase, same numbers).
+// Mirror of training/skeleton.py (same names in camelCase, same numbers): the 17-joint duet
+// skeleton, reduction from BVH, metres, resampling, root, mirroring.
 //
 // A `Motion` holds one dancer as world-space joint positions and rotations per frame, flat and
 // frame-major: positions [F × 17 × 3], rotations [F × 17 × 9] (row-major 3x3).

@@ -126,7 +126,7 @@ export interface Manifest {
 /** Follower model choices in the panel and the URL. */
 export type FollowerChoice = 'ours' | 'ccm' | 'compare';
 
-/** The test hook on window.duet (DESIGN.md, "Contracts"). Tests read only this. */
+/** The test hook on window.duet: the end-to-end tests (tests/e2e) read only this. */
 export interface DuetHook {
   ready: boolean;
   error: string | null;
