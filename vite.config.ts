@@ -25,7 +25,5 @@ export default defineConfig({
   build: { target: 'es2022' },
   test: {
     include: ['tests/web/**/*.test.ts'],
-    // The web unit tests are written alongside the features mirror; until then an empty run is fine.
-    passWithNoTests: true,
   },
 });

@@ -310,11 +310,11 @@ def rollout(take: EvalTake, follower_policy, temperature: float, seed: int, star
             xl = leader_input(follower.track, leader.track, now)[0]
             ol = np.asarray(leader_policy(xl, temperature, rng)["output"][0], np.float64)
             # Leader first, as rollout.finish_step does.
-            if output_is_absurd(leader, ol):
+            if output_is_absurd(ol):
                 reset_beside(leader, follower, start_pose["leader"])
             else:
                 apply_output(leader, ol)
-        if output_is_absurd(follower, of):
+        if output_is_absurd(of):
             reset_beside(follower, leader, start_pose["follower"])
         else:
             apply_output(follower, of)

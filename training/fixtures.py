@@ -460,7 +460,7 @@ def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_o
             if bad:
                 k, v = spoil[bad]
                 out[k] = v
-        absurd = [ro.output_is_absurd(duet.leader, lead_out), ro.output_is_absurd(duet.follower, follow_out)]
+        absurd = [ro.output_is_absurd(lead_out), ro.output_is_absurd(follow_out)]
         ro.finish_step(duet, lead_out, follow_out, fi)
         steps.append({
             "stick": stick, "steeringBefore": exact(before_velocity),

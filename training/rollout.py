@@ -88,7 +88,7 @@ def rotation_y(heading: float) -> np.ndarray:
     return np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]])
 
 
-def output_is_absurd(d: Dancer, output: np.ndarray) -> bool:
+def output_is_absurd(output: np.ndarray) -> bool:
     if not np.all(np.isfinite(output)):
         return True
     pose = output[OUT["pose"]].reshape(feat.N_JOINTS, 12)
@@ -247,7 +247,7 @@ def finish_step(duet: Duet, leader_output: np.ndarray, follower_output: np.ndarr
                 follower_intention: np.ndarray | None = None) -> None:
     for d, partner, out, role in ((duet.leader, duet.follower, leader_output, "leader"),
                                   (duet.follower, duet.leader, follower_output, "follower")):
-        if output_is_absurd(d, out):
+        if output_is_absurd(out):
             reset_beside(d, partner, duet.start_pose[role])
             if d is duet.leader:
                 duet.steering.anchor = duet.leader.root.copy()

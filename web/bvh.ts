@@ -1,4 +1,4 @@
-// BVH reading and forward kinematics: the TypeScript mirror of training/bvh.py.
+// Mirror of training/bvh.py: BVH reading and forward kinematics (same names in camelCase).
 //
 // A BVH file is a joint hierarchy (offsets + channel orders) followed by one line of channel
 // values per frame. Every joint is kept, End Sites included, because a dropped joint's offset

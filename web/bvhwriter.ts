@@ -16,7 +16,7 @@
 // rotation; local = parent_worldᵀ · world, then ZXY Euler angles in degrees (robust at gimbal
 // lock, unwrapped against the previous frame so animation curves do not jump by 360°).
 
-import { FPS, JOINT_NAMES, N_JOINTS, PARENTS, SCALE } from './skeleton';
+import { FPS, JOINT_NAMES, N_JOINTS, PARENTS, ROTATIONS_SIZE, SCALE } from './skeleton';
 
 /** BVH units per metre (see the header comment). */
 export const BVH_UNITS_PER_METRE = 1 / SCALE;
@@ -216,7 +216,7 @@ export function writeBvhFromWorld(take: {
   const stride = take.hipStride ?? 3;
   const channels = new Float64Array(frames * CHANNELS_PER_FRAME);
   for (let f = 0; f < frames; f++) {
-    frameChannels(take.hips, f * stride, take.rotations, f * 153, channels, f * CHANNELS_PER_FRAME,
+    frameChannels(take.hips, f * stride, take.rotations, f * ROTATIONS_SIZE, channels, f * CHANNELS_PER_FRAME,
       f > 0 ? channels : null, (f - 1) * CHANNELS_PER_FRAME);
   }
   return writeBvh({ offsets: take.offsets, frames, channels, fps: take.fps });

@@ -4,53 +4,17 @@
 // or broken one, another skeleton, a frame rate that is not a multiple of 30 -- becomes a toast:
 // a short visible message that goes away by itself. The page keeps running; window.duet.error is
 // for fatal errors only and stays untouched.
-//
-// Toasts are text only (textContent), so a file name or a message never becomes markup.
 
 import { BvhError } from './bvh';
 import { DuetError } from './errors';
-import { JOINT_NAMES, type Motion, motionFromBvhText } from './skeleton';
+import { FPS, JOINT_NAMES, type Motion, motionFromBvhText } from './skeleton';
+import { type ToastKind, showToast } from './toast';
 
 /** Bigger files are refused before reading (a 10-minute 120 fps take is ~30 MB). */
 export const MAX_BVH_BYTES = 64 * 1024 * 1024;
 /** Plausible standing height of a dancer, metres (foot to head along the bones). */
 const HEIGHT_RANGE: [number, number] = [0.5, 4];
 const NAME_LENGTH = 60;
-
-// =================================================================================================
-// Toasts
-
-export type ToastKind = 'info' | 'error';
-
-let toasts: HTMLElement | null = null;
-
-/** A message at the bottom of the page for a few seconds (click to dismiss). */
-export function showToast(title: string, detail = '', kind: ToastKind = 'error', ms = kind === 'error' ? 9000 : 5000): HTMLElement {
-  if (!toasts) {
-    toasts = document.createElement('div');
-    toasts.className = 'toasts';
-    document.body.appendChild(toasts);
-  }
-  const toast = document.createElement('div');
-  toast.className = `toast toast-${kind}`;
-  toast.setAttribute('role', kind === 'error' ? 'alert' : 'status');
-  const heading = document.createElement('strong');
-  heading.textContent = title;
-  toast.appendChild(heading);
-  if (detail) {
-    const body = document.createElement('p');
-    body.textContent = detail;
-    toast.appendChild(body);
-  }
-  const remove = () => toast.remove();
-  toast.addEventListener('click', remove);
-  setTimeout(remove, ms);
-  // At most four at a time: the oldest goes first.
-  while (toasts.children.length >= 4) toasts.firstElementChild?.remove();
-  toasts.appendChild(toast);
-  if (kind === 'error') console.warn('[duet]', `${title}: ${detail}`);
-  return toast;
-}
 
 // =================================================================================================
 // Reading a leader file
@@ -129,15 +93,6 @@ export interface LeaderFileOptions {
   notify?: (title: string, detail: string, kind: ToastKind) => void;
 }
 
-/** The simulation side of leader playback (rollout.ts DuetSimulation). */
-export interface LeaderPlayable {
-  setLeaderPlayback(motion: Motion | null): void;
-}
-
-export function canPlayLeader(simulation: object): simulation is LeaderPlayable {
-  return typeof (simulation as Partial<LeaderPlayable>).setLeaderPlayback === 'function';
-}
-
 export class LeaderFileInput {
   readonly input: HTMLInputElement;
   private readonly hint: HTMLElement;
@@ -207,7 +162,7 @@ export class LeaderFileInput {
     try {
       const motion = await readLeaderFile(file);
       await this.options.onMotion(motion, displayName(file.name));
-      this.notify('The leader dances a file', `${displayName(file.name)}: ${(motion.frames / 30).toFixed(1)} s, looping. “leader back to model” ends it.`, 'info');
+      this.notify('The leader dances a file', `${displayName(file.name)}: ${(motion.frames / FPS).toFixed(1)} s, looping. “leader back to model” ends it.`, 'info');
     } catch (error) {
       if (error instanceof DuetError) this.notify(error.title, error.detail, 'error');
       else this.notify(`Cannot dance ${displayName(file.name)}`, error instanceof Error ? error.message : String(error), 'error');

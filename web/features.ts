@@ -1,5 +1,5 @@
-// Feature vectors of the paper, in the root space of the character being predicted ("self").
-// TypeScript mirror of training/features.py: same names in camelCase, same order of numbers;
+// Mirror of training/features.py: feature vectors of the paper, in the root space of the
+// character being predicted ("self"). Same names in camelCase, same order of numbers;
 // tests/web/features.test.ts pins both to the fixtures that training/fixtures.py writes.
 // Layout and conventions: docs/features.md.
 //
@@ -8,7 +8,7 @@
 // path allocates nothing. Module-level scratch arrays hold gathered inputs (JS is single-threaded
 // and none of these functions re-enters another while its scratch is live).
 
-import { FEET, FPS, KEY_JOINTS, type Motion, N_JOINTS, rootFromMotion } from './skeleton';
+import { FEET, FPS, KEY_JOINTS, type Motion, N_JOINTS, POSITIONS_SIZE, ROTATIONS_SIZE, rootFromMotion } from './skeleton';
 
 /** Any float array a feature can be written into (policy inputs are float32, tests use float64). */
 export type Out = Float32Array | Float64Array;
@@ -254,7 +254,7 @@ export class Track {
 
   /** F frames of zeros (the rollout fills them). */
   static empty(frames: number): Track {
-    return new Track(new Float64Array(frames * 51), new Float64Array(frames * 153), new Float64Array(frames * 2), new Float64Array(frames));
+    return new Track(new Float64Array(frames * POSITIONS_SIZE), new Float64Array(frames * ROTATIONS_SIZE), new Float64Array(frames * 2), new Float64Array(frames));
   }
 
   get frames(): number {
@@ -263,16 +263,11 @@ export class Track {
 
   /** Move frames 1..now one slot back (the rollout's step): frame `now` is then free for the new one. */
   shiftPast(now: number): void {
-    this.positions.copyWithin(0, 51, 51 * (now + 1));
-    this.rotations.copyWithin(0, 153, 153 * (now + 1));
+    this.positions.copyWithin(0, POSITIONS_SIZE, POSITIONS_SIZE * (now + 1));
+    this.rotations.copyWithin(0, ROTATIONS_SIZE, ROTATIONS_SIZE * (now + 1));
     this.root.copyWithin(0, 2, 2 * (now + 1));
     this.heading.copyWithin(0, 1, now + 1);
   }
-}
-
-/** Frames t with a full second of past and a full second of future after t+1: [first, end). */
-export function validFrames(frames: number): { first: number; end: number } {
-  return { first: HISTORY, end: Math.max(HISTORY, frames - HISTORY - 1) };
 }
 
 const gatherRoots = new Float64Array(KEYS * 2);
@@ -312,45 +307,57 @@ function keyJointsAt(track: Track, t: number, offsets: readonly number[], rootX:
 }
 
 function poseAt(track: Track, t: number, rootX: number, rootZ: number, heading: number, out: Out, at: number): void {
-  copyFrame(track.positions, 51, t, gatherPositions);
-  copyFrame(track.positions, 51, t - 1, gatherPrevious);
-  copyFrame(track.rotations, 153, t, gatherRotations);
+  copyFrame(track.positions, POSITIONS_SIZE, t, gatherPositions);
+  copyFrame(track.positions, POSITIONS_SIZE, t - 1, gatherPrevious);
+  copyFrame(track.rotations, ROTATIONS_SIZE, t, gatherRotations);
   poseBlock(gatherPositions, gatherPrevious, gatherRotations, rootX, rootZ, heading, out, at);
 }
 
-// Where each block starts (Python concatenates; here every block writes at its offset).
-const FOLLOWER_BLOCKS = blockSlices(FOLLOWER_INPUT_LAYOUT);
-const LEADER_BLOCKS = blockSlices(LEADER_INPUT_LAYOUT);
+/** Writes one input block at out[at..]: read from `partner` or `me` at frame t, in the root space (x, z, h). */
+type InputBlock = (partner: Track, me: Track, t: number, x: number, z: number, h: number, out: Out, at: number) => void;
+
+// What each input block name means; the layout tables above give the order and the sizes.
+const INPUT_BLOCKS: Record<string, InputBlock> = {
+  partner_trajectory_past: (partner, _me, t, x, z, h, out, at) => trajectoryAt(partner, t, PAST_OFFSETS, x, z, h, out, at),
+  partner_trajectory_future: (partner, _me, t, x, z, h, out, at) => trajectoryAt(partner, t, FUTURE_OFFSETS, x, z, h, out, at),
+  partner_key_joints_past: (partner, _me, t, x, z, h, out, at) => keyJointsAt(partner, t, PAST_OFFSETS, x, z, h, out, at),
+  partner_pose: (partner, _me, t, x, z, h, out, at) => poseAt(partner, t, x, z, h, out, at),
+  self_trajectory_past: (_partner, me, t, x, z, h, out, at) => trajectoryAt(me, t, PAST_OFFSETS, x, z, h, out, at),
+  self_key_joints_past: (_partner, me, t, x, z, h, out, at) => keyJointsAt(me, t, PAST_OFFSETS, x, z, h, out, at),
+  self_pose: (_partner, me, t, x, z, h, out, at) => poseAt(me, t, x, z, h, out, at),
+  // The leader's control is its own planned (steered) future trajectory.
+  control: (_partner, me, t, x, z, h, out, at) => trajectoryAt(me, t, FUTURE_OFFSETS, x, z, h, out, at),
+};
+
+/** A layout table as (writer, start) pairs in its order (Python concatenates; here every block writes at its offset). */
+function inputPlan(layout: Layout): { write: InputBlock; start: number }[] {
+  const slices = blockSlices(layout);
+  return layout.map(([name]) => {
+    const write = INPUT_BLOCKS[name];
+    if (!write) throw new Error(`no features for input block "${name}"`);
+    return { write, start: slices[name].start };
+  });
+}
+
+const FOLLOWER_PLAN = inputPlan(FOLLOWER_INPUT_LAYOUT);
+const LEADER_PLAN = inputPlan(LEADER_INPUT_LAYOUT);
 const OUTPUT_BLOCKS = blockSlices(OUTPUT_LAYOUT);
 
-/** Input I [660] for the follower at frame t (partner = leader, whose future is steered). */
-export function followerInput(partner: Track, me: Track, t: number, out: Out, at = 0): void {
+function writeInput(plan: { write: InputBlock; start: number }[], partner: Track, me: Track, t: number, out: Out, at: number): void {
   const x = me.root[2 * t];
   const z = me.root[2 * t + 1];
   const h = me.heading[t];
-  const b = FOLLOWER_BLOCKS;
-  trajectoryAt(partner, t, PAST_OFFSETS, x, z, h, out, at + b.partner_trajectory_past.start);
-  trajectoryAt(partner, t, FUTURE_OFFSETS, x, z, h, out, at + b.partner_trajectory_future.start);
-  keyJointsAt(partner, t, PAST_OFFSETS, x, z, h, out, at + b.partner_key_joints_past.start);
-  poseAt(partner, t, x, z, h, out, at + b.partner_pose.start);
-  trajectoryAt(me, t, PAST_OFFSETS, x, z, h, out, at + b.self_trajectory_past.start);
-  keyJointsAt(me, t, PAST_OFFSETS, x, z, h, out, at + b.self_key_joints_past.start);
-  poseAt(me, t, x, z, h, out, at + b.self_pose.start);
+  for (const block of plan) block.write(partner, me, t, x, z, h, out, at + block.start);
+}
+
+/** Input I [660] for the follower at frame t (partner = leader, whose future is steered). */
+export function followerInput(partner: Track, me: Track, t: number, out: Out, at = 0): void {
+  writeInput(FOLLOWER_PLAN, partner, me, t, out, at);
 }
 
 /** Input I [660] for the leader (partner = follower, control = own future trajectory). */
 export function leaderInput(partner: Track, me: Track, t: number, out: Out, at = 0): void {
-  const x = me.root[2 * t];
-  const z = me.root[2 * t + 1];
-  const h = me.heading[t];
-  const b = LEADER_BLOCKS;
-  trajectoryAt(partner, t, PAST_OFFSETS, x, z, h, out, at + b.partner_trajectory_past.start);
-  keyJointsAt(partner, t, PAST_OFFSETS, x, z, h, out, at + b.partner_key_joints_past.start);
-  poseAt(partner, t, x, z, h, out, at + b.partner_pose.start);
-  trajectoryAt(me, t, PAST_OFFSETS, x, z, h, out, at + b.self_trajectory_past.start);
-  keyJointsAt(me, t, PAST_OFFSETS, x, z, h, out, at + b.self_key_joints_past.start);
-  poseAt(me, t, x, z, h, out, at + b.self_pose.start);
-  trajectoryAt(me, t, FUTURE_OFFSETS, x, z, h, out, at + b.control.start);
+  writeInput(LEADER_PLAN, partner, me, t, out, at);
 }
 
 /** Output O [323]: the self at t+1, in the root space of t+1 (root update in t's). */
@@ -364,8 +371,8 @@ export function outputFeatures(me: Track, t: number, out: Out, at = 0): void {
   trajectoryAt(me, n, FUTURE_OFFSETS, x, z, h, out, at + b.trajectory_future.start);
   keyJointsAt(me, n, FUTURE_OFFSETS, x, z, h, out, at + b.key_joints_future.start);
   poseAt(me, n, x, z, h, out, at + b.pose.start);
-  copyFrame(me.positions, 51, n, gatherPositions);
-  copyFrame(me.positions, 51, t, gatherPrevious);
+  copyFrame(me.positions, POSITIONS_SIZE, n, gatherPositions);
+  copyFrame(me.positions, POSITIONS_SIZE, t, gatherPrevious);
   footContacts(gatherPositions, gatherPrevious, out, at + b.contacts.start);
 }
 

@@ -14,16 +14,16 @@ import { Stage } from './scene';
 import { Controls } from './controls';
 import { Hud } from './hud';
 import { Panel } from './panel';
-import { LIMITS, copyLink, defaultSettings, readSettings, writeSettings } from './share';
-// Record & leader file (record.ts, dropzone.ts).
-import type { Motion } from './skeleton';
-import { MAX_RECORD_FRAMES, type RecordableDuet, RecordPanel, Recorder, formatDuration } from './record';
-import { LeaderFileInput, canPlayLeader, showToast } from './dropzone';
+import { LIMITS, type Settings, copyLink, defaultSettings, readSettings, writeSettings } from './share';
+import { FPS, type Motion } from './skeleton';
+import { KEYS, N_KEY_JOINTS } from './features';
+import { DancerTrack } from './interpolation';
+import { MAX_RECORD_FRAMES, Recorder, formatDuration } from './record';
+import { RecordPanel } from './recordpanel';
+import { LeaderFileInput } from './dropzone';
+import { showToast } from './toast';
 
-/** The duet loop (features, both models, pose): loaded with the models, not with the page. */
-const loadSimulationModule = () => import('./rollout');
-
-const DT = 1 / 30;
+const DT = 1 / FPS;
 const NO_GUARDS = { resets: 0, leashed: 0 };
 /** A long stall counts as at most this much time, so the dance never jumps ahead. */
 const MAX_FRAME_SECONDS = 0.5;
@@ -33,11 +33,14 @@ const MAX_BACKLOG_SECONDS = 0.5;
  *  took to draw, so that slow drawing (software WebGL) cannot starve the simulation either. */
 const MIN_STEP_BUDGET_MS = 50;
 const MAX_GHOSTS = LIMITS.ghosts[1];
+const PAUSED_STATUS = 'paused — Space to resume';
 const FOLLOWER_MODELS: Record<FollowerChoice, string[]> = {
   ours: ['follower'],
   ccm: ['follower_ccm'],
   compare: ['follower', 'follower_ccm'],
 };
+/** Each model gets its own noise stream, all derived from the one seed in the URL. */
+const MODEL_NAMES = ['leader', 'follower', 'follower_ccm'];
 
 const hook: DuetHook = {
   ready: false,
@@ -55,83 +58,28 @@ const hook: DuetHook = {
 window.duet = hook;
 installGlobalErrorHandlers();
 
-/** Last two simulation states of one dancer, copied so drawing can interpolate between them. */
-class DancerTrack {
-  readonly previous = new Float32Array(51);
-  readonly current = new Float32Array(51);
-  readonly drawn = new Float32Array(51);
-  readonly root = new Float32Array(4); // previous x, z, current x, z
-  readonly future = new Float32Array(12);
-  readonly intention = new Float32Array(90);
-  hasIntention = false;
-  // Joint rotations (for the hands, feet and face) interpolate like the positions; contacts do not.
-  readonly previousRotations = new Float32Array(153);
-  readonly currentRotations = new Float32Array(153);
-  readonly drawnRotations = new Float32Array(153);
-  readonly contacts = new Float32Array(2);
-  hasRotations = false;
-
-  capture(view: DancerView, snap: boolean): void {
-    this.previous.set(snap ? view.positions : this.current);
-    this.current.set(view.positions);
-    this.root[0] = snap ? view.root[0] : this.root[2];
-    this.root[1] = snap ? view.root[1] : this.root[3];
-    this.root[2] = view.root[0];
-    this.root[3] = view.root[1];
-    this.future.set(view.future);
-    this.hasIntention = view.intention !== undefined;
-    if (view.intention) this.intention.set(view.intention);
-    this.hasRotations = view.rotations !== undefined;
-    if (view.rotations) {
-      this.previousRotations.set(snap ? view.rotations : this.currentRotations);
-      this.currentRotations.set(view.rotations);
-    }
-    if (view.contacts) this.contacts.set(view.contacts);
-    else this.contacts.fill(0);
-  }
-
-  /** Rotations between the last two steps, or null when the simulation gives none. */
-  interpolateRotations(alpha: number): Float32Array | null {
-    if (!this.hasRotations) return null;
-    const a = this.previousRotations, b = this.currentRotations, out = this.drawnRotations;
-    for (let i = 0; i < 153; i++) out[i] = a[i] + (b[i] - a[i]) * alpha;
-    return out;
-  }
-
-  interpolate(alpha: number): Float32Array {
-    for (let i = 0; i < 51; i++) this.drawn[i] = this.previous[i] + (this.current[i] - this.previous[i]) * alpha;
-    return this.drawn;
-  }
-
-  rootX(alpha: number): number {
-    return this.root[0] + (this.root[2] - this.root[0]) * alpha;
-  }
-
-  rootZ(alpha: number): number {
-    return this.root[1] + (this.root[3] - this.root[1]) * alpha;
-  }
-}
-
 function publish(target: DuetHook['leader'], view: DancerView): void {
   target.root[0] = view.root[0];
   target.root[1] = view.root[1];
   target.heading = view.heading;
 }
 
-async function start(): Promise<void> {
-  checkBrowserSupport();
-  // Start every download at once: onnxruntime and the simulation code now, the models as soon as
-  // the manifest names them; the floor is drawn meanwhile.
-  const runtime = Promise.all([import('./ort'), import('./policy'), loadSimulationModule()]);
+/**
+ * onnxruntime, the policies and the duet loop (features, both models, pose): loaded with the
+ * models, not with the page (ORT alone is 3.7 MB gzipped).
+ */
+function loadRuntime() {
+  const runtime = Promise.all([import('./ort'), import('./policy'), import('./simulation')]);
   runtime.catch(() => undefined); // reported where it is awaited
-  const manifest: Manifest = await loadManifest();
-  const defaults = defaultSettings(manifest.defaultTemperature);
-  const settings = readSettings(location.search, defaults);
-  const hasCcm = 'follower_ccm' in manifest.models;
-  if (!hasCcm) settings.model = 'ours';
+  return runtime;
+}
 
+type Runtime = Awaited<ReturnType<typeof loadRuntime>>;
+
+/** Each model file fetched once, from the first time it is asked for. */
+function modelDownloads(manifest: Manifest): (name: string) => Promise<Uint8Array> {
   const downloads = new Map<string, Promise<Uint8Array>>();
-  const download = (name: string) => {
+  return (name) => {
     if (!downloads.has(name)) {
       const bytes = fetchModelBytes(manifest, name);
       bytes.catch(() => undefined); // reported where it is awaited
@@ -139,266 +87,342 @@ async function start(): Promise<void> {
     }
     return downloads.get(name)!;
   };
-  for (const name of ['leader', ...FOLLOWER_MODELS[settings.model]]) download(name);
+}
 
-  // The floor is up while the models download: something to look at, never a blank canvas.
-  const app = document.getElementById('app')!;
-  const stage = new Stage(app, manifest.skeleton.parents, MAX_GHOSTS);
-  if (settings.camera) stage.setOrbit(settings.camera);
-  const hud = new Hud(document.getElementById('overlay')!);
-  hud.setStatus('loading models…');
-  const credit = document.getElementById('credit');
-  if (credit) credit.textContent = manifest.credit ?? '';
+/** The page once the manifest is in: floor, controls, panel, recording, and the animation loop. */
+class Page {
+  private readonly defaults: Settings;
+  private readonly settings: Settings;
+  private readonly hasCcm: boolean;
+  private readonly download: (name: string) => Promise<Uint8Array>;
+  private readonly stage: Stage;
+  private readonly hud: Hud;
+  private readonly controls: Controls;
+  private readonly recorder: Recorder;
+  private readonly leaderFileInput: LeaderFileInput;
+  private readonly recordPanel: RecordPanel;
 
-  let simulation: Simulation | null = null;
-  let paused = false;
-  let accumulator = 0;
-  let stepping = false;
-  let drawMs = 0; // smoothed wall time per animation frame not spent stepping
-  let steppedMs = 0; // wall time spent stepping since the last animation frame
-  let ghostPoses: Float32Array[] = [];
-  const leader = new DancerTrack();
-  const followers = [new DancerTrack(), new DancerTrack()];
+  private simulation: Simulation | null = null;
+  private paused = false;
+  private accumulator = 0;
+  private stepping = false;
+  private drawMs = 0; // smoothed wall time per animation frame not spent stepping
+  private steppedMs = 0; // wall time spent stepping since the last animation frame
+  private ghostPoses: Float32Array[] = [];
+  private readonly leader = new DancerTrack();
+  private readonly followers = [new DancerTrack(), new DancerTrack()];
+  /** Steps, resets and model switches must not overlap: they all go through this queue. */
+  private queue: Promise<void> = Promise.resolve();
+  private leaderFile: { motion: Motion; name: string } | null = null;
 
-  // Steps, resets and model switches must not overlap: they all go through this queue.
-  let queue: Promise<void> = Promise.resolve();
-  const exclusive = (task: () => Promise<void> | void): Promise<void> => {
-    const run = queue.then(task);
-    queue = run.catch(() => undefined);
+  // Set once the runtime has loaded.
+  private createSimulation: CreateSimulation | null = null;
+  private createPolicy: Runtime[1]['createPolicy'] | null = null;
+  private readonly policies = new Map<string, Promise<Policy>>();
+
+  // The display rate, for the HUD.
+  private frames = 0;
+  private fps = 0;
+  private fpsSince = 0;
+  private last = 0;
+  private lastIdleDraw = -Infinity;
+
+  constructor(private readonly manifest: Manifest) {
+    this.defaults = defaultSettings(manifest.defaultTemperature);
+    this.settings = readSettings(location.search, this.defaults);
+    this.hasCcm = 'follower_ccm' in manifest.models;
+    if (!this.hasCcm) this.settings.model = 'ours';
+    this.download = modelDownloads(manifest);
+    for (const name of ['leader', ...FOLLOWER_MODELS[this.settings.model]]) this.download(name);
+
+    // The floor is up while the models download: something to look at, never a blank canvas.
+    this.stage = new Stage(document.getElementById('app')!, manifest.skeleton.parents, MAX_GHOSTS);
+    if (this.settings.camera) this.stage.setOrbit(this.settings.camera);
+    this.hud = new Hud(document.getElementById('overlay')!);
+    this.hud.setStatus('loading models…');
+    const credit = document.getElementById('credit');
+    if (credit) credit.textContent = manifest.credit ?? '';
+
+    this.controls = new Controls({
+      surface: this.stage.canvas,
+      viewForward: (out) => this.stage.viewForward(out),
+      onPause: () => this.togglePause(),
+      onReset: () => this.reset(),
+    });
+    const panel = this.createPanel();
+    this.recorder = new Recorder(MAX_RECORD_FRAMES, () =>
+      showToast('Recording stopped', `It reached the ${formatDuration(MAX_RECORD_FRAMES / FPS)} limit. Download the take (“download BVH”).`, 'error', 15_000));
+    this.leaderFileInput = new LeaderFileInput({
+      notify: showToast,
+      onMotion: (motion, name) => this.playLeaderFile(motion, name),
+    });
+    this.recordPanel = new RecordPanel({
+      gui: panel.gui,
+      overlay: document.getElementById('overlay')!,
+      recorder: this.recorder,
+      duet: () => this.simulation?.duet ?? null,
+      between: (task) => this.exclusive(task),
+      notify: showToast,
+      onOpenLeaderFile: () => this.leaderFileInput.open(),
+      onLeaderModel: () => this.leaderBackToModel(),
+    });
+  }
+
+  private createPanel(): Panel {
+    return new Panel({
+      settings: this.settings,
+      models: this.hasCcm ? ['ours', 'ccm', 'compare'] : ['ours'],
+      onModel: (choice) => this.useModel(choice).catch(this.fail),
+      onGhosts: () => this.exclusive(() => this.refreshGhosts()).catch(this.fail),
+      onReset: () => this.reset(),
+      onShare: () => this.share(),
+    });
+  }
+
+  /** Run a task after every task queued before it. */
+  private exclusive(task: () => Promise<void> | void): Promise<void> {
+    const run = this.queue.then(task);
+    this.queue = run.catch(() => undefined);
     return run;
-  };
-  const fail = (error: unknown) => {
-    simulation = null; // stop stepping; the overlay explains
+  }
+
+  private readonly fail = (error: unknown): void => {
+    this.simulation = null; // stop stepping; the overlay explains
     showError(error);
   };
 
-  const capture = (snap: boolean) => {
+  private status(): string {
+    return this.paused ? PAUSED_STATUS : '';
+  }
+
+  /** Copy the simulation's views for drawing (snap: no interpolation from the last state). */
+  private capture(snap: boolean): void {
+    const simulation = this.simulation;
     if (!simulation) return;
-    leader.capture(simulation.leader, snap);
-    for (let i = 0; i < simulation.followers.length; i++) followers[i].capture(simulation.followers[i], snap);
+    this.leader.capture(simulation.leader, snap);
+    for (let i = 0; i < simulation.followers.length; i++) this.followers[i].capture(simulation.followers[i], snap);
     publish(hook.leader, simulation.leader);
     publish(hook.follower, simulation.followers[0]);
     const stats = simulation.stepMs();
     hook.stepMs.median = stats.median;
     hook.stepMs.p95 = stats.p95;
-  };
+  }
 
-  const reset = () =>
-    exclusive(() => {
-      if (!simulation) return;
-      simulation.reset();
-      accumulator = 0;
-      capture(true);
-      stage.follow(0.5 * (leader.root[2] + followers[0].root[2]), 0.5 * (leader.root[3] + followers[0].root[3]), 0, true);
+  /** Put the camera between the partners at once. */
+  private snapCamera(): void {
+    const { leader, followers } = this;
+    this.stage.follow(0.5 * (leader.root[2] + followers[0].root[2]), 0.5 * (leader.root[3] + followers[0].root[3]), 0, true);
+  }
+
+  private reset(): Promise<void> {
+    return this.exclusive(() => {
+      if (!this.simulation) return;
+      this.simulation.reset();
+      this.accumulator = 0;
+      this.capture(true);
+      this.snapCamera();
     });
+  }
 
-  const togglePause = () => {
-    paused = !paused;
-    hook.paused = paused;
-    hud.setStatus(paused ? 'paused — Space to resume' : '');
-  };
+  private togglePause(): void {
+    this.paused = !this.paused;
+    hook.paused = this.paused;
+    this.hud.setStatus(this.status());
+  }
 
-  const controls = new Controls({
-    surface: stage.canvas,
-    viewForward: (out) => stage.viewForward(out),
-    onPause: togglePause,
-    onReset: reset,
-  });
-
-  // Models load after the floor is drawn: ORT alone is 3.7 MB gzipped.
-  let createSimulation: CreateSimulation | null = null;
-  let createPolicy: ((manifest: Manifest, name: string, bytes: Uint8Array, seed: number) => Promise<Policy>) | null = null;
-
-  // Each model gets its own noise stream, all derived from the one seed in the URL.
-  const policies = new Map<string, Promise<Policy>>();
-  const modelNames = ['leader', 'follower', 'follower_ccm'];
-  const policy = (name: string): Promise<Policy> => {
-    let loading = policies.get(name);
+  /** One model's policy, created once. */
+  private policy(name: string): Promise<Policy> {
+    let loading = this.policies.get(name);
     if (!loading) {
-      const seed = (settings.seed + modelNames.indexOf(name) * 0x9e3779b9) >>> 0;
-      loading = download(name).then((bytes) => createPolicy!(manifest, name, bytes, seed)).then((p) => {
+      const seed = (this.settings.seed + MODEL_NAMES.indexOf(name) * 0x9e3779b9) >>> 0;
+      loading = this.download(name).then((bytes) => this.createPolicy!(this.manifest, name, bytes, seed)).then((p) => {
         hook.modelBytes += p.entry.bytes;
         return p;
       });
-      policies.set(name, loading);
+      this.policies.set(name, loading);
     }
     return loading;
-  };
+  }
 
   /** (Re)build the simulation for a follower choice; a new simulation starts from the start pose. */
-  const useModel = (choice: FollowerChoice) =>
-    exclusive(async () => {
-      hud.setStatus('loading models…');
-      const [leaderPolicy, ...followerPolicies] = await Promise.all([policy('leader'), ...FOLLOWER_MODELS[choice].map(policy)]);
-      simulation = createSimulation!({ manifest, leader: leaderPolicy, followers: followerPolicies, seed: settings.seed });
-      applyLeaderFile(); // record & leader file: a new simulation keeps the leader's file
+  private useModel(choice: FollowerChoice): Promise<void> {
+    return this.exclusive(async () => {
+      this.hud.setStatus('loading models…');
+      const [leaderPolicy, ...followerPolicies] = await Promise.all([this.policy('leader'), ...FOLLOWER_MODELS[choice].map((n) => this.policy(n))]);
+      this.simulation = this.createSimulation!({ manifest: this.manifest, leader: leaderPolicy, followers: followerPolicies, seed: this.settings.seed });
+      this.applyLeaderFile(); // a new simulation keeps the leader's file
       hook.model = choice;
-      accumulator = 0;
-      capture(true);
-      stage.follow(0.5 * (leader.root[2] + followers[0].root[2]), 0.5 * (leader.root[3] + followers[0].root[3]), 0, true);
-      hud.setStatus(paused ? 'paused — Space to resume' : '');
+      this.accumulator = 0;
+      this.capture(true);
+      this.snapCamera();
+      this.hud.setStatus(this.status());
     });
-
-  const refreshGhosts = async () => {
-    ghostPoses = simulation && settings.ghosts > 0 ? await simulation.ghosts(settings.ghosts) : [];
-  };
-
-  const panel = new Panel({
-    settings,
-    models: hasCcm ? ['ours', 'ccm', 'compare'] : ['ours'],
-    onModel: (choice) => useModel(choice).catch(fail),
-    onGhosts: () => exclusive(refreshGhosts).catch(fail),
-    onReset: reset,
-    onShare: async () => {
-      const query = writeSettings(settings, stage.getOrbit(), defaults.temperature);
-      const url = `${location.origin}${location.pathname}?${query}`;
-      history.replaceState(null, '', url);
-      if (await copyLink(url)) {
-        hud.setStatus('link copied');
-        setTimeout(() => hud.setStatus(paused ? 'paused — Space to resume' : ''), 2000);
-      } else {
-        window.prompt('Copy this link:', url);
-      }
-    },
-  });
-
-  // --- Record & leader file (record.ts, dropzone.ts) --------------------------------------------
-  const recordable = (): RecordableDuet | null =>
-    simulation && 'duet' in simulation ? (simulation as Simulation & { duet: RecordableDuet }).duet : null;
-  const recorder = new Recorder(MAX_RECORD_FRAMES, () =>
-    showToast('Recording stopped', `It reached the ${formatDuration(MAX_RECORD_FRAMES / 30)} limit. Download the take (“download BVH”).`, 'error', 15_000));
-  let leaderFile: { motion: Motion; name: string } | null = null;
-  function applyLeaderFile(): void {
-    if (simulation && canPlayLeader(simulation)) simulation.setLeaderPlayback(leaderFile?.motion ?? null);
   }
-  const leaderFileInput = new LeaderFileInput({
-    notify: showToast,
-    onMotion: (motion, name) =>
-      exclusive(() => {
-        if (!simulation || !canPlayLeader(simulation)) throw new Error('The dancers are still loading; try again in a moment.');
-        simulation.setLeaderPlayback(motion); // throws (nothing changed) on a motion it cannot play
-        leaderFile = { motion, name };
-        recordPanel.setLeaderFile(name);
-      }),
-  });
-  const recordPanel = new RecordPanel({
-    gui: panel.gui,
-    overlay: document.getElementById('overlay')!,
-    recorder,
-    duet: recordable,
-    between: (task) => exclusive(task),
-    notify: showToast,
-    onOpenLeaderFile: () => leaderFileInput.open(),
-    onLeaderModel: () =>
-      exclusive(() => {
-        leaderFile = null;
-        applyLeaderFile();
-        recordPanel.setLeaderFile(null);
-      }).catch(fail),
-  });
-  // --- end record & leader file ------------------------------------------------------------------
+
+  private async refreshGhosts(): Promise<void> {
+    const { simulation, settings } = this;
+    this.ghostPoses = simulation && settings.ghosts > 0 ? await simulation.ghosts(settings.ghosts) : [];
+  }
+
+  /** Write the settings into the URL and copy it. */
+  private async share(): Promise<void> {
+    const query = writeSettings(this.settings, this.stage.getOrbit(), this.defaults.temperature);
+    const url = `${location.origin}${location.pathname}?${query}`;
+    history.replaceState(null, '', url);
+    if (await copyLink(url)) {
+      this.hud.setStatus('link copied');
+      setTimeout(() => this.hud.setStatus(this.status()), 2000);
+    } else {
+      window.prompt('Copy this link:', url);
+    }
+  }
+
+  private applyLeaderFile(): void {
+    this.simulation?.setLeaderPlayback(this.leaderFile?.motion ?? null);
+  }
+
+  private playLeaderFile(motion: Motion, name: string): Promise<void> {
+    return this.exclusive(() => {
+      if (!this.simulation) throw new Error('The dancers are still loading; try again in a moment.');
+      this.simulation.setLeaderPlayback(motion); // throws (nothing changed) on a motion it cannot play
+      this.leaderFile = { motion, name };
+      this.recordPanel.setLeaderFile(name);
+    });
+  }
+
+  private leaderBackToModel(): void {
+    this.exclusive(() => {
+      this.leaderFile = null;
+      this.applyLeaderFile();
+      this.recordPanel.setLeaderFile(null);
+    }).catch(this.fail);
+  }
 
   /** Run the steps that real time asks for; called from the animation loop, one call at a time. */
-  const advance = async () => {
+  private async advance(): Promise<void> {
     const began = performance.now();
     let steps = 0;
-    while (simulation && accumulator >= DT) {
-      await simulation.step(controls.getSteer(), settings.temperature);
-      accumulator -= DT;
+    while (this.simulation && this.accumulator >= DT) {
+      await this.simulation.step(this.controls.getSteer(), this.settings.temperature);
+      this.accumulator -= DT;
       steps++;
-      capture(false);
-      if (recorder.recording && recordable()) recorder.capture(recordable()!); // record & leader file
+      this.capture(false);
+      const duet = this.simulation?.duet;
+      if (this.recorder.recording && duet) this.recorder.capture(duet);
       hook.frame++;
       if (hook.firstFrameMs === null) hook.firstFrameMs = performance.now();
       hook.ready = true;
       // Draw between steps when stepping is slow (software rendering, big models, high speed).
-      if (performance.now() - began > Math.max(MIN_STEP_BUDGET_MS, drawMs)) break;
+      if (performance.now() - began > Math.max(MIN_STEP_BUDGET_MS, this.drawMs)) break;
     }
-    if (steps > 0 && settings.ghosts > 0) await refreshGhosts();
-    if (steps > 0) recordPanel.update(); // record & leader file
-    steppedMs += performance.now() - began;
-  };
+    if (steps > 0 && this.settings.ghosts > 0) await this.refreshGhosts();
+    if (steps > 0) this.recordPanel.update();
+    this.steppedMs += performance.now() - began;
+  }
 
-  // Measure the display rate for the HUD.
-  let frames = 0;
-  let fps = 0;
-  let fpsSince = performance.now();
-  let last = performance.now();
-  let lastIdleDraw = -Infinity;
+  /** Start the animation loop. */
+  startLoop(): void {
+    this.fpsSince = performance.now();
+    this.last = performance.now();
+    requestAnimationFrame(this.frame);
+    // Browsers stop animation frames in hidden tabs: start timing afresh when the tab comes back.
+    document.addEventListener('visibilitychange', () => {
+      this.last = performance.now();
+    });
+  }
 
-  const frame = (now: number) => {
-    requestAnimationFrame(frame);
-    const elapsed = Math.min(Math.max(0, now - last) / 1000, MAX_FRAME_SECONDS);
-    drawMs += 0.2 * (Math.max(0, elapsed * 1000 - steppedMs) - drawMs);
-    steppedMs = 0;
-    last = now;
-    frames++;
-    if (now - fpsSince >= 500) {
-      fps = (frames * 1000) / (now - fpsSince);
-      frames = 0;
-      fpsSince = now;
-    }
+  private readonly frame = (now: number): void => {
+    requestAnimationFrame(this.frame);
+    const elapsed = Math.min(Math.max(0, now - this.last) / 1000, MAX_FRAME_SECONDS);
+    this.drawMs += 0.2 * (Math.max(0, elapsed * 1000 - this.steppedMs) - this.drawMs);
+    this.steppedMs = 0;
+    this.last = now;
+    this.countFrame(now);
 
     // A device that cannot keep up runs the dance in slow motion rather than piling up work.
-    if (simulation && !paused) accumulator = Math.min(accumulator + elapsed * settings.speed, MAX_BACKLOG_SECONDS * settings.speed);
-    if (simulation && !stepping && accumulator >= DT) {
-      stepping = true;
-      exclusive(advance)
-        .catch(fail)
-        .finally(() => (stepping = false));
+    const { settings } = this;
+    if (this.simulation && !this.paused) this.accumulator = Math.min(this.accumulator + elapsed * settings.speed, MAX_BACKLOG_SECONDS * settings.speed);
+    if (this.simulation && !this.stepping && this.accumulator >= DT) {
+      this.stepping = true;
+      this.exclusive(() => this.advance())
+        .catch(this.fail)
+        .finally(() => (this.stepping = false));
     }
 
     // While models load (or after an error) there is nothing moving: redraw rarely and leave the
     // CPU to downloading and compiling.
-    if (simulation || now - lastIdleDraw > 250) {
-      lastIdleDraw = now;
-      draw(Math.min(1, accumulator / DT), elapsed);
+    if (this.simulation || now - this.lastIdleDraw > 250) {
+      this.lastIdleDraw = now;
+      this.draw(Math.min(1, this.accumulator / DT), elapsed);
     }
-    const guards = simulation ? simulation.guards() : NO_GUARDS;
-    hud.update(now, { stepMs: hook.stepMs, fps, threads: hook.threads, modelBytes: hook.modelBytes, guards });
+    const guards = this.simulation ? this.simulation.guards() : NO_GUARDS;
+    this.hud.update(now, { stepMs: hook.stepMs, fps: this.fps, threads: hook.threads, modelBytes: hook.modelBytes, guards });
   };
 
-  const draw = (alpha: number, elapsed: number) => {
+  private countFrame(now: number): void {
+    this.frames++;
+    if (now - this.fpsSince >= 500) {
+      this.fps = (this.frames * 1000) / (now - this.fpsSince);
+      this.frames = 0;
+      this.fpsSince = now;
+    }
+  }
+
+  private draw(alpha: number, elapsed: number): void {
+    const { stage, simulation, leader, followers } = this;
     const count = simulation ? simulation.followers.length : 0;
     stage.leader.setCount(simulation ? 1 : 0);
     if (simulation) stage.leader.setPose(0, leader.interpolate(alpha), leader.interpolateRotations(alpha), leader.contacts);
+    // Hand glows: dancer 0 is the leader, 1 and 2 the followers (Stage.setHandContact).
+    for (let h = 0; h < 2; h++) {
+      stage.setHandContact(0, h, simulation ? leader.hands[h] : 0);
+      for (let i = 0; i < stage.followers.length; i++) stage.setHandContact(i + 1, h, i < count ? followers[i].hands[h] : 0);
+    }
     for (let i = 0; i < stage.followers.length; i++) {
       stage.followers[i].setCount(i < count ? 1 : 0);
       if (i < count) stage.followers[i].setPose(0, followers[i].interpolate(alpha), followers[i].interpolateRotations(alpha), followers[i].contacts);
     }
+    this.drawOverlays(alpha, count);
+    if (simulation) stage.follow(0.5 * (leader.rootX(alpha) + followers[0].rootX(alpha)), 0.5 * (leader.rootZ(alpha) + followers[0].rootZ(alpha)), elapsed);
+    stage.render();
+  }
 
-    // Overlays: the leader's and each follower's future root path; the followers' intentions.
+  /** The leader's and each follower's future root path; the followers' intentions; the ghosts. */
+  private drawOverlays(alpha: number, count: number): void {
+    const { stage, settings, leader, followers } = this;
     for (let i = 0; i < stage.trajectories.length; i++) {
       const overlay = stage.trajectories[i];
       const track = i === 0 ? leader : followers[i - 1];
-      overlay.group.visible = settings.trajectories && simulation !== null && i <= count;
+      overlay.group.visible = settings.trajectories && this.simulation !== null && i <= count;
       if (overlay.group.visible) overlay.setFloorPath(track.rootX(alpha), track.rootZ(alpha), track.future);
     }
     for (let i = 0; i < stage.intentions.length; i++) {
       const overlay = stage.intentions[i];
       overlay.group.visible = settings.intentions && i < count && followers[i].hasIntention;
-      if (overlay.group.visible) overlay.setKeyMajorPoints(followers[i].intention, 6, 5);
+      if (overlay.group.visible) overlay.setKeyMajorPoints(followers[i].intention, KEYS, N_KEY_JOINTS);
     }
-
-    const ghosts = settings.ghosts > 0 ? Math.min(ghostPoses.length, settings.ghosts) : 0;
+    const ghosts = settings.ghosts > 0 ? Math.min(this.ghostPoses.length, settings.ghosts) : 0;
     stage.ghosts.setCount(ghosts);
-    for (let i = 0; i < ghosts; i++) stage.ghosts.setPose(i, ghostPoses[i]);
+    for (let i = 0; i < ghosts; i++) stage.ghosts.setPose(i, this.ghostPoses[i]);
+  }
 
-    if (simulation) stage.follow(0.5 * (leader.rootX(alpha) + followers[0].rootX(alpha)), 0.5 * (leader.rootZ(alpha) + followers[0].rootZ(alpha)), elapsed);
-    stage.render();
-  };
+  /** The runtime is in: make the policies and the simulation, and start dancing. */
+  async attach([ortModule, policyModule, simulationModule]: Runtime): Promise<void> {
+    hook.threads = ortModule.configureThreads(this.settings.threads);
+    this.createPolicy = policyModule.createPolicy;
+    this.createSimulation = simulationModule.createSimulation;
+    await this.useModel(this.settings.model);
+  }
+}
 
-  requestAnimationFrame(frame);
-  // Browsers stop animation frames in hidden tabs: start timing afresh when the tab comes back.
-  document.addEventListener('visibilitychange', () => {
-    last = performance.now();
-  });
-
-  const [ortModule, policyModule, simulationModule] = await runtime;
-  hook.threads = ortModule.configureThreads(settings.threads);
-  createPolicy = policyModule.createPolicy;
-  createSimulation = simulationModule.createSimulation;
-  await useModel(settings.model);
+async function start(): Promise<void> {
+  checkBrowserSupport();
+  // Start every download at once: onnxruntime and the simulation code now, the models as soon as
+  // the manifest names them; the floor is drawn meanwhile.
+  const runtime = loadRuntime();
+  const page = new Page(await loadManifest());
+  page.startLoop();
+  await page.attach(await runtime);
 }
 
 start().catch(showError);

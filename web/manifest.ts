@@ -4,10 +4,15 @@
 
 import type { Manifest } from './types';
 import { DuetError } from './errors';
+import {
+  FOLLOWER_INPUT_LAYOUT, INPUT_SIZE, INTENTION_SIZE, LEADER_INPUT_LAYOUT, type Layout, N_JOINTS, OUTPUT_LAYOUT, OUTPUT_SIZE,
+} from './features';
 
 /** Sizes this page was written for; the manifest must agree. */
 export const MANIFEST_VERSION = 1;
-export const LAYOUT = { input: 660, output: 323, intention: 90 } as const;
+export const LAYOUT = { input: INPUT_SIZE, output: OUTPUT_SIZE, intention: INTENTION_SIZE } as const;
+/** The block lists the manifest must hold, in this page's layout tables. */
+export const BLOCK_LISTS = { followerInput: FOLLOWER_INPUT_LAYOUT, leaderInput: LEADER_INPUT_LAYOUT, outputBlocks: OUTPUT_LAYOUT } as const;
 
 /** Fetch and check public/models/manifest.json (relative, so a sub-path deployment works). */
 export async function loadManifest(url = 'models/manifest.json'): Promise<Manifest> {
@@ -41,8 +46,12 @@ export function validateManifest(manifest: Manifest): void {
   for (const key of ['input', 'output', 'intention'] as const) {
     if (layout[key] !== LAYOUT[key]) throw bad(`layout.${key} is ${layout[key]}, this page expects ${LAYOUT[key]}`);
   }
+  for (const key of Object.keys(BLOCK_LISTS) as (keyof typeof BLOCK_LISTS)[]) {
+    const difference = firstDifference(layout[key], BLOCK_LISTS[key]);
+    if (difference) throw bad(`layout.${key} ${difference}`);
+  }
   const joints = manifest.skeleton?.parents?.length;
-  if (joints !== 17) throw bad(`skeleton has ${joints} joints, expected 17`);
+  if (joints !== N_JOINTS) throw bad(`skeleton has ${joints} joints, expected ${N_JOINTS}`);
   for (const name of ['follower', 'leader']) {
     if (!manifest.models?.[name]) throw bad(`no "${name}" model listed`);
   }
@@ -52,6 +61,20 @@ export function validateManifest(manifest: Manifest): void {
   }
 }
 
+/** Where a manifest's block list first differs from this page's (null where they agree). */
+export function firstDifference(blocks: unknown, expected: Layout): string | null {
+  const show = ([name, size]: readonly [string, number]) => `"${name}" (${size})`;
+  if (!Array.isArray(blocks)) return `is missing; this page expects ${expected.map(show).join(', ')}`;
+  for (let i = 0; i < Math.max(blocks.length, expected.length); i++) {
+    const block: unknown = blocks[i];
+    const want = expected[i];
+    const valid = Array.isArray(block) && block.length === 2 && typeof block[0] === 'string' && typeof block[1] === 'number';
+    if (valid && want && block[0] === want[0] && block[1] === want[1]) continue;
+    const got = block === undefined ? 'missing' : valid ? show(block as [string, number]) : JSON.stringify(block);
+    return `block ${i + 1} is ${got}, this page expects ${want ? show(want) : 'no more blocks'}`;
+  }
+  return null;
+}
 
 /** Download one model's bytes and check them against the manifest. Independent of ORT, so the
  *  downloads run while onnxruntime itself is still loading. */

@@ -10,8 +10,6 @@
 
 export const ort = await import('onnxruntime-web/wasm');
 
-export type Ort = typeof ort;
-
 /**
  * Set the number of WASM threads. Must run before the first InferenceSession is created.
  * Threads need SharedArrayBuffer, which browsers only give to cross-origin-isolated pages

@@ -3,11 +3,10 @@
 // the follower reacts to a real dance. The recording is moved rigidly (turn about Y + shift) so
 // that its first frame starts where the leader stands; at the end it loops, re-anchored the same way.
 
-import { FUTURE_OFFSETS, HISTORY, Track, footContacts, wrapAngle } from './features';
-import { FPS, type Motion, N_JOINTS } from './skeleton';
+import { FUTURE_OFFSETS, Track, footContacts, wrapAngle } from './features';
+import { FPS, type Motion, N_JOINTS, POSITIONS_SIZE } from './skeleton';
+import { NOW } from './rollout';
 
-/** The current frame in a rollout track (rollout.ts's NOW). */
-const NOW = HISTORY;
 
 export class LeaderPlayback {
   /** The recording with its root and heading (world, as recorded). */
@@ -22,8 +21,8 @@ export class LeaderPlayback {
   private fromZ = 0;
   private toX = 0;
   private toZ = 0;
-  private readonly current = new Float64Array(51);
-  private readonly previous = new Float64Array(51);
+  private readonly current = new Float64Array(POSITIONS_SIZE);
+  private readonly previous = new Float64Array(POSITIONS_SIZE);
 
   constructor(motion: Motion) {
     if (Math.abs(motion.fps - FPS) > 1e-6) throw new RangeError(`a leader recording must be at ${FPS} fps, got ${motion.fps}`);
@@ -75,9 +74,9 @@ export class LeaderPlayback {
     this.writePlan(track);
     // A rigid move changes neither heights nor speeds: contacts straight from the recording.
     const p = this.recording.positions;
-    for (let i = 0; i < 51; i++) {
-      this.current[i] = p[this.frame * 51 + i];
-      this.previous[i] = p[(this.frame - 1) * 51 + i];
+    for (let i = 0; i < POSITIONS_SIZE; i++) {
+      this.current[i] = p[this.frame * POSITIONS_SIZE + i];
+      this.previous[i] = p[(this.frame - 1) * POSITIONS_SIZE + i];
     }
     footContacts(this.current, this.previous, contacts, 0);
   }

@@ -6,20 +6,13 @@
 // run(), and read `result`, so stepping at 30 Hz creates no garbage of ours.
 
 import { ort } from './ort';
-import type { Manifest, ModelEntry } from './types';
+import type { Manifest, ModelEntry, PolicyResult, StepPolicy } from './types';
 import { DuetError } from './errors';
 import { createUniform, fillUniform } from './random';
-import { LAYOUT } from './manifest';
+import { INPUT_SIZE, INTENTION_SIZE, OUTPUT_SIZE } from './features';
 
 type Session = Awaited<ReturnType<typeof ort.InferenceSession.create>>;
 type Tensor = InstanceType<typeof ort.Tensor>;
-
-export interface PolicyResult {
-  /** [B × 323] raw model output (root update, trajectory, key joints, pose, contacts). */
-  output: Float32Array;
-  /** [B × 90] predicted partner key joints, or null for models without an intention predictor. */
-  intention: Float32Array | null;
-}
 
 /** Buffers and tensors for one batch size, created on first use and kept. */
 interface Batch {
@@ -30,7 +23,7 @@ interface Batch {
   result: PolicyResult;
 }
 
-export class Policy {
+export class Policy implements StepPolicy {
   /** Write the [660] input features here before run(). */
   readonly input: Float32Array;
   /** Filled by run(); the same object and arrays every call. */
@@ -84,28 +77,24 @@ export class Policy {
     return batch.result;
   }
 
-  async release(): Promise<void> {
-    await this.session.release();
-  }
-
   private batch(k: number): Batch {
     let batch = this.batches.get(k);
     if (!batch) {
       const noiseSize = this.entry.channels * this.entry.classes;
-      const input = new Float32Array(k * LAYOUT.input);
+      const input = new Float32Array(k * INPUT_SIZE);
       const noise = new Float32Array(k * noiseSize);
       batch = {
         size: k,
         input,
         noise,
         feeds: {
-          input: new ort.Tensor('float32', input, [k, LAYOUT.input]),
+          input: new ort.Tensor('float32', input, [k, INPUT_SIZE]),
           temperature: this.temperatureTensor,
           noise: new ort.Tensor('float32', noise, [k, noiseSize]),
         },
         result: {
-          output: new Float32Array(k * LAYOUT.output),
-          intention: this.entry.intention ? new Float32Array(k * LAYOUT.intention) : null,
+          output: new Float32Array(k * OUTPUT_SIZE),
+          intention: this.entry.intention ? new Float32Array(k * INTENTION_SIZE) : null,
         },
       };
       this.batches.set(k, batch);
@@ -149,7 +138,7 @@ export async function createPolicy(manifest: Manifest, name: string, bytes: Uint
 /** The ONNX graph must have the inputs and outputs of the contract, with matching widths. */
 function checkSession(name: string, entry: ModelEntry, session: Session): void {
   const bad = (detail: string) => new DuetError('A model does not match this page', `${name}: ${detail}`);
-  const widths: Record<string, number> = { input: LAYOUT.input, noise: entry.channels * entry.classes };
+  const widths: Record<string, number> = { input: INPUT_SIZE, noise: entry.channels * entry.classes };
   for (const input of ['input', 'temperature', 'noise']) {
     if (!session.inputNames.includes(input)) throw bad(`no input named "${input}"`);
   }

@@ -8,18 +8,15 @@
 //
 // Stopping keeps the take; "download" saves what was recorded so far, also while recording (which
 // goes on). At MAX_RECORD_FRAMES the recording stops and says so; no frame is ever dropped silently.
+// The panel folder and the recording indicator are recordpanel.ts.
 
-import type GUI from 'lil-gui';
-import type { Controller } from 'lil-gui';
-import { HISTORY } from './features';
 import { CHANNELS_PER_FRAME, frameChannels, writeBvh } from './bvhwriter';
-import { FPS } from './skeleton';
+import { FPS, POSITIONS_SIZE, ROTATIONS_SIZE } from './skeleton';
+import { NOW } from './rollout';
 
 /** 10 minutes at 30 fps. */
 export const MAX_RECORD_FRAMES = 10 * 60 * FPS;
-/** The current frame of a rollout Track (rollout.ts NOW). */
-const NOW = HISTORY;
-const CHUNK_FRAMES = 900; // 30 s per chunk
+const CHUNK_FRAMES = 30 * FPS; // 30 s per chunk
 
 /** What the recorder reads of a rollout.ts Dancer. */
 export interface RecordableDancer {
@@ -28,7 +25,7 @@ export interface RecordableDancer {
   readonly track: { readonly positions: ArrayLike<number>; readonly rotations: ArrayLike<number> };
 }
 
-/** What the recorder reads of a rollout.ts Duet (DuetSimulation.duet). */
+/** What the recorder reads of a rollout.ts Duet (simulation.ts DuetSimulation.duet). */
 export interface RecordableDuet {
   readonly leader: RecordableDancer;
   readonly followers: readonly RecordableDancer[];
@@ -57,7 +54,7 @@ class DancerTake {
       prevAt = ((f - 1) % CHUNK_FRAMES) * CHANNELS_PER_FRAME;
     }
     const t = dancer.track;
-    frameChannels(t.positions, NOW * 51, t.rotations, NOW * 153, this.chunks[chunk], at, previous, prevAt);
+    frameChannels(t.positions, NOW * POSITIONS_SIZE, t.rotations, NOW * ROTATIONS_SIZE, this.chunks[chunk], at, previous, prevAt);
     this.frames++;
   }
 
@@ -150,135 +147,4 @@ export function timestamp(date = new Date()): string {
 export function formatDuration(seconds: number): string {
   const minutes = Math.floor(seconds / 60);
   return `${minutes}:${(seconds - 60 * minutes).toFixed(1).padStart(4, '0')}`;
-}
-
-/** Save text as a file through a temporary link (no server involved). */
-export function downloadText(name: string, text: string, type = 'text/plain'): void {
-  const url = URL.createObjectURL(new Blob([text], { type }));
-  const link = document.createElement('a');
-  link.href = url;
-  link.download = name;
-  link.style.display = 'none';
-  document.body.appendChild(link);
-  link.click();
-  link.remove();
-  // Revoking at once can cancel the download in some browsers.
-  setTimeout(() => URL.revokeObjectURL(url), 60_000);
-}
-
-// =================================================================================================
-// The panel folder and the recording indicator.
-
-export interface RecordPanelOptions {
-  gui: GUI;
-  /** Where the "● REC 0:12.3" line goes (the HUD overlay). */
-  overlay: HTMLElement;
-  recorder: Recorder;
-  /** The running duet, or null while models load. */
-  duet(): RecordableDuet | null;
-  /** Run a task between simulation steps (main.ts's exclusive queue). */
-  between(task: () => void): Promise<void>;
-  /** A short message for people (dropzone.ts showToast). */
-  notify(title: string, detail: string, kind: 'info' | 'error'): void;
-  onOpenLeaderFile(): void;
-  onLeaderModel(): void;
-}
-
-export class RecordPanel {
-  private readonly folder: GUI;
-  private readonly recordButton: Controller;
-  private readonly modelButton: Controller;
-  private readonly indicator: HTMLElement;
-  private leaderFile: string | null = null;
-  private lastText = '';
-  private lastLabel = '';
-
-  constructor(private readonly options: RecordPanelOptions) {
-    const { gui } = options;
-    this.folder = gui.addFolder('record · leader file');
-    const actions = {
-      record: () => this.toggle(),
-      download: () => this.download(),
-      open: () => options.onOpenLeaderFile(),
-      model: () => options.onLeaderModel(),
-    };
-    this.recordButton = this.folder.add(actions, 'record');
-    this.folder.add(actions, 'download').name('download BVH (leader + follower)');
-    this.folder.add(actions, 'open').name('leader from BVH file…');
-    this.modelButton = this.folder.add(actions, 'model').name('leader back to model').disable();
-    this.indicator = document.createElement('div');
-    this.indicator.className = 'record-status';
-    this.indicator.hidden = true;
-    options.overlay.appendChild(this.indicator);
-    this.update();
-  }
-
-  /** The leader dances a file (its name) or the model (null). */
-  setLeaderFile(name: string | null): void {
-    this.leaderFile = name;
-    this.modelButton.enable(name !== null);
-    this.update();
-  }
-
-  /** Refresh the button label and the indicator (cheap; call after steps). */
-  update(): void {
-    const { recorder } = this.options;
-    const label = recorder.recording ? '■ stop recording' : '● record';
-    if (label !== this.lastLabel) this.recordButton.name((this.lastLabel = label));
-    const lines: string[] = [];
-    if (recorder.recording) lines.push(`● REC ${formatDuration(recorder.seconds)}`);
-    else if (recorder.full) lines.push(`recording stopped at the ${formatDuration(recorder.seconds)} limit — download it`);
-    else if (recorder.frames > 0 && !recorder.saved) lines.push(`take ${formatDuration(recorder.seconds)} not downloaded yet`);
-    if (this.leaderFile) lines.push(`leader dances ${this.leaderFile}`);
-    const text = lines.join('\n');
-    if (text === this.lastText) return;
-    this.lastText = text;
-    this.indicator.textContent = text;
-    this.indicator.hidden = text === '';
-    this.indicator.classList.toggle('recording', recorder.recording);
-  }
-
-  toggle(): void {
-    const { recorder, notify } = this.options;
-    if (recorder.recording) {
-      recorder.stop();
-      notify('Recording stopped', `${formatDuration(recorder.seconds)} recorded — “download BVH” saves it.`, 'info');
-      this.update();
-      return;
-    }
-    const duet = this.options.duet();
-    if (!duet) {
-      notify('Not yet', 'The dancers are still loading; record once they move.', 'error');
-      return;
-    }
-    if (recorder.frames > 0 && !recorder.saved &&
-      !window.confirm(`Start a new take? The last one (${formatDuration(recorder.seconds)}) was not downloaded and will be lost.`)) {
-      return;
-    }
-    this.options.between(() => {
-      const current = this.options.duet();
-      if (current) recorder.start(current);
-      this.update();
-    }).catch((error) => notify('Could not record', String((error as Error)?.message ?? error), 'error'));
-  }
-
-  download(): void {
-    const { recorder, notify } = this.options;
-    let files: ReturnType<Recorder['export']>;
-    try {
-      files = recorder.export();
-    } catch (error) {
-      notify('Could not write the BVH files', String((error as Error)?.message ?? error), 'error');
-      return;
-    }
-    if (!files) {
-      notify('Nothing recorded yet', 'Press “● record”, dance a little, then download.', 'error');
-      return;
-    }
-    const stamp = timestamp();
-    downloadText(`duet-leader-${stamp}.bvh`, files.leader);
-    downloadText(`duet-follower-${stamp}.bvh`, files.follower);
-    notify('BVH saved', `${files.frames} frames (${formatDuration(files.frames / FPS)}) per dancer: duet-leader-${stamp}.bvh and duet-follower-${stamp}.bvh.`, 'info');
-    this.update();
-  }
 }

@@ -1,4 +1,4 @@
-// The duet at run time: TypeScript mirror of training/rollout.py, and the page's Simulation.
+// Mirror of training/rollout.py: the duet at run time.
 //
 // Each dancer is a `Track` of 61 frames: 30 past, the current frame at index NOW = 30, and 30 slots
 // of planned future of which only the key frames (NOW+5, ..., NOW+30) are filled. The features are
@@ -12,17 +12,13 @@
 // Differences from Python, none of which changes a number: a duet has a list of followers (two in
 // compare mode, each reacting to the same leader; the leader reacts to the first); outputs are
 // read at an offset so batched (ghost) results need no copies; scratch arrays are preallocated.
+// The page's Simulation (policies in, views out) is simulation.ts.
 
 import {
-  FUTURE_OFFSETS, HISTORY, INPUT_SIZE, INTENTION_SIZE, KEYS, N_JOINTS, OUTPUT_LAYOUT, OUTPUT_SIZE, type Out, Track,
+  FUTURE_OFFSETS, HISTORY, INTENTION_SIZE, KEYS, N_JOINTS, OUTPUT_LAYOUT, OUTPUT_SIZE, type Out, Track,
   blockSlices, followerInput, fromRootSpaceDirections, fromRootSpacePoints, leaderInput, wrapAngle,
 } from './features';
-import { FEET, FPS, KEY_JOINTS, type Motion, PARENTS, forwardKinematicsReduced } from './skeleton';
-import { FootLock } from './footik';
-import { LeaderPlayback } from './playback';
-import { StepTimer } from './timing';
-import type { Policy } from './policy';
-import type { CreateSimulation, DancerView, Simulation, SimulationOptions, Steer } from './types';
+import { FEET, FPS, KEY_JOINTS, PARENTS, POSITIONS_SIZE, ROTATIONS_SIZE, forwardKinematicsReduced } from './skeleton';
 
 export const NOW = HISTORY;
 export const TRACK_FRAMES = 2 * HISTORY + 1;
@@ -100,7 +96,7 @@ export class Dancer {
 
   /** The current joint positions [17 × 3] (a view into the track). */
   get positions(): Float64Array {
-    return this.track.positions.subarray(NOW * 51, NOW * 51 + 51);
+    return this.track.positions.subarray(NOW * POSITIONS_SIZE, NOW * POSITIONS_SIZE + POSITIONS_SIZE);
   }
 
   /** Make this dancer an exact copy of `other` (same offsets assumed): for trying outputs out. */
@@ -113,9 +109,11 @@ export class Dancer {
   }
 }
 
+/** Forward vectors [17 × 3], then up vectors from UP_AT on. */
 const poseVectors = new Float64Array(N_JOINTS * 3 * 2);
-const poseRotations = new Float64Array(N_JOINTS * 9);
-const turnedRotations = new Float64Array(N_JOINTS * 9);
+const UP_AT = N_JOINTS * 3;
+const poseRotations = new Float64Array(ROTATIONS_SIZE);
+const turnedRotations = new Float64Array(ROTATIONS_SIZE);
 const hipScratch = new Float64Array(3);
 const hipWorld = new Float64Array(3);
 
@@ -124,10 +122,10 @@ function standStill(d: Dancer, pose: StartPose, rootX: number, rootZ: number, he
   for (let j = 0; j < N_JOINTS; j++) {
     for (let k = 0; k < 3; k++) {
       poseVectors[3 * j + k] = pose.forward[j][k];
-      poseVectors[51 + 3 * j + k] = pose.up[j][k];
+      poseVectors[UP_AT + 3 * j + k] = pose.up[j][k];
     }
   }
-  rotationsFromVectors(poseVectors, poseVectors.subarray(51), N_JOINTS, poseRotations);
+  rotationsFromVectors(poseVectors, poseVectors.subarray(UP_AT), N_JOINTS, poseRotations);
   // R_y(heading) · R, column by column (rotation_y in Python).
   const c = Math.cos(heading);
   const s = Math.sin(heading);
@@ -145,9 +143,9 @@ function standStill(d: Dancer, pose: StartPose, rootX: number, rootZ: number, he
   fromRootSpacePoints(hipScratch, 0, 1, rootX, rootZ, heading, hipWorld, 0);
   const t = d.track;
   forwardKinematicsReduced(d.offsets, hipWorld, 0, turnedRotations, 0, t.positions, 0);
-  for (let f = 1; f < TRACK_FRAMES; f++) t.positions.copyWithin(f * 51, 0, 51);
+  for (let f = 1; f < TRACK_FRAMES; f++) t.positions.copyWithin(f * POSITIONS_SIZE, 0, POSITIONS_SIZE);
   for (let f = 0; f < TRACK_FRAMES; f++) {
-    t.rotations.set(turnedRotations, f * 153);
+    t.rotations.set(turnedRotations, f * ROTATIONS_SIZE);
     t.root[2 * f] = rootX;
     t.root[2 * f + 1] = rootZ;
     t.heading[f] = heading;
@@ -162,7 +160,7 @@ export function startDancer(offsets: ArrayLike<number>, startPose: StartPose, ro
 }
 
 /** Output O (raw, 323, read at output[at..]) a dancer must not take: non-finite, a joint too far, a jump. */
-export function outputIsAbsurd(_d: Dancer, output: ArrayLike<number>, at = 0): boolean {
+export function outputIsAbsurd(output: ArrayLike<number>, at = 0): boolean {
   for (let i = 0; i < OUTPUT_SIZE; i++) if (!Number.isFinite(output[at + i])) return true;
   let farthest = 0;
   for (let j = 0; j < N_JOINTS; j++) {
@@ -199,19 +197,19 @@ export function applyOutput(d: Dancer, output: ArrayLike<number>, at = 0): void 
   for (let j = 0; j < N_JOINTS; j++) {
     for (let k = 0; k < 3; k++) {
       poseVectors[3 * j + k] = output[pose + 12 * j + 6 + k];
-      poseVectors[51 + 3 * j + k] = output[pose + 12 * j + 9 + k];
+      poseVectors[UP_AT + 3 * j + k] = output[pose + 12 * j + 9 + k];
     }
   }
   fromRootSpaceDirections(poseVectors, 0, 2 * N_JOINTS, heading, poseVectors, 0); // forward and up, in place
-  rotationsFromVectors(poseVectors, poseVectors.subarray(51), N_JOINTS, t.rotations, NOW * 153);
+  rotationsFromVectors(poseVectors, poseVectors.subarray(UP_AT), N_JOINTS, t.rotations, NOW * ROTATIONS_SIZE);
   hipScratch[0] = output[pose];
   hipScratch[1] = output[pose + 1];
   hipScratch[2] = output[pose + 2];
   fromRootSpacePoints(hipScratch, 0, 1, rootX, rootZ, heading, hipWorld, 0);
-  forwardKinematicsReduced(d.offsets, hipWorld, 0, t.rotations, NOW * 153, t.positions, NOW * 51);
+  forwardKinematicsReduced(d.offsets, hipWorld, 0, t.rotations, NOW * ROTATIONS_SIZE, t.positions, NOW * POSITIONS_SIZE);
   // The predicted hip height can sag a few cm below what the legs need; lifting the whole body
   // keeps the ankles on or above the floor without bending a bone.
-  const p = NOW * 51;
+  const p = NOW * POSITIONS_SIZE;
   const lift = MIN_ANKLE_HEIGHT - Math.min(t.positions[p + 3 * FEET[0] + 1], t.positions[p + 3 * FEET[1] + 1]);
   if (lift > 0) for (let j = 0; j < N_JOINTS; j++) t.positions[p + 3 * j + 1] += lift;
   // The predicted future root path becomes the plan (the leader's is bent by steering later).
@@ -245,7 +243,6 @@ export function resetBeside(d: Dancer, partner: Dancer, startPose: StartPose): v
   d.resets += 1;
 }
 
-/** The user's stick (world x, z; length <= 1) turned into a smooth velocity for the plan. */
 /**
  * The user's stick (world x, z; length <= 1) turned into a smooth velocity, and the anchor that
  * velocity carries: the spot the leader dances around. It moves only while steered.
@@ -296,8 +293,8 @@ export function shiftDancer(d: Dancer, sx: number, sz: number): void {
     t.root[2 * (NOW + off) + 1] += sz;
   }
   for (let j = 0; j < N_JOINTS; j++) {
-    t.positions[NOW * 51 + 3 * j] += sx;
-    t.positions[NOW * 51 + 3 * j + 2] += sz;
+    t.positions[NOW * POSITIONS_SIZE + 3 * j] += sx;
+    t.positions[NOW * POSITIONS_SIZE + 3 * j + 2] += sz;
   }
 }
 
@@ -392,22 +389,22 @@ export function stepInputs(duet: Duet, leaderOut: Out | null, followerOuts: Out[
 
 const intentionLocal = new Float64Array(INTENTION_SIZE);
 
-/**
- * Move everyone one frame on. A null leader output means the leader was moved already (playback).
- * Each absurd output resets its dancer beside its partner instead.
- */
 /** Put the anchor under the leader (start, reset, recorded leader). */
 export function setAnchor(duet: Duet): void {
   duet.steering.anchor[0] = duet.leader.rootX;
   duet.steering.anchor[1] = duet.leader.rootZ;
 }
 
+/**
+ * Move everyone one frame on. A null leader output means the leader was moved already (playback).
+ * Each absurd output resets its dancer beside its partner instead.
+ */
 export function finishStep(
   duet: Duet, leaderOutput: ArrayLike<number> | null, followerOutputs: ArrayLike<number>[],
   followerIntentions: (ArrayLike<number> | null)[] = [],
 ): void {
   if (leaderOutput) {
-    if (outputIsAbsurd(duet.leader, leaderOutput)) {
+    if (outputIsAbsurd(leaderOutput)) {
       resetBeside(duet.leader, duet.followers[0], duet.startPose.leader);
       setAnchor(duet);
     } else {
@@ -418,7 +415,7 @@ export function finishStep(
     setAnchor(duet); // a recording leads: the anchor waits where the model will take over
   }
   duet.followers.forEach((f, i) => {
-    if (outputIsAbsurd(f, followerOutputs[i])) resetBeside(f, duet.leader, duet.startPose.follower);
+    if (outputIsAbsurd(followerOutputs[i])) resetBeside(f, duet.leader, duet.startPose.follower);
     else applyOutput(f, followerOutputs[i]);
     if (keepClose(f, duet.leader)) f.leashed += 1;
     const intention = followerIntentions[i];
@@ -430,196 +427,3 @@ export function finishStep(
   });
   duet.frame += 1;
 }
-
-// =================================================================================================
-// The page's Simulation: policies in, DancerViews out.
-
-/** Per dancer: what the page draws, kept up to date from the dancer after every step. */
-class View implements DancerView {
-  root: [number, number] = [0, 0];
-  heading = 0;
-  readonly positions = new Float32Array(N_JOINTS * 3);
-  readonly future = new Float32Array(KEYS * 2);
-  intention?: Float32Array;
-  readonly rotations = new Float32Array(N_JOINTS * 9);
-  readonly contacts = new Float32Array(2);
-  readonly feet = new FootLock();
-  private resets = -1;
-
-  constructor(withIntention: boolean) {
-    if (withIntention) this.intention = new Float32Array(INTENTION_SIZE);
-  }
-
-  update(d: Dancer, jumped = false): void {
-    this.root[0] = d.rootX;
-    this.root[1] = d.rootZ;
-    this.heading = d.heading;
-    const t = d.track;
-    for (let i = 0; i < 51; i++) this.positions[i] = t.positions[NOW * 51 + i];
-    for (let i = 0; i < 153; i++) this.rotations[i] = t.rotations[NOW * 153 + i];
-    this.contacts[0] = d.contacts[0];
-    this.contacts[1] = d.contacts[1];
-    for (let k = 0; k < KEYS; k++) {
-      this.future[2 * k] = t.root[2 * (NOW + FUTURE_OFFSETS[k])];
-      this.future[2 * k + 1] = t.root[2 * (NOW + FUTURE_OFFSETS[k]) + 1];
-    }
-    if (this.intention && d.intention) this.intention.set(d.intention);
-    // A dancer that was just placed anew must not drag its old foot locks along.
-    if (jumped || d.resets !== this.resets) this.feet.clear();
-    this.resets = d.resets;
-    this.feet.apply(this.positions, d.contacts, d.heading);
-  }
-}
-
-export class DuetSimulation implements Simulation {
-  readonly leader: DancerView;
-  readonly followers: DancerView[];
-  duet: Duet;
-  private readonly leaderView: View;
-  private readonly followerViews: View[];
-  private readonly leaderPolicy: Policy;
-  private readonly followerPolicies: Policy[];
-  private readonly followerInputs: Float32Array[];
-  // Own copies of each model's result: two roles may never share a Policy's result arrays.
-  private readonly leaderOutput = new Float32Array(OUTPUT_SIZE);
-  private readonly guardCounts = { resets: 0, leashed: 0 };
-  private readonly followerOutputs: Float32Array[];
-  private readonly followerIntentions: (Float32Array | null)[];
-  private readonly timer = new StepTimer(300);
-  private playback: LeaderPlayback | null = null;
-  private temperature: number;
-  private readonly ghost: Dancer;
-  private readonly ghostPoses: Float32Array[] = [];
-
-  constructor(private readonly options: SimulationOptions) {
-    const { manifest, leader, followers } = options;
-    if (followers.length < 1) throw new RangeError('a duet needs at least one follower');
-    this.leaderPolicy = leader;
-    this.followerPolicies = followers;
-    this.followerInputs = followers.map((p) => p.input);
-    this.temperature = manifest.defaultTemperature ?? 0.5;
-    this.duet = startDuet(manifest, followers.length);
-    this.leaderView = new View(false);
-    this.followerViews = followers.map((p) => new View(p.hasIntention));
-    this.leader = this.leaderView;
-    this.followers = this.followerViews;
-    this.followerOutputs = followers.map(() => new Float32Array(OUTPUT_SIZE));
-    this.followerIntentions = followers.map((p) => (p.hasIntention ? new Float32Array(INTENTION_SIZE) : null));
-    this.ghost = new Dancer(this.duet.followers[0].offsets);
-    this.updateViews(true);
-  }
-
-  reset(): void {
-    this.duet = startDuet(this.options.manifest, this.followerPolicies.length);
-    this.playback?.start(this.duet.leader.track);
-    this.timer.clear();
-    this.updateViews(true);
-  }
-
-  async step(steer: Steer, temperature: number): Promise<void> {
-    const started = performance.now();
-    this.temperature = temperature;
-    const duet = this.duet;
-    const playing = this.playback !== null;
-    if (!playing) {
-      const sx = steer.active ? steer.x : 0;
-      const sz = steer.active ? steer.z : 0;
-      steerPlan(duet.leader, duet.steering, sx, sz);
-    }
-    stepInputs(duet, playing ? null : this.leaderPolicy.input, this.followerInputs);
-    if (!playing) {
-      const result = await this.leaderPolicy.run(temperature);
-      this.leaderOutput.set(result.output);
-    }
-    for (let i = 0; i < this.followerPolicies.length; i++) {
-      const result = await this.followerPolicies[i].run(temperature);
-      this.followerOutputs[i].set(result.output);
-      if (result.intention) this.followerIntentions[i]?.set(result.intention);
-    }
-    if (this.playback) this.playback.advance(duet.leader.track, duet.leader.contacts);
-    finishStep(duet, playing ? null : this.leaderOutput, this.followerOutputs, this.followerIntentions);
-    this.updateViews(false);
-    this.timer.add(performance.now() - started);
-  }
-
-  /**
-   * k alternative next poses of the first follower: its model run once on k copies of its current
-   * input (each sample draws its own noise), each output applied to a scratch copy of the dancer.
-   */
-  async ghosts(k: number): Promise<Float32Array[]> {
-    if (k <= 0) return [];
-    const policy = this.followerPolicies[0];
-    const follower = this.duet.followers[0];
-    const input = policy.batchInput(k);
-    followerInput(this.duet.leader.track, follower.track, NOW, input, 0);
-    for (let i = 1; i < k; i++) input.copyWithin(i * INPUT_SIZE, 0, INPUT_SIZE);
-    const { output } = await policy.runBatch(k, this.temperature);
-    while (this.ghostPoses.length < k) this.ghostPoses.push(new Float32Array(N_JOINTS * 3));
-    for (let i = 0; i < k; i++) {
-      this.ghost.copyFrom(follower);
-      if (!outputIsAbsurd(this.ghost, output, i * OUTPUT_SIZE)) applyOutput(this.ghost, output, i * OUTPUT_SIZE);
-      const p = this.ghost.track.positions;
-      for (let n = 0; n < 51; n++) this.ghostPoses[i][n] = p[NOW * 51 + n];
-    }
-    return this.ghostPoses.slice(0, k);
-  }
-
-  /** Called every animation frame by the HUD: sums into one reused object, allocates nothing. */
-  guards(): { resets: number; leashed: number } {
-    const g = this.guardCounts;
-    g.resets = this.duet.leader.resets;
-    g.leashed = this.duet.leader.leashed;
-    for (const f of this.duet.followers) {
-      g.resets += f.resets;
-      g.leashed += f.leashed;
-    }
-    return g;
-  }
-
-  stepMs(): { median: number; p95: number } {
-    return this.timer.summary();
-  }
-
-  /**
-   * Drive the leader from a recorded motion (30 fps, e.g. motionFromBvhText) instead of the leader
-   * model, or go back to the model with null. The recording starts where the leader stands now,
-   * facing where it faces, and loops.
-   */
-  setLeaderPlayback(motion: Motion | null): void {
-    if (!motion) {
-      this.playback = null;
-      return;
-    }
-    const playback = new LeaderPlayback(motion);
-    playback.takeOver(this.duet.leader.track);
-    this.playback = playback;
-  }
-
-  /** Whether the leader follows a recording; the recording's current frame and length. */
-  get leaderPlayback(): { frame: number; frames: number } | null {
-    return this.playback ? { frame: this.playback.frame, frames: this.playback.frames } : null;
-  }
-
-  private updateViews(jumped: boolean): void {
-    const leader = this.duet.leader;
-    this.leaderView.update(leader, jumped);
-    this.duet.followers.forEach((f, i) => {
-      const view = this.followerViews[i];
-      view.update(f, jumped);
-      // Before the first prediction: the leader's key joints where they are now, at every key.
-      if (view.intention && !f.intention) {
-        for (let k = 0; k < KEYS; k++) {
-          KEY_JOINTS.forEach((j, n) => {
-            for (let a = 0; a < 3; a++) view.intention![(k * KEY_JOINTS.length + n) * 3 + a] = leader.track.positions[NOW * 51 + 3 * j + a];
-          });
-        }
-      }
-    });
-  }
-}
-
-export function createDuetSimulation(options: SimulationOptions): DuetSimulation {
-  return new DuetSimulation(options);
-}
-
-export const createSimulation: CreateSimulation = createDuetSimulation;

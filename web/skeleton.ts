@@ -1,5 +1,5 @@
-// The 17-joint duet skeleton: reduction from BVH, metres, resampling, root, mirroring.
-// TypeScript mirror of training/skeleton.py (same names in camelCase, same numbers).
+// Mirror of training/skeleton.py (same names in camelCase, same numbers): the 17-joint duet
+// skeleton, reduction from BVH, metres, resampling, root, mirroring.
 //
 // A `Motion` holds one dancer as world-space joint positions and rotations per frame, flat and
 // frame-major: positions [F × 17 × 3], rotations [F × 17 × 9] (row-major 3x3).
@@ -18,9 +18,13 @@ export const JOINT_NAMES = [
 ] as const;
 export const PARENTS = [-1, 0, 1, 2, 3, 2, 5, 6, 2, 8, 9, 0, 11, 12, 0, 14, 15];
 export const N_JOINTS = 17;
+/** Numbers per frame: joint positions [17 × 3] and world rotations [17 × 9] of a Motion or Track. */
+export const POSITIONS_SIZE = N_JOINTS * 3; // 51
+export const ROTATIONS_SIZE = N_JOINTS * 9; // 153
 // Head, both hands, both feet: the paper's five key joints for trajectories and intention.
 export const KEY_JOINTS = [4, 7, 10, 13, 16];
 export const FEET = [13, 16];
+export const HEAD = JOINT_NAMES.indexOf('head'); // 4
 
 const isUpper = (c: string) => c >= 'A' && c <= 'Z';
 /** Index of each joint's left/right twin (itself for the spine). */
@@ -118,8 +122,8 @@ export function resample(motion: Motion, fps: number = FPS, phase = 0): Motion {
   const rotations = new Float64Array(frames * N_JOINTS * 9);
   for (let f = 0; f < frames; f++) {
     const src = phase + f * step;
-    positions.set(motion.positions.subarray(src * 51, src * 51 + 51), f * 51);
-    rotations.set(motion.rotations.subarray(src * 153, src * 153 + 153), f * 153);
+    positions.set(motion.positions.subarray(src * POSITIONS_SIZE, src * POSITIONS_SIZE + POSITIONS_SIZE), f * POSITIONS_SIZE);
+    rotations.set(motion.rotations.subarray(src * ROTATIONS_SIZE, src * ROTATIONS_SIZE + ROTATIONS_SIZE), f * ROTATIONS_SIZE);
   }
   return { positions, rotations, offsets: motion.offsets, fps, frames };
 }
@@ -156,10 +160,10 @@ const R_SHLDR = 8;
 
 /** [F × 17 × 3] -> [F × 2] unit floor vector (x, z) the body faces (hips and shoulders). */
 export function facingDirection(positions: ArrayLike<number>): Float64Array {
-  const F = positions.length / 51;
+  const F = positions.length / POSITIONS_SIZE;
   const out = new Float64Array(F * 2);
   for (let f = 0; f < F; f++) {
-    const b = f * 51;
+    const b = f * POSITIONS_SIZE;
     const ax = positions[b + 3 * L_THIGH] - positions[b + 3 * R_THIGH] + (positions[b + 3 * L_SHLDR] - positions[b + 3 * R_SHLDR]);
     const az = positions[b + 3 * L_THIGH + 2] - positions[b + 3 * R_THIGH + 2] + (positions[b + 3 * L_SHLDR + 2] - positions[b + 3 * R_SHLDR + 2]);
     // forward = across × up, with up = +Y: (ax, ay, az) × (0, 1, 0) = (-az, 0, ax)
@@ -177,8 +181,8 @@ export function rootFromMotion(motion: Motion, smoothing = ROOT_SMOOTHING): { ro
   const F = motion.frames;
   const hip = new Float64Array(F * 2);
   for (let f = 0; f < F; f++) {
-    hip[2 * f] = motion.positions[f * 51];
-    hip[2 * f + 1] = motion.positions[f * 51 + 2];
+    hip[2 * f] = motion.positions[f * POSITIONS_SIZE];
+    hip[2 * f + 1] = motion.positions[f * POSITIONS_SIZE + 2];
   }
   const root = gaussianSmooth(hip, 2, smoothing);
   const fwd = gaussianSmooth(facingDirection(motion.positions), 2, smoothing);

@@ -1,8 +1,9 @@
-// Shared types between the page shell (main, scene, hud, ...) and the simulation (rollout.ts).
+// Shared types between the page shell (main, scene, hud, ...) and the simulation (simulation.ts).
 // The shell only ever talks to a `Simulation`; what happens inside one step (features, both
 // models, pose) is the simulation's business.
 
-import type { Policy } from './policy';
+import type { Motion } from './skeleton';
+import type { RecordableDuet } from './record';
 
 /** A 2D steering request on the floor, in world x/z; |(x, z)| is in 0..1. */
 export interface Steer {
@@ -30,6 +31,9 @@ export interface DancerView {
   rotations?: Float32Array;
   /** Optional, for the floor marks under planted feet: foot contact [left, right] in 0..1. */
   contacts?: Float32Array;
+  /** Optional, for the hand glow: per hand [left, right], how far the contact layer draws it to
+   *  the partner's hand, 0..1. */
+  hands?: Float32Array;
 }
 
 export interface Simulation {
@@ -47,19 +51,48 @@ export interface Simulation {
   /** Guard counts since the start: dancers reset after absurd model output, and frames the
    *  leash drew a follower toward the leader (see rollout.ts). */
   guards(): { resets: number; leashed: number };
+  /**
+   * Drive the leader from a recorded motion (30 fps) instead of the leader model, or go back to
+   * the model with null. Throws, changing nothing, on a motion it cannot play.
+   */
+  setLeaderPlayback(motion: Motion | null): void;
+  /** The dancers as they are now, for the recorder (a new object after reset). */
+  readonly duet: RecordableDuet;
+}
+
+/** What one model returns; the arrays are the policy's own and overwritten by its next run. */
+export interface PolicyResult {
+  /** [B × 323] raw model output (root update, trajectory, key joints, pose, contacts). */
+  output: Float32Array;
+  /** [B × 90] predicted partner key joints, or null for models without an intention predictor. */
+  intention: Float32Array | null;
+}
+
+/** What the simulation needs of one model (policy.ts Policy; fakes in the tests). */
+export interface StepPolicy {
+  /** Write the [660] input features here before run(). */
+  readonly input: Float32Array;
+  /** Whether run() returns an intention. */
+  readonly hasIntention: boolean;
+  /** One step for one character: reads `input`. */
+  run(temperature: number): Promise<PolicyResult>;
+  /** The [k × 660] input block for a batched run (e.g. k ghost samples); write rows here. */
+  batchInput(k: number): Float32Array;
+  /** k samples at once, each with its own noise: reads batchInput(k), returns [k × ...] results. */
+  runBatch(k: number, temperature: number): Promise<PolicyResult>;
 }
 
 /** What the shell hands to the simulation factory. */
 export interface SimulationOptions {
   manifest: Manifest;
-  leader: Policy;
+  leader: StepPolicy;
   /** [ours] or [ccm], or [ours, ccm] in compare mode. */
-  followers: Policy[];
+  followers: StepPolicy[];
   /** Seed for anything random the simulation does itself (the policies carry their own PRNG). */
   seed: number;
 }
 
-/** rollout.ts exports a function of this type named `createSimulation`. */
+/** simulation.ts exports a function of this type named `createSimulation`. */
 export type CreateSimulation = (options: SimulationOptions) => Simulation;
 
 export interface ModelEntry {
@@ -82,8 +115,16 @@ export interface Manifest {
     offsets: { leader: number[][]; follower: number[][] };
   };
   keyJoints: number[];
-  layout: { input: number; output: number; intention: number };
-  /** Opaque to the shell; read by rollout.ts. */
+  layout: {
+    input: number;
+    output: number;
+    intention: number;
+    /** (block name, size) in order, as training/features.py lays them out (web/features.ts too). */
+    followerInput: [string, number][];
+    leaderInput: [string, number][];
+    outputBlocks: [string, number][];
+  };
+  /** Opaque to the shell; read by rollout.ts (startDuet). */
   startPose: unknown;
   models: Record<string, ModelEntry>;
   defaultTemperature: number;
@@ -93,7 +134,7 @@ export interface Manifest {
 /** Follower model choices in the panel and the URL. */
 export type FollowerChoice = 'ours' | 'ccm' | 'compare';
 
-/** The test hook on window.duet (DESIGN.md, "Contracts"). Tests read only this. */
+/** The test hook on window.duet: the end-to-end tests (tests/e2e) read only this. */
 export interface DuetHook {
   ready: boolean;
   error: string | null;

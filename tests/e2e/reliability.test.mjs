@@ -211,6 +211,18 @@ describe('bad inputs show a clear message, not a blank canvas', () => {
     await page.close();
   });
 
+  test('manifest whose block layout differs (same sizes, two blocks swapped)', async (t) => {
+    const { page } = await openPage(browser);
+    await editManifest(page, (manifest) => {
+      const blocks = manifest.layout.followerInput;
+      [blocks[0], blocks[1]] = [blocks[1], blocks[0]];
+    });
+    await page.goto(`${server.url}?seed=1`);
+    await expectMessage(t, page, /manifest does not match this page/i,
+      /layout\.followerInput block 1 is "partner_trajectory_future" \(24\), this page expects "partner_trajectory_past" \(24\)/);
+    await page.close();
+  });
+
   test('model file missing (404)', async (t) => {
     const { page } = await openPage(browser);
     await page.route('**/models/follower.onnx', (route) => route.fulfill({ status: 404, body: 'not found' }));
