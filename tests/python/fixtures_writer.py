@@ -1,4 +1,4 @@
-"""Fixtures that pin web/*.ts to the Python reference: `python -m training.fixtures`.
+"""Fixtures that pin web/*.ts to the Python reference: `.venv/bin/python tests/python/fixtures_writer.py`.
 
 Writes tests/fixtures/{bvh,features,rollout}.json: inputs, and what training/bvh.py,
 skeleton.py, features.py and rollout.py compute from them. tests/web/*.test.ts run the TypeScript
@@ -15,19 +15,24 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import sys
 from pathlib import Path
 
 import numpy as np
 
-from . import features as feat
-from . import rollout as ro
-from .bvh import BvhError, axis_rotation, forward_kinematics, local_transforms, parse_bvh
-from .features import Track
-from .skeleton import (JOINT_NAMES, MIRROR, PARENTS, Motion, facing_direction,
-                       forward_kinematics_reduced, gaussian_smooth, mirror_motion, reduce_bvh,
-                       resample, root_from_motion)
+REPO = Path(__file__).resolve().parents[2]
+if str(REPO) not in sys.path:      # run as a script from anywhere
+    sys.path.insert(0, str(REPO))
 
-OUT_DIR = Path(__file__).resolve().parent.parent / "tests" / "fixtures"
+from training import features as feat  # noqa: E402
+from training import rollout as ro  # noqa: E402
+from training.bvh import BvhError, axis_rotation, forward_kinematics, local_transforms, parse_bvh  # noqa: E402
+from training.features import Track  # noqa: E402
+from training.skeleton import (FPS, JOINT_NAMES, MIRROR, PARENTS, Motion, facing_direction,  # noqa: E402
+                               forward_kinematics_reduced, gaussian_smooth, mirror_motion, reduce_bvh,
+                               resample, root_from_motion)
+
+OUT_DIR = REPO / "tests" / "fixtures"
 FRAMES = 63            # 30 past + 2 frames t + 31 future: valid_frames(63) == [30, 31]
 SEED = 20240611
 
@@ -256,7 +261,7 @@ def euler(angles_deg: np.ndarray) -> np.ndarray:
 def procedural_dancer(rng: np.random.Generator, frames: int, centre_angle: np.ndarray,
                       offsets: np.ndarray, scale: float) -> Motion:
     """A dancer on a circle around a drifting centre, facing the centre, stepping and swinging."""
-    t = np.arange(frames) / 30.0
+    t = np.arange(frames) / FPS
     J = len(PARENTS)
     local = np.empty((frames, J, 3, 3))
     # Sinusoidal joint angles with random amplitudes and phases, plus seeded random jitter.
@@ -291,7 +296,7 @@ def procedural_dancer(rng: np.random.Generator, frames: int, centre_angle: np.nd
 
 
 def procedural_pair(rng: np.random.Generator) -> tuple[Motion, Motion]:
-    t = np.arange(FRAMES) / 30.0
+    t = np.arange(FRAMES) / FPS
     angle = 1.3 + 0.5 * t    # the pair turns slowly; the leader's heading crosses ±pi
     lead_offsets = OFFSETS.copy()
     follow_offsets = np.round(OFFSETS * 0.94, 6)
