@@ -18,12 +18,12 @@ for m in follower follower_ccm leader follower_small follower_ccm_large follower
          follower_no_intention_noise follower_end_to_end follower_end_to_end_no_ss; do
   if finished "runs/models/$m"; then names+=(--model "$m"); fi
 done
-$PY -m training.export "${names[@]}" --out "$MODELS" --fp32 runs/eval_fp32 --data "$DATA"
+$PY -m training.export "${names[@]}" --models "$MODELS" --fp32 runs/eval_fp32 --data "$DATA"
 # The λG sweep lives in runs/sweep/lgG/follower: export each under its own name.
 for dir in runs/sweep/lg*; do
   finished "$dir/follower" || continue
   g=$(basename "$dir")
-  $PY -m training.export --runs "$dir" --model follower --out "runs/sweep_export/$g" --fp32 "runs/sweep_export/$g/fp32" --data "$DATA"
+  $PY -m training.export --runs "$dir" --model follower --models "runs/sweep_export/$g" --fp32 "runs/sweep_export/$g/fp32" --data "$DATA"
   cp "runs/sweep_export/$g/follower.onnx" "$MODELS/follower_$g.onnx"
   ln -sfn "../sweep/$g/follower" "runs/models/follower_$g"     # codebook error reads the checkpoint
 done

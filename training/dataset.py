@@ -18,7 +18,6 @@ from .features import (HISTORY, Track, follower_input, intention_target, leader_
                        valid_frames)
 from .skeleton import FPS, Motion, mirror_motion, reduce_bvh, resample
 
-DEFAULT_DATA = "../shared/data/cmu-salsa"
 # Split by take so no validation or test frame has a near-duplicate neighbour in training.
 # 12 is clean; 02 and 13 are full-length takes without the head glitches of 06/07.
 VALIDATION_TAKES = ["12"]

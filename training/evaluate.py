@@ -39,8 +39,9 @@ from tqdm import tqdm
 
 from . import features as feat
 from . import metrics as M
-from .dataset import (DEFAULT_DATA, TEST_TAKES, VALIDATION_TAKES, DataError, discover_takes,
+from .dataset import (TEST_TAKES, VALIDATION_TAKES, DataError, discover_takes,
                       load_pair, pair_tracks, select_takes)
+from .folders import DEFAULT_DATA, add_folder
 from .features import FUTURE_OFFSETS, HISTORY, Track, follower_input, leader_input, output_features
 from .motion_matching import MotionMatching, build, load_tracks, own_future, training_takes
 from .rollout import NOW, Dancer, OnnxPolicy, apply_output, output_is_absurd, reset_beside
@@ -167,8 +168,8 @@ def codebook_errors(tf: dict, methods: list[str], runs: str, prepared: str, mani
     the input encoder's argmax (temperature 0). Motion Matching has no encoder of its own: its
     estimate is our output encoder's code of the frame it picked, against the same target."""
     import torch
-    from .export import load_step_model
-    from .train import TrainError
+    from .prepared import TrainError
+    from .runs import load_run
     torch.set_num_threads(1)
     x, y = torch.from_numpy(tf["x"]).float(), torch.from_numpy(tf["y"]).float()
     res, notes, models = {}, [], {}
@@ -177,7 +178,7 @@ def codebook_errors(tf: dict, methods: list[str], runs: str, prepared: str, mani
         if method not in models:
             name = checkpoint_name(method)
             try:
-                m = load_step_model(Path(runs) / name, prepared)
+                m = load_run(Path(runs) / name, prepared).model
             except TrainError as e:
                 models[method] = None
                 notes.append(f"codebook error of {method}: {e}")
@@ -194,10 +195,8 @@ def codebook_errors(tf: dict, methods: list[str], runs: str, prepared: str, mani
 
     @torch.no_grad()
     def codes(m, out=None):
-        xn = (x - m.input_mean) / m.input_std
-        intention = m.predictor(xn) if m.cfg.intention else None
-        logits = (m.matching.estimate_logits(xn, intention) if out is None else
-                  m.matching.target_logits(xn, (out - m.output_mean) / m.output_std, intention))
+        estimate, target, _ = m.logits(x, out)
+        logits = estimate if out is None else target
         return M.one_hot(logits.reshape(len(x), m.cfg.channels, -1).argmax(-1).numpy(), m.cfg.classes)
 
     for method in methods:
@@ -597,14 +596,14 @@ def clean(o):
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m training.evaluate", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--data", default=DEFAULT_DATA, help="folder of SUBJECT_TAKE.bvh pairs to evaluate on")
+    add_folder(ap, "data", "the takes to evaluate on")
     ap.add_argument("--takes", default=",".join(TEST_TAKES), help="comma-separated takes of --data")
-    ap.add_argument("--models", default="public/models", help="exported ONNX models + manifest.json")
+    add_folder(ap, "models", "the follower and leader models evaluated")
     ap.add_argument("--out", default="runs/eval", help="writes OUT/metrics.json and OUT/metrics.md")
     ap.add_argument("--methods", default=None,
                     help="comma-separated: ours, ccm, motion_matching, other follower ONNX names (default: all)")
-    ap.add_argument("--runs", default="runs/models", help="torch checkpoints (codebook error only)")
-    ap.add_argument("--prepared", default="runs/data", help="prepared data of those checkpoints (normalization)")
+    add_folder(ap, "runs", "torch checkpoints, read for the codebook error only")
+    add_folder(ap, "prepared", "the normalization of those checkpoints")
     ap.add_argument("--train-data", default=DEFAULT_DATA, help="takes for Motion Matching and the encoder")
     ap.add_argument("--train-takes", default=None,
                     help="default: all of --train-data except validation, test and evaluated takes")

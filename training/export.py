@@ -16,34 +16,19 @@ import numpy as np
 import torch
 
 from . import features as feat
-from .dataset import DEFAULT_DATA, DataError, discover_takes, load_pair
-from .models import CodebookMatching, IntentionPredictor, ModelConfig, StepModel
+from .dataset import DataError, discover_takes, load_pair
+from .folders import add_folder
+from .models import StepModel
+from .prepared import TrainError
+from .runs import load_run
 from .skeleton import FPS, JOINT_NAMES, KEY_JOINTS, PARENTS
-from .train import SHIPPED, TrainError, load_checkpoint, load_stats
+from .train import SHIPPED
 
 MANIFEST_VERSION = 1
 OPSET = 18
 DEFAULT_TEMPERATURE = 0.5
 CREDIT = ("The data used in this project was obtained from mocap.cs.cmu.edu. "
           "The database was created with funding from NSF EIA-0196217.")
-
-
-def load_step_model(run: Path, data: str) -> StepModel:
-    ckpt = run / "checkpoint.pt"
-    if not ckpt.exists():
-        raise TrainError(f"{ckpt} not found: train it first (python -m training.train --model {run.name})")
-    ck = load_checkpoint(ckpt)
-    if ck.get("stage") != "done":
-        raise TrainError(f"{ckpt}: training did not finish (stage {ck.get('stage')}); "
-                         f"continue it with --resume")
-    cfg = ModelConfig(**ck["config"]["model"])
-    predictor = IntentionPredictor(cfg) if cfg.intention else None
-    if predictor is not None:
-        predictor.load_state_dict(ck["predictor"])
-    matching = CodebookMatching(cfg)
-    matching.load_state_dict(ck["matching"])
-    model = StepModel(cfg, predictor, matching, load_stats(data, cfg.role))
-    return model.eval()
 
 
 def export_onnx(model: StepModel, path: Path) -> None:
@@ -110,7 +95,7 @@ def export_all(names: list[str], runs: str, out: str, data: str, prepared: str, 
     fp32_dir.mkdir(parents=True, exist_ok=True)
     models = {}
     for name in names:
-        model = load_step_model(Path(runs) / name, prepared)
+        model = load_run(Path(runs) / name, prepared).model
         fp32 = fp32_dir / f"{name}.onnx"
         export_onnx(model, fp32)
         quantize(fp32, out_dir / f"{name}.onnx")
@@ -121,21 +106,22 @@ def export_all(names: list[str], runs: str, out: str, data: str, prepared: str, 
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m training.export", description=__doc__)
+    ap = argparse.ArgumentParser(prog="python -m training.export", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--model", action="append", help=f"default: {', '.join(SHIPPED)}")
-    ap.add_argument("--runs", default="runs/models", help="training output folder")
-    ap.add_argument("--prepared", default="runs/data", help="prepared data (for normalization)")
-    ap.add_argument("--data", default=DEFAULT_DATA, help="BVH folder (skeleton offsets)")
-    ap.add_argument("--out", default="public/models")
+    add_folder(ap, "runs", "read")
+    add_folder(ap, "prepared", "read for the normalization")
+    add_folder(ap, "data", "read for the skeleton offsets")
+    add_folder(ap, "models", "written", old=("--out",))
     ap.add_argument("--fp32", default=None, help="where to keep the fp32 ONNX (default RUNS/fp32)")
     args = ap.parse_args(argv)
     try:
-        m = export_all(args.model or SHIPPED, args.runs, args.out, args.data, args.prepared, args.fp32)
+        m = export_all(args.model or SHIPPED, args.runs, args.models, args.data, args.prepared, args.fp32)
     except (TrainError, DataError) as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
     total = sum(v["bytes"] for v in m["models"].values())
-    print(f"wrote {args.out}/manifest.json; models total {total / 1e6:.2f} MB")
+    print(f"wrote {args.models}/manifest.json; models total {total / 1e6:.2f} MB")
     return 0
 
 

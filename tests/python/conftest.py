@@ -92,7 +92,7 @@ def prepared3(data3, tmp_path_factory):
     """training.prepare on 3 takes (all phases, mirrored train): train 10, validation 12, test 06."""
     from training.prepare import main
     out = tmp_path_factory.mktemp("prepared3")
-    rc = main(["--data", str(data3), "--out", str(out), "--validation", SMALL_TAKES["validation"],
+    rc = main(["--data", str(data3), "--prepared", str(out), "--validation", SMALL_TAKES["validation"],
                "--test", SMALL_TAKES["test"]])
     assert rc == 0
     return out
@@ -103,7 +103,7 @@ def smoke_runs(prepared3, tmp_path_factory):
     """`training.train --all --smoke` on the 3-take data: one folder per shipped model."""
     from training.train import main
     out = tmp_path_factory.mktemp("runs")
-    rc = main(["--all", "--smoke", "--data", str(prepared3), "--out", str(out)])
+    rc = main(["--all", "--smoke", "--prepared", str(prepared3), "--runs", str(out)])
     assert rc == 0
     return out
 
@@ -115,7 +115,7 @@ def exported(smoke_runs, prepared3, data3, tmp_path_factory):
     root = tmp_path_factory.mktemp("exported")
     models, fp32 = root / "models", root / "fp32"
     rc = main(["--runs", str(smoke_runs), "--prepared", str(prepared3), "--data", str(data3),
-               "--out", str(models), "--fp32", str(fp32)])
+               "--models", str(models), "--fp32", str(fp32)])
     assert rc == 0
     return {"models": models, "fp32": fp32, "runs": smoke_runs, "prepared": prepared3}
 

@@ -14,6 +14,7 @@ import torch
 from training import export as E
 from training import features as feat
 from training.dataset import discover_takes, load_pair
+from training.runs import load_run
 from training.skeleton import FPS, JOINT_NAMES, KEY_JOINTS, PARENTS
 from training.train import SHIPPED
 
@@ -52,7 +53,7 @@ def run_torch(model, x, temperature, noise):
 
 @pytest.fixture(scope="module")
 def models(exported):
-    return {name: E.load_step_model(exported["runs"] / name, str(exported["prepared"])) for name in SHIPPED}
+    return {name: load_run(exported["runs"] / name, str(exported["prepared"])).model for name in SHIPPED}
 
 
 @pytest.fixture(scope="module")
@@ -203,10 +204,10 @@ def test_export_refuses_unfinished_or_missing_runs(exported, data3, tmp_path, ca
     ck["stage"] = "matching"
     torch.save(ck, runs / "follower" / "checkpoint.pt")
     common = ["--runs", str(runs), "--prepared", str(exported["prepared"]), "--data", str(data3),
-              "--out", str(tmp_path / "out"), "--fp32", str(tmp_path / "fp32")]
+              "--models", str(tmp_path / "out"), "--fp32", str(tmp_path / "fp32")]
     assert E.main(["--model", "follower", *common]) == 2
     err = capsys.readouterr().err
-    assert "error:" in err and "did not finish" in err and "--resume" in err
+    assert "error:" in err and "has not finished" in err and "--resume" in err
     assert E.main(["--model", "leader", *common]) == 2
     err = capsys.readouterr().err
     assert "error:" in err and "leader" in err and "not found" in err

@@ -1,0 +1,57 @@
+"""The folders the commands read and write, and the one flag name each has in every command.
+
+    --data DIR       BVH couples, SUBJECT_TAKE.bvh (the CMU salsa takes)   prepare, export, evaluate, plots,
+                                                                          motion_matching
+    --prepared DIR   prepared arrays: {train,validation,test,stats}.npz    prepare writes; train, validation,
+                     (default runs/data)                                  export, plots read
+    --runs DIR       trained runs, one folder per model with checkpoint.pt train writes; export, plots read
+                     (default runs/models)
+    --models DIR     exported ONNX step models + manifest.json              export writes; evaluate, soak,
+                     (default public/models)                              plots read
+
+`--out` is left for what a command writes that is none of these (evaluate's report, plots' PNGs).
+
+Older names are still accepted, hidden from --help, and print a note naming the new flag:
+prepare --out, train --data / --out, validation --data, export --out, plots --bvh. (plots --data
+used to mean the prepared arrays; it now means the BVH couples, like everywhere else.)
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+
+DEFAULT_DATA = "../shared/data/cmu-salsa"
+DEFAULT_PREPARED = "runs/data"
+DEFAULT_RUNS = "runs/models"
+DEFAULT_MODELS = "public/models"
+
+DEFAULTS = {"data": DEFAULT_DATA, "prepared": DEFAULT_PREPARED, "runs": DEFAULT_RUNS, "models": DEFAULT_MODELS}
+WHAT = {
+    "data": "BVH couples (folder of SUBJECT_TAKE.bvh pairs)",
+    "prepared": "prepared arrays (training.prepare's output)",
+    "runs": "trained runs, one folder per model (training.train's output)",
+    "models": "exported ONNX models + manifest.json (training.export's output)",
+}
+
+
+class _OldName(argparse.Action):
+    """A renamed flag: sets the new flag's value and says so on stderr."""
+
+    def __init__(self, option_strings, dest, new: str, **kw):
+        self.new = new
+        super().__init__(option_strings, dest, **kw)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        print(f"note: {option_string} is now {self.new} (the old name still works)", file=sys.stderr)
+        setattr(namespace, self.dest, values)
+
+
+def add_folder(ap: argparse.ArgumentParser, name: str, use: str, default: str | None = None,
+               old: tuple[str, ...] = ()) -> None:
+    """Add --NAME (data, prepared, runs or models) with its one meaning; `use` says what this
+    command does with it; `old` are former names of the same flag, kept as hidden aliases."""
+    default = DEFAULTS[name] if default is None else default
+    ap.add_argument(f"--{name}", default=default, metavar="DIR",
+                    help=f"{WHAT[name]}: {use} (default {default})")
+    for flag in old:
+        ap.add_argument(flag, dest=name, action=_OldName, new=f"--{name}", help=argparse.SUPPRESS)
