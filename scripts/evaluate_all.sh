@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
 # Regenerates docs/results.md's numbers and plots from the shipped models plus the
 # evaluation-only models (train those first: bash scripts/train_ablations.sh).
-#   bash scripts/evaluate_all.sh [DATA]      (DATA defaults to ../shared/data/cmu-salsa)
+#   bash scripts/evaluate_all.sh [DATA]      (DATA defaults to $DUET_DATA, data/cmu-salsa or ../shared/data/cmu-salsa)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 PY=.venv/bin/python
-DATA=${1:-../shared/data/cmu-salsa}
+DATA=${1:-$($PY -c "from training.folders import default_data; print(default_data())")}
 MODELS=runs/eval_models
 rm -rf "$MODELS" && mkdir -p "$MODELS"
 finished() {   # a run whose training reached the end (export refuses the others)

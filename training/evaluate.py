@@ -41,7 +41,7 @@ from . import features as feat
 from . import metrics as M
 from .dataset import (TEST_TAKES, VALIDATION_TAKES, DataError, discover_takes,
                       load_pair, pair_tracks, select_takes)
-from .folders import DEFAULT_DATA, add_folder
+from .folders import add_folder
 from .features import FUTURE_OFFSETS, HISTORY, Track, follower_input, leader_input, output_features
 from .motion_matching import MotionMatching, build, load_tracks, own_future, training_takes
 from .rollout import NOW, Dancer, OnnxPolicy, apply_output, output_is_absurd, reset_beside
@@ -604,7 +604,9 @@ def main(argv=None) -> int:
                     help="comma-separated: ours, ccm, motion_matching, other follower ONNX names (default: all)")
     add_folder(ap, "runs", "torch checkpoints, read for the codebook error only")
     add_folder(ap, "prepared", "the normalization of those checkpoints")
-    ap.add_argument("--train-data", default=DEFAULT_DATA, help="takes for Motion Matching and the encoder")
+    ap.add_argument("--train-data", default=None, metavar="DIR",
+                    help="BVH couples whose training takes build Motion Matching and the evaluation "
+                         "encoder (default: --data)")
     ap.add_argument("--train-takes", default=None,
                     help="default: all of --train-data except validation, test and evaluated takes")
     ap.add_argument("--leader", default=None, help="subject that leads (default: first by name)")
@@ -618,6 +620,8 @@ def main(argv=None) -> int:
     ap.add_argument("--encoder-epochs", type=int, default=M.EncoderConfig.epochs)
     ap.add_argument("--quiet", action="store_true", help="no progress bar")
     args = ap.parse_args(argv)
+    if args.train_data is None:
+        args.train_data = args.data
     try:
         res = evaluate(args)
     except (EvalError, DataError) as e:

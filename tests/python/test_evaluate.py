@@ -112,8 +112,8 @@ def test_bad_input_is_one_line_and_exit_2(exported, data3, tmp_path, capsys, cha
     assert not (tmp_path / "out" / "metrics.json").exists()
 
 
-def test_bend_plan_turns_and_shifts_the_future_keys(real_tracks):
-    lead, _ = real_tracks
+def test_bend_plan_turns_and_shifts_the_future_keys(take_tracks):
+    lead, _ = take_tracks
     t = 100
     w = E.window(lead, t)
     turned = E.window(lead, t)

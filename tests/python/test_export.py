@@ -18,9 +18,7 @@ from training.runs import load_run
 from training.skeleton import FPS, JOINT_NAMES, KEY_JOINTS, PARENTS
 from training.train import SHIPPED
 
-from conftest import needs_data
 
-pytestmark = needs_data
 
 # Bounds for int8 against fp32 on the 362 validation frames, set from measurement with the smoke
 # models (2 channels x 4 classes, hidden 32) over two training configurations: code flips 0-2.5 %

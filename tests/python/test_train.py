@@ -18,9 +18,8 @@ import torch
 from training import features as feat
 from training import train as T
 
-from conftest import REPO, needs_data
+from conftest import REPO
 
-pytestmark = needs_data
 
 
 def run_main(capsys, *args):
