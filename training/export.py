@@ -1,9 +1,16 @@
-"""python -m training.export: trained checkpoints -> dynamic-int8 ONNX step models + manifest.
+"""python -m training.export: trained runs -> dynamic-int8 ONNX step models + manifest.
+
+    python -m training.export                    # runs/models/{follower,follower_ccm,leader} -> public/models
+    python -m training.export --runs R --models M --model follower
 
 One ONNX file per model holds the whole step (normalization, intention, input encoder, Gumbel-max
 sampling with temperature and noise as inputs, gather decoder, de-normalization), so the page
 only builds features and reads results. Dynamic int8 (per channel) because static QDQ int8 runs
 6-8x slower in the browser's WASM backend.
+
+Each follower also gets MODELS/eval/NAME.output_encoder.onnx (fp32, evaluation only; the page
+never downloads it): what training.evaluate needs for the codebook error. Every file carries the
+run's fingerprint (training/stamp.py), repeated in manifest.json.
 """
 from __future__ import annotations
 
@@ -18,9 +25,10 @@ import torch
 from . import features as feat
 from .dataset import DataError, discover_takes, load_pair
 from .folders import add_folder
-from .models import StepModel
+from .models import OutputEncoderStep, StepModel
 from .prepared import TrainError
-from .runs import load_run
+from .runs import fingerprint, load_run
+from .stamp import eval_file, write_stamp
 from .skeleton import FPS, JOINT_NAMES, KEY_JOINTS, PARENTS
 from .train import SHIPPED
 
@@ -41,6 +49,22 @@ def export_onnx(model: StepModel, path: Path) -> None:
                       input_names=["input", "temperature", "noise"], output_names=names,
                       dynamic_axes={"input": {0: "batch"}, "noise": {0: "batch"},
                                     **{n: {0: "batch"} for n in names}})
+
+
+def export_output_encoder(model: StepModel, path: Path) -> None:
+    """fp32 ONNX of OutputEncoderStep: (input [B, 660], output [B, 323]) -> target_logits [B, C*D].
+    fp32, not int8: it is the reference every follower's codes are scored against."""
+    cfg = model.cfg
+    path.parent.mkdir(parents=True, exist_ok=True)
+    torch.onnx.export(OutputEncoderStep(model).eval(), (torch.zeros(2, cfg.input_size), torch.zeros(2, cfg.output_size)),
+                      str(path), opset_version=OPSET, dynamo=False, input_names=["input", "output"],
+                      output_names=["target_logits"],
+                      dynamic_axes={"input": {0: "batch"}, "output": {0: "batch"}, "target_logits": {0: "batch"}})
+
+
+def stamp_of(name: str, model: StepModel) -> dict:
+    return {"fingerprint": fingerprint(model), "name": name, "role": model.cfg.role,
+            "channels": model.cfg.channels, "classes": model.cfg.classes}
 
 
 def quantize(src: Path, dst: Path) -> None:
@@ -81,9 +105,13 @@ def write_manifest(out: Path, models: dict[str, StepModel], data: str, prepared:
     }
     for name, m in models.items():
         f = out / f"{name}.onnx"
-        manifest["models"][name] = {"file": f.name, "bytes": f.stat().st_size, "role": m.cfg.role,
-                                    "channels": m.cfg.channels, "classes": m.cfg.classes,
-                                    "intention": m.cfg.intention, "hidden": m.cfg.hidden}
+        entry = manifest["models"][name] = {
+            "file": f.name, "bytes": f.stat().st_size, "role": m.cfg.role, "channels": m.cfg.channels,
+            "classes": m.cfg.classes, "intention": m.cfg.intention, "hidden": m.cfg.hidden,
+            "fingerprint": fingerprint(m)}
+        e = eval_file(out, name)
+        if m.cfg.role == "follower" and e.exists():
+            entry["eval"] = {"outputEncoder": str(e.relative_to(out)), "bytes": e.stat().st_size}
     (out / "manifest.json").write_text(json.dumps(manifest, indent=1))
     return manifest
 
@@ -99,6 +127,11 @@ def export_all(names: list[str], runs: str, out: str, data: str, prepared: str, 
         fp32 = fp32_dir / f"{name}.onnx"
         export_onnx(model, fp32)
         quantize(fp32, out_dir / f"{name}.onnx")
+        stamp = stamp_of(name, model)
+        write_stamp(out_dir / f"{name}.onnx", stamp)
+        if model.cfg.role == "follower":
+            export_output_encoder(model, eval_file(out_dir, name))
+            write_stamp(eval_file(out_dir, name), stamp)
         models[name] = model
         print(f"{name}: fp32 {fp32.stat().st_size / 1e6:.2f} MB -> int8 "
               f"{(out_dir / f'{name}.onnx').stat().st_size / 1e6:.2f} MB")

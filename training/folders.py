@@ -84,3 +84,18 @@ def add_folder(ap: argparse.ArgumentParser, name: str, use: str, default: str | 
                     help=f"{WHAT[name]}: {use} (default {default})")
     for flag in old:
         ap.add_argument(flag, dest=name, action=_OldName, new=f"--{name}", help=argparse.SUPPRESS)
+
+
+class _Retired(argparse.Action):
+    def __init__(self, option_strings, dest, why: str, **kw):
+        self.why = why
+        super().__init__(option_strings, argparse.SUPPRESS, **kw)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        print(f"note: {option_string} is no longer read: {self.why}", file=sys.stderr)
+
+
+def add_retired(ap: argparse.ArgumentParser, flag: str, why: str) -> None:
+    """A flag this command no longer uses: still accepted (old scripts keep working), hidden,
+    ignored with a note saying why."""
+    ap.add_argument(flag, action=_Retired, why=why, default=argparse.SUPPRESS, help=argparse.SUPPRESS)

@@ -186,3 +186,18 @@ class StepModel(nn.Module):
         columns = code + torch.arange(self.cfg.channels, device=code.device) * d   # [B, C]
         h = first.weight.t()[columns].sum(1) + first.bias
         return rest(h)
+
+
+class OutputEncoderStep(nn.Module):
+    """Evaluation only: raw input I [B, 660] and the recorded output O [B, 323] -> the output
+    encoder's target logits S [B, C*D], normalization and intention inside (export writes it as
+    eval/NAME.output_encoder.onnx; the page never loads it). Its argmax is the code the recorded
+    motion gets, against which a step model's own code is scored (codebook error)."""
+
+    def __init__(self, step: StepModel):
+        super().__init__()
+        self.step = step
+
+    def forward(self, x, y):
+        return self.step.logits(x, y).target
+

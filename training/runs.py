@@ -7,7 +7,9 @@ trained on, as eval-mode modules ready to call.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+import hashlib
+import json
+from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import torch
@@ -46,6 +48,20 @@ class Run:
     @property
     def cfg(self) -> ModelConfig:
         return self.model.cfg
+
+    def fingerprint(self) -> str:
+        return fingerprint(self.model)
+
+
+def fingerprint(model: StepModel) -> str:
+    """16 hex digits that name one training (weights, configuration and normalization): export
+    writes it into a step model, its evaluation files and the manifest, so evaluation can refuse
+    files of different trainings side by side."""
+    h = hashlib.sha256(json.dumps(asdict(model.cfg), sort_keys=True).encode())
+    for name, t in sorted(model.state_dict().items()):
+        h.update(f"{name} {t.dtype} {tuple(t.shape)}".encode())
+        h.update(t.detach().cpu().contiguous().numpy().tobytes())
+    return h.hexdigest()[:16]
 
 
 def load_run(run: str | Path, prepared: str) -> Run:

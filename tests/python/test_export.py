@@ -210,3 +210,32 @@ def test_export_refuses_unfinished_or_missing_runs(exported, data3, tmp_path, ca
     err = capsys.readouterr().err
     assert "error:" in err and "leader" in err and "not found" in err
     assert not (tmp_path / "out" / "manifest.json").exists()
+
+
+def test_evaluation_files_share_the_training_fingerprint(exported, models, validation):
+    """Every exported file carries its training's fingerprint (also in the manifest); each
+    follower's output encoder file gives the torch output encoder's logits."""
+    from training.stamp import eval_file, read_stamp
+    out = exported["models"]
+    m = json.loads((out / "manifest.json").read_text())
+    prints = {name: entry["fingerprint"] for name, entry in m["models"].items()}
+    assert len(set(prints.values())) == len(SHIPPED)
+    for name, entry in m["models"].items():
+        stamp = read_stamp(out / entry["file"])
+        assert stamp == {"fingerprint": prints[name], "name": name, "role": entry["role"],
+                         "channels": entry["channels"], "classes": entry["classes"]}
+        if entry["role"] == "leader":
+            assert "eval" not in entry and not eval_file(out, name).exists()
+            continue
+        enc = eval_file(out, name)
+        assert entry["eval"] == {"outputEncoder": f"eval/{enc.name}", "bytes": enc.stat().st_size}
+        assert read_stamp(enc) == stamp
+        model = models[name]
+        x = validation["follower"]
+        with np.load(exported["prepared"] / "validation.npz") as z:
+            y = z["follower_output"].astype(np.float32)
+        got = session(enc).run(None, {"input": x, "output": y})[0]
+        with torch.no_grad():
+            ref = model.logits(torch.from_numpy(x), torch.from_numpy(y)).target.numpy()
+        np.testing.assert_allclose(got, ref, atol=1e-4, rtol=1e-4)
+
