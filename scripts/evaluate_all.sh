@@ -9,7 +9,7 @@ DATA=${1:-$($PY -c "from training.folders import default_data; print(default_dat
 MODELS=runs/eval_models
 rm -rf "$MODELS" && mkdir -p "$MODELS"
 finished() {   # a run whose training reached the end (export refuses the others)
-  [ -f "$1/checkpoint.pt" ] && $PY -c "import sys, torch; sys.exit(torch.load('$1/checkpoint.pt', weights_only=False)['stage'] != 'done')"
+  [ -f "$1/checkpoint.pt" ] && $PY -c "import sys; from training.runs import load_checkpoint; sys.exit(load_checkpoint('$1/checkpoint.pt')['stage'] != 'done')"
 }
 
 # Every finished follower variant, exported like the shipped ones (the manifest comes along).
