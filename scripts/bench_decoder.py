@@ -11,10 +11,11 @@ import onnxruntime as ort
 import torch
 from pathlib import Path
 
-from training.export import load_step_model, export_onnx, quantize
+from training.export import export_onnx, quantize
 from training.models import StepModel
+from training.runs import load_run
 torch.set_num_threads(1)
-m = load_step_model(Path('runs/models/follower'), 'runs/data')
+m = load_run(Path('runs/models/follower'), 'runs/data').model
 class FullDecode(StepModel):
     def decode(self, code):   # one-hot [B, C*D] times the full first-layer matrix
         oh = torch.nn.functional.one_hot(code, self.cfg.classes).float().reshape(code.shape[0], -1)

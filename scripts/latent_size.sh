@@ -10,7 +10,7 @@ for cs in 8:1 16:1 24:1 24:2 24:3; do
   c=${cs%:*}; s=${cs#*:}
   out="runs/latent/c${c}_s${s}"
   for m in follower follower_ccm; do
-    $PY -m training.train --model "$m" --channels "$c" --seed "$s" --out "$out" "$@"
+    $PY -m training.train --model "$m" --channels "$c" --seed "$s" --runs "$out" "$@"
     runs+=("$out/$m")
   done
 done

@@ -9,5 +9,5 @@ for m in follower_small follower_ccm_large follower_no_gan follower_no_intention
   $PY -m training.train --model "$m" "$@"
 done
 for g in 0.1 1; do   # λC is 10; λG 0 and 0.01 are follower_no_gan and follower
-  $PY -m training.train --model follower --lambda-generator "$g" --out "runs/sweep/lg$g" "$@"
+  $PY -m training.train --model follower --lambda-generator "$g" --runs "runs/sweep/lg$g" "$@"
 done

@@ -16,13 +16,15 @@ import numpy as np
 from .bvh import BvhError, read_bvh
 from .features import (HISTORY, Track, follower_input, intention_target, leader_input, output_features,
                        valid_frames)
-from .skeleton import FPS, Motion, mirror_motion, reduce_bvh, resample
+from .skeleton import FPS, HEAD, SCALE, Motion, mirror_motion, reduce_bvh, resample
 
-DEFAULT_DATA = "../shared/data/cmu-salsa"
 # Split by take so no validation or test frame has a near-duplicate neighbour in training.
 # 12 is clean; 02 and 13 are full-length takes without the head glitches of 06/07.
 VALIDATION_TAKES = ["12"]
 TEST_TAKES = ["02", "13"]
+
+# Mean height (m) of a standing adult's head joint; far outside it the units are wrong.
+HEAD_HEIGHT = (1.2, 2.2)
 
 NAME = re.compile(r"^(?P<subject>[^_]+)_(?P<take>[^.]+)\.bvh$", re.IGNORECASE)
 
@@ -41,10 +43,12 @@ class Take:
 def discover_takes(data: str | Path, leader: str | None = None) -> list[Take]:
     data = Path(data)
     if not data.is_dir():
-        raise DataError(f"data folder {data} does not exist")
+        raise DataError(f"data folder {data} does not exist: put the CMU salsa takes there (README, \"Data\") "
+                        f"or name the folder with --data DIR or DUET_DATA=DIR")
     files = sorted(p for p in data.iterdir() if p.suffix.lower() == ".bvh")
     if not files:
-        raise DataError(f"{data}: no .bvh files (expected SUBJECT_TAKE.bvh pairs)")
+        raise DataError(f"{data}: no .bvh files (expected SUBJECT_TAKE.bvh pairs such as 60_01.bvh and "
+                        f"61_01.bvh; README, \"Data\")")
     by_subject: dict[str, dict[str, Path]] = {}
     for p in files:
         m = NAME.match(p.name)
@@ -94,10 +98,16 @@ def load_pair(take: Take) -> tuple[Motion, Motion]:
         raise DataError(f"take {take.name}: {lead_bvh.frames * lead_bvh.frame_time:.2f} s is too short "
                         f"(a sample needs {min_seconds:.2f} s)")
     try:
-        return (reduce_bvh(lead_bvh, str(take.leader_path)),
-                reduce_bvh(follow_bvh, str(take.follower_path)))
+        pair = (reduce_bvh(lead_bvh, str(take.leader_path)), reduce_bvh(follow_bvh, str(take.follower_path)))
     except BvhError as e:
         raise DataError(str(e)) from None
+    for path, motion in zip((take.leader_path, take.follower_path), pair):
+        head = float(motion.positions[:, HEAD, 1].mean())
+        if not HEAD_HEIGHT[0] <= head <= HEAD_HEIGHT[1]:
+            raise DataError(f"{path}: the head joint is {head:.2f} m above the floor on average, not "
+                            f"{HEAD_HEIGHT[0]}-{HEAD_HEIGHT[1]} m: other units than the CMU copy this "
+                            f"project reads (1 unit = {SCALE} m, training/skeleton.py SCALE), or not Y-up")
+    return pair
 
 
 def phases(motion: Motion) -> int:

@@ -8,8 +8,10 @@ training takes, and the recording itself ("ground_truth", the reference every me
 against). Three protocols:
 
 (a) teacher-forced: every input from the recording, one step; MPJPE of the t+1 pose in the
-    follower's root space (codes at temperature 0). Codebook error needs the output encoder,
-    which the ONNX lacks: it comes from the torch checkpoints in --runs when they are there.
+    follower's root space (codes at temperature 0). Codebook error: the step model's code at
+    temperature 0 against its output encoder's code of the recorded output, read from
+    MODELS/eval/NAME.output_encoder.onnx; a step model and an evaluation file (or manifest entry)
+    of different trainings (their fingerprints differ) are refused.
 (b) free-running: the leader is played back from the recording (its whole window, future keys
     included, every step); the follower starts from the recording's state and is fed its own
     output (rollout.apply_output), for each --seeds x --temperatures. MPJPE in root space against
@@ -39,10 +41,12 @@ from tqdm import tqdm
 
 from . import features as feat
 from . import metrics as M
-from .dataset import (DEFAULT_DATA, TEST_TAKES, VALIDATION_TAKES, DataError, discover_takes,
+from .dataset import (TEST_TAKES, VALIDATION_TAKES, DataError, discover_takes,
                       load_pair, pair_tracks, select_takes)
+from .folders import add_folder, add_retired
 from .features import FUTURE_OFFSETS, HISTORY, Track, follower_input, leader_input, output_features
 from .motion_matching import MotionMatching, build, load_tracks, own_future, training_takes
+from .stamp import eval_file, read_stamp
 from .rollout import NOW, Dancer, OnnxPolicy, apply_output, output_is_absurd, reset_beside
 
 OUT = feat.block_slices(feat.OUTPUT_LAYOUT)
@@ -128,17 +132,13 @@ def load_onnx(path: Path) -> OnnxPolicy:
         raise EvalError(f"{path}: cannot be loaded by onnxruntime ({e.__class__.__name__})") from None
 
 
-def checkpoint_name(method: str) -> str:
-    return {v: k for k, v in NAMES.items()}.get(method, method)
-
-
 # ---------------------------------------------------------------- (a) teacher-forced
 
 def teacher_forced(takes, policies: dict, mm_oracle: MotionMatching | None, bar) -> dict:
     """Per method: predicted O [N, 323] for every evaluated frame (inputs from the recording)."""
     x = np.concatenate([follower_input(t.lead, t.follow, t.frames) for t in takes])
     y = np.concatenate([output_features(t.follow, t.frames) for t in takes])
-    outputs = {}
+    outputs, codes = {}, {}
     for name, policy in policies.items():
         if name == "ground_truth":
             outputs[name] = y
@@ -147,74 +147,92 @@ def teacher_forced(takes, policies: dict, mm_oracle: MotionMatching | None, bar)
             outputs[name] = np.asarray(policy(x)["output"], np.float64)
         else:
             rng = np.random.default_rng(0)   # unused at temperature 0
-            outputs[name] = np.concatenate([policy(x[s:s + 512], 0.0, rng)["output"]
-                                            for s in range(0, len(x), 512)]).astype(np.float64)
+            res = [policy(x[s:s + 512], 0.0, rng) for s in range(0, len(x), 512)]
+            outputs[name] = np.concatenate([r["output"] for r in res]).astype(np.float64)
+            codes[name] = np.concatenate([r["code"] for r in res])
         bar.update(len(x))
     if mm_oracle is not None:
         fut = np.concatenate([own_future(t.follow, t.frames) for t in takes])
         outputs["motion_matching_oracle"] = np.asarray(mm_oracle(x, self_future=fut)["output"], np.float64)
-    return {"x": x, "y": y, "outputs": outputs}
+    return {"x": x, "y": y, "outputs": outputs, "codes": codes}
 
 
 def pose_positions(o: np.ndarray) -> np.ndarray:
     return o[:, OUT["pose"]].reshape(len(o), feat.N_JOINTS, 12)[..., :3]
 
 
-def codebook_errors(tf: dict, methods: list[str], runs: str, prepared: str, manifest: dict) -> tuple[dict, list[str]]:
-    """Codebook error per method from the torch checkpoints (None + a note where impossible).
+class OutputEncoder:
+    """An evaluation file (MODELS/eval/NAME.output_encoder.onnx): the code the output encoder of
+    one training gives a recorded or generated output, beside the input it answers."""
 
-    A model's target code is the output encoder's argmax on the recorded output, its estimate
-    the input encoder's argmax (temperature 0). Motion Matching has no encoder of its own: its
-    estimate is our output encoder's code of the frame it picked, against the same target."""
-    import torch
-    from .export import load_step_model
-    from .train import TrainError
-    torch.set_num_threads(1)
-    x, y = torch.from_numpy(tf["x"]).float(), torch.from_numpy(tf["y"]).float()
-    res, notes, models = {}, [], {}
+    def __init__(self, path: Path, stamp: dict):
+        import onnxruntime as ort
+        so = ort.SessionOptions()
+        so.intra_op_num_threads = 1
+        so.inter_op_num_threads = 1
+        try:
+            self.session = ort.InferenceSession(str(path), so, providers=["CPUExecutionProvider"])
+        except Exception as e:   # onnxruntime raises its own types for a damaged file
+            raise EvalError(f"{path}: cannot be loaded by onnxruntime ({e.__class__.__name__})") from None
+        self.channels, self.classes = stamp["channels"], stamp["classes"]
 
-    def model_for(method):
-        if method not in models:
-            name = checkpoint_name(method)
-            try:
-                m = load_step_model(Path(runs) / name, prepared)
-            except TrainError as e:
-                models[method] = None
-                notes.append(f"codebook error of {method}: {e}")
-                return None
-            shipped = manifest.get("models", {}).get(name, {})
-            mismatch = [k for k in ("channels", "classes", "hidden", "intention")
-                        if k in shipped and shipped[k] != getattr(m.cfg, k)]
-            if mismatch:
-                notes.append(f"codebook error of {method}: {Path(runs) / name} does not match the exported "
-                             f"model ({', '.join(mismatch)} differ); not computed")
-                m = None
-            models[method] = m
-        return models[method]
+    def codes(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """Code indices [N, C] of outputs y [N, 323] after inputs x [N, 660] (raw features)."""
+        logits = np.concatenate([self.session.run(None, {"input": x[s:s + 512].astype(np.float32),
+                                                         "output": y[s:s + 512].astype(np.float32)})[0]
+                                 for s in range(0, len(x), 512)])
+        return logits.reshape(len(x), self.channels, self.classes).argmax(-1)
 
-    @torch.no_grad()
-    def codes(m, out=None):
-        xn = (x - m.input_mean) / m.input_std
-        intention = m.predictor(xn) if m.cfg.intention else None
-        logits = (m.matching.estimate_logits(xn, intention) if out is None else
-                  m.matching.target_logits(xn, (out - m.output_mean) / m.output_std, intention))
-        return M.one_hot(logits.reshape(len(x), m.cfg.channels, -1).argmax(-1).numpy(), m.cfg.classes)
 
+def output_encoders(root: Path, manifest: dict, onnx: dict[str, Path], methods: list[str]) -> tuple[dict, list[str]]:
+    """{method: OutputEncoder or None} for the learned followers whose codebook error is needed
+    (ours too where Motion Matching is scored with it), and notes. Refuses (EvalError) a step model
+    beside an evaluation file or manifest entry of another training."""
+    wanted = [m for m in methods if m in onnx] + (["ours"] if "motion_matching" in methods and "ours" in onnx else [])
+    encoders, notes = {}, []
+    for method in dict.fromkeys(wanted):
+        step = onnx[method]
+        enc = eval_file(root, step.stem)
+        stamps = {str(step): read_stamp(step), str(enc): read_stamp(enc) if enc.exists() else None}
+        prints = {f: (st or {}).get("fingerprint") for f, st in stamps.items()}
+        listed = manifest.get("models", {}).get(step.stem)
+        if listed is not None:
+            prints[f"{root / 'manifest.json'} ({step.stem})"] = listed.get("fingerprint")
+        trainings = {fp: f for f, fp in prints.items() if fp}
+        if len(trainings) > 1:
+            (fa, a), (fb, b) = list(trainings.items())[:2]
+            raise EvalError(f"{a} and {b} come from different trainings (fingerprints {fa} and {fb}); "
+                            f"export them together: python -m training.export --models {root}")
+        if not enc.exists():
+            notes.append(f"codebook error of {method}: {enc} not found (python -m training.export writes it)")
+            encoders[method] = None
+            continue
+        unstamped = [f for f, fp in prints.items() if not fp]
+        if unstamped:
+            raise EvalError(f"{unstamped[0]} carries no training fingerprint, so {enc} cannot be matched "
+                            f"with it; export them together: python -m training.export --models {root}")
+        encoders[method] = OutputEncoder(enc, stamps[str(enc)])
+    return encoders, notes
+
+
+def codebook_errors(tf: dict, methods: list[str], encoders: dict) -> dict:
+    """Codebook error per method from the exported files (None where an evaluation file is missing).
+
+    A model's target code is its output encoder's argmax on the recorded output (the evaluation
+    file), its estimate the code its step model picks at temperature 0 (the shipped file). Motion
+    Matching has no encoder of its own: its estimate is our output encoder's code of the frame it
+    picked, against the same target."""
+    res = {}
     for method in methods:
-        if method == "ground_truth":
+        enc = encoders.get("ours" if method == "motion_matching" else method)
+        if method == "ground_truth" or enc is None:
             res[method] = None
             continue
-        m = model_for("ours" if method == "motion_matching" else method)
-        if m is None:
-            res[method] = None
-            continue
-        target = codes(m, y)
-        if method == "motion_matching":
-            estimate = codes(m, torch.from_numpy(tf["outputs"][method]).float())
-        else:
-            estimate = codes(m)
-        res[method] = M.codebook_error(target, estimate)
-    return res, notes
+        target = enc.codes(tf["x"], tf["y"])
+        estimate = (enc.codes(tf["x"], tf["outputs"][method]) if method == "motion_matching"
+                    else tf["codes"][method])
+        res[method] = M.codebook_error(M.one_hot(target, enc.classes), M.one_hot(estimate, enc.classes))
+    return res
 
 
 # ---------------------------------------------------------------- (b), (c) rollouts
@@ -462,6 +480,8 @@ def evaluate(args) -> dict:
             raise EvalError(f"{args.models}: no follower models (*.onnx with role follower in manifest.json)")
         methods = available
     methods = [m for m in methods if m != "ground_truth"] + ["ground_truth"]
+    encoders, encoder_notes = output_encoders(Path(args.models), manifest, onnx, methods)
+    notes += encoder_notes
     if any(p[0] == "model" for p in parsed.values()) and leader_onnx is None:
         dropped = [c for c, p in parsed.items() if p[0] == "model"]
         notes.append(f"no leader.onnx in {args.models}: skipped {', '.join(dropped)}")
@@ -512,8 +532,7 @@ def evaluate(args) -> dict:
     teacher = {}
     for m, o in tf["outputs"].items():
         teacher[m] = {"mpjpe_cm": M.mpjpe_cm(pose_positions(o), pose_positions(tf["y"]))}
-    cb, cb_notes = codebook_errors(tf, methods, args.runs, args.prepared, manifest)
-    notes += cb_notes
+    cb = codebook_errors(tf, methods, encoders)
     for m in methods:
         teacher[m]["codebook_error"] = cb.get(m)
     if mm is not None:
@@ -561,8 +580,10 @@ def evaluate(args) -> dict:
                           "rollout_mpjpe_cm": roll["mpjpe_cm"], "root_error_m": roll["root_error_m"],
                           "resets": roll["resets"]}
     if any(v is None for m, v in cb.items() if m != "ground_truth"):
-        notes.append("codebook error is null where no matching finished checkpoint was found in --runs "
-                     f"({args.runs}, normalization from {args.prepared})")
+        notes.append(f"codebook error is null where {args.models}/eval/ lacks the model's output encoder")
+    notes.append("codebook error: the step model's own code at temperature 0 (the exported int8 file) against "
+                 "the code its output encoder gives the recorded output (eval/NAME.output_encoder.onnx, fp32); "
+                 "both files carry one training's fingerprint")
     notes.append("MPJPE: joint positions in the follower's own root space (teacher-forced: the t+1 pose of "
                  "the output; rollout: the generated pose vs the recording at the same frame). Foot skate: "
                  f"horizontal ankle motion per frame while the ankle is below {feat.CONTACT_HEIGHT} m. "
@@ -572,7 +593,7 @@ def evaluate(args) -> dict:
         "takes": names, "frames": frames,
         "methods": methods_out,
         "protocols": {"teacher_forced": teacher, "rollout": rollouts, "controlled": controlled},
-        "config": {"data": str(args.data), "models": str(args.models), "runs": str(args.runs),
+        "config": {"data": str(args.data), "models": str(args.models),
                    "train_takes": train_names, "seeds": seeds, "temperatures": temps,
                    "headline_temperature": temps[0], "max_frames": args.max_frames,
                    "conditions": list(parsed), "encoder": {**cfg.__dict__, "fingerprint": encoder.state["fingerprint"]},
@@ -598,15 +619,17 @@ def clean(o):
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m training.evaluate", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--data", default=DEFAULT_DATA, help="folder of SUBJECT_TAKE.bvh pairs to evaluate on")
+    add_folder(ap, "data", "the takes to evaluate on")
     ap.add_argument("--takes", default=",".join(TEST_TAKES), help="comma-separated takes of --data")
-    ap.add_argument("--models", default="public/models", help="exported ONNX models + manifest.json")
+    add_folder(ap, "models", "the follower and leader models evaluated")
     ap.add_argument("--out", default="runs/eval", help="writes OUT/metrics.json and OUT/metrics.md")
     ap.add_argument("--methods", default=None,
                     help="comma-separated: ours, ccm, motion_matching, other follower ONNX names (default: all)")
-    ap.add_argument("--runs", default="runs/models", help="torch checkpoints (codebook error only)")
-    ap.add_argument("--prepared", default="runs/data", help="prepared data of those checkpoints (normalization)")
-    ap.add_argument("--train-data", default=DEFAULT_DATA, help="takes for Motion Matching and the encoder")
+    for flag in ("--runs", "--prepared"):
+        add_retired(ap, flag, "codebook error now comes from MODELS/eval/ (training.export writes it)")
+    ap.add_argument("--train-data", default=None, metavar="DIR",
+                    help="BVH couples whose training takes build Motion Matching and the evaluation "
+                         "encoder (default: --data)")
     ap.add_argument("--train-takes", default=None,
                     help="default: all of --train-data except validation, test and evaluated takes")
     ap.add_argument("--leader", default=None, help="subject that leads (default: first by name)")
@@ -620,6 +643,8 @@ def main(argv=None) -> int:
     ap.add_argument("--encoder-epochs", type=int, default=M.EncoderConfig.epochs)
     ap.add_argument("--quiet", action="store_true", help="no progress bar")
     args = ap.parse_args(argv)
+    if args.train_data is None:
+        args.train_data = args.data
     try:
         res = evaluate(args)
     except (EvalError, DataError) as e:

@@ -1,9 +1,16 @@
-"""python -m training.export: trained checkpoints -> dynamic-int8 ONNX step models + manifest.
+"""python -m training.export: trained runs -> dynamic-int8 ONNX step models + manifest.
+
+    python -m training.export                    # runs/models/{follower,follower_ccm,leader} -> public/models
+    python -m training.export --runs R --models M --model follower
 
 One ONNX file per model holds the whole step (normalization, intention, input encoder, Gumbel-max
 sampling with temperature and noise as inputs, gather decoder, de-normalization), so the page
 only builds features and reads results. Dynamic int8 (per channel) because static QDQ int8 runs
 6-8x slower in the browser's WASM backend.
+
+Each follower also gets MODELS/eval/NAME.output_encoder.onnx (fp32, evaluation only; the page
+never downloads it): what training.evaluate needs for the codebook error. Every file carries the
+run's fingerprint (training/stamp.py), repeated in manifest.json.
 """
 from __future__ import annotations
 
@@ -16,34 +23,20 @@ import numpy as np
 import torch
 
 from . import features as feat
-from .dataset import DEFAULT_DATA, DataError, discover_takes, load_pair
-from .models import CodebookMatching, IntentionPredictor, ModelConfig, StepModel
+from .dataset import DataError, discover_takes, load_pair
+from .folders import add_folder
+from .models import OutputEncoderStep, StepModel
+from .prepared import TrainError
+from .runs import fingerprint, load_run
+from .stamp import eval_file, write_stamp
 from .skeleton import FPS, JOINT_NAMES, KEY_JOINTS, PARENTS
-from .train import SHIPPED, TrainError, load_checkpoint, load_stats
+from .train import SHIPPED
 
 MANIFEST_VERSION = 1
 OPSET = 18
 DEFAULT_TEMPERATURE = 0.5
 CREDIT = ("The data used in this project was obtained from mocap.cs.cmu.edu. "
           "The database was created with funding from NSF EIA-0196217.")
-
-
-def load_step_model(run: Path, data: str) -> StepModel:
-    ckpt = run / "checkpoint.pt"
-    if not ckpt.exists():
-        raise TrainError(f"{ckpt} not found: train it first (python -m training.train --model {run.name})")
-    ck = load_checkpoint(ckpt)
-    if ck.get("stage") != "done":
-        raise TrainError(f"{ckpt}: training did not finish (stage {ck.get('stage')}); "
-                         f"continue it with --resume")
-    cfg = ModelConfig(**ck["config"]["model"])
-    predictor = IntentionPredictor(cfg) if cfg.intention else None
-    if predictor is not None:
-        predictor.load_state_dict(ck["predictor"])
-    matching = CodebookMatching(cfg)
-    matching.load_state_dict(ck["matching"])
-    model = StepModel(cfg, predictor, matching, load_stats(data, cfg.role))
-    return model.eval()
 
 
 def export_onnx(model: StepModel, path: Path) -> None:
@@ -56,6 +49,22 @@ def export_onnx(model: StepModel, path: Path) -> None:
                       input_names=["input", "temperature", "noise"], output_names=names,
                       dynamic_axes={"input": {0: "batch"}, "noise": {0: "batch"},
                                     **{n: {0: "batch"} for n in names}})
+
+
+def export_output_encoder(model: StepModel, path: Path) -> None:
+    """fp32 ONNX of OutputEncoderStep: (input [B, 660], output [B, 323]) -> target_logits [B, C*D].
+    fp32, not int8: it is the reference every follower's codes are scored against."""
+    cfg = model.cfg
+    path.parent.mkdir(parents=True, exist_ok=True)
+    torch.onnx.export(OutputEncoderStep(model).eval(), (torch.zeros(2, cfg.input_size), torch.zeros(2, cfg.output_size)),
+                      str(path), opset_version=OPSET, dynamo=False, input_names=["input", "output"],
+                      output_names=["target_logits"],
+                      dynamic_axes={"input": {0: "batch"}, "output": {0: "batch"}, "target_logits": {0: "batch"}})
+
+
+def stamp_of(name: str, model: StepModel) -> dict:
+    return {"fingerprint": fingerprint(model), "name": name, "role": model.cfg.role,
+            "channels": model.cfg.channels, "classes": model.cfg.classes}
 
 
 def quantize(src: Path, dst: Path) -> None:
@@ -96,9 +105,13 @@ def write_manifest(out: Path, models: dict[str, StepModel], data: str, prepared:
     }
     for name, m in models.items():
         f = out / f"{name}.onnx"
-        manifest["models"][name] = {"file": f.name, "bytes": f.stat().st_size, "role": m.cfg.role,
-                                    "channels": m.cfg.channels, "classes": m.cfg.classes,
-                                    "intention": m.cfg.intention, "hidden": m.cfg.hidden}
+        entry = manifest["models"][name] = {
+            "file": f.name, "bytes": f.stat().st_size, "role": m.cfg.role, "channels": m.cfg.channels,
+            "classes": m.cfg.classes, "intention": m.cfg.intention, "hidden": m.cfg.hidden,
+            "fingerprint": fingerprint(m)}
+        e = eval_file(out, name)
+        if m.cfg.role == "follower" and e.exists():
+            entry["eval"] = {"outputEncoder": str(e.relative_to(out)), "bytes": e.stat().st_size}
     (out / "manifest.json").write_text(json.dumps(manifest, indent=1))
     return manifest
 
@@ -110,10 +123,15 @@ def export_all(names: list[str], runs: str, out: str, data: str, prepared: str, 
     fp32_dir.mkdir(parents=True, exist_ok=True)
     models = {}
     for name in names:
-        model = load_step_model(Path(runs) / name, prepared)
+        model = load_run(Path(runs) / name, prepared).model
         fp32 = fp32_dir / f"{name}.onnx"
         export_onnx(model, fp32)
         quantize(fp32, out_dir / f"{name}.onnx")
+        stamp = stamp_of(name, model)
+        write_stamp(out_dir / f"{name}.onnx", stamp)
+        if model.cfg.role == "follower":
+            export_output_encoder(model, eval_file(out_dir, name))
+            write_stamp(eval_file(out_dir, name), stamp)
         models[name] = model
         print(f"{name}: fp32 {fp32.stat().st_size / 1e6:.2f} MB -> int8 "
               f"{(out_dir / f'{name}.onnx').stat().st_size / 1e6:.2f} MB")
@@ -121,21 +139,22 @@ def export_all(names: list[str], runs: str, out: str, data: str, prepared: str, 
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m training.export", description=__doc__)
+    ap = argparse.ArgumentParser(prog="python -m training.export", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--model", action="append", help=f"default: {', '.join(SHIPPED)}")
-    ap.add_argument("--runs", default="runs/models", help="training output folder")
-    ap.add_argument("--prepared", default="runs/data", help="prepared data (for normalization)")
-    ap.add_argument("--data", default=DEFAULT_DATA, help="BVH folder (skeleton offsets)")
-    ap.add_argument("--out", default="public/models")
+    add_folder(ap, "runs", "read")
+    add_folder(ap, "prepared", "read for the normalization")
+    add_folder(ap, "data", "read for the skeleton offsets")
+    add_folder(ap, "models", "written", old=("--out",))
     ap.add_argument("--fp32", default=None, help="where to keep the fp32 ONNX (default RUNS/fp32)")
     args = ap.parse_args(argv)
     try:
-        m = export_all(args.model or SHIPPED, args.runs, args.out, args.data, args.prepared, args.fp32)
+        m = export_all(args.model or SHIPPED, args.runs, args.models, args.data, args.prepared, args.fp32)
     except (TrainError, DataError) as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
     total = sum(v["bytes"] for v in m["models"].values())
-    print(f"wrote {args.out}/manifest.json; models total {total / 1e6:.2f} MB")
+    print(f"wrote {args.models}/manifest.json; models total {total / 1e6:.2f} MB")
     return 0
 
 

@@ -12,14 +12,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .skeleton import FEET, KEY_JOINTS, FPS, Motion, root_from_motion
+from .skeleton import FEET, FPS, JOINT_NAMES, KEY_JOINTS, Motion, root_from_motion
 
 KEYS = 6                                     # trajectory keys per second (the paper's k)
 KEY_STEP = FPS // KEYS                       # 5 frames between keys at 30 fps
 PAST_OFFSETS = np.arange(-KEYS, 0) * KEY_STEP        # t-30 ... t-5
 FUTURE_OFFSETS = np.arange(1, KEYS + 1) * KEY_STEP   # t+5 ... t+30
 HISTORY = KEYS * KEY_STEP                    # 30 frames of past are needed
-N_JOINTS = 17
+N_JOINTS = len(JOINT_NAMES)                  # 17
 N_KEY_JOINTS = len(KEY_JOINTS)
 
 TRAJECTORY_SIZE = KEYS * 4                   # 24

@@ -19,10 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .features import CONTACT_HEIGHT, Track, pose_block, root_update
-from .skeleton import FEET, FPS
-
-HANDS = [7, 10]          # lHand, rHand
+from .features import CONTACT_HEIGHT, POSE_SIZE, ROOT_UPDATE_SIZE, Track, pose_block, root_update
+from .skeleton import FEET, FPS, HANDS
 
 
 # ---------------------------------------------------------------- pose and motion quality
@@ -204,7 +202,7 @@ def diversity(x: np.ndarray, pairs: int = 300, seed: int = 0) -> float:
 # ---------------------------------------------------------------- windows of motion
 
 WINDOW = 15
-FRAME_FEATURES = 204 + 3
+FRAME_FEATURES = POSE_SIZE + ROOT_UPDATE_SIZE     # 207
 
 
 def motion_features(track: Track, frames: np.ndarray) -> np.ndarray:

@@ -6,6 +6,7 @@ trained pieces with normalization so one call is one animation step (what export
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass
+from typing import NamedTuple
 
 import torch
 import torch.nn as nn
@@ -114,6 +115,22 @@ class CodebookMatching(nn.Module):
         return self.decoder(code), code
 
 
+class Logits(NamedTuple):
+    estimate: torch.Tensor               # Ŝ from the input encoder [B, C*D]
+    target: torch.Tensor | None          # S from the output encoder, when an output was given
+    intention: torch.Tensor | None       # the predictor's (normalized) intention; None for CCM
+
+
+def code_logits(predictor: IntentionPredictor | None, matching: CodebookMatching, xn: torch.Tensor,
+                yn: torch.Tensor | None = None) -> Logits:
+    """Normalized input (and output) -> intention -> code logits: the one way every caller
+    (training's validation, the step model, evaluation, plots) reads the encoders."""
+    intention = predictor(xn) if matching.cfg.intention else None
+    estimate = matching.estimate_logits(xn, intention)
+    target = None if yn is None else matching.target_logits(xn, yn, intention)
+    return Logits(estimate, target, intention)
+
+
 class Discriminator(nn.Module):
     """Tells target logits S from estimated Ŝ (2 layers). It sees per-channel log-softmax: the
     logits without their arbitrary per-channel offset, so it judges the distribution itself."""
@@ -143,10 +160,14 @@ class StepModel(nn.Module):
         for k, v in stats.items():
             self.register_buffer(k, v.float())
 
-    def forward(self, x, temperature, noise):
+    def logits(self, x: torch.Tensor, y: torch.Tensor | None = None) -> Logits:
+        """code_logits on raw features: normalized here with the model's own statistics."""
         xn = (x - self.input_mean) / self.input_std
-        intention_n = self.predictor(xn) if self.cfg.intention else None
-        logits = self.matching.estimate_logits(xn, intention_n)
+        yn = None if y is None else (y - self.output_mean) / self.output_std
+        return code_logits(self.predictor, self.matching, xn, yn)
+
+    def forward(self, x, temperature, noise):
+        logits, _, intention_n = self.logits(x)
         b, c = x.shape[0], self.cfg.channels
         u = noise.clamp(1e-7, 1 - 1e-7)
         z = logits.reshape(b, c, -1) + temperature.reshape(1, 1, 1) * -torch.log(-torch.log(u.reshape(b, c, -1)))
@@ -165,3 +186,18 @@ class StepModel(nn.Module):
         columns = code + torch.arange(self.cfg.channels, device=code.device) * d   # [B, C]
         h = first.weight.t()[columns].sum(1) + first.bias
         return rest(h)
+
+
+class OutputEncoderStep(nn.Module):
+    """Evaluation only: raw input I [B, 660] and the recorded output O [B, 323] -> the output
+    encoder's target logits S [B, C*D], normalization and intention inside (export writes it as
+    eval/NAME.output_encoder.onnx; the page never loads it). Its argmax is the code the recorded
+    motion gets, against which a step model's own code is scored (codebook error)."""
+
+    def __init__(self, step: StepModel):
+        super().__init__()
+        self.step = step
+
+    def forward(self, x, y):
+        return self.step.logits(x, y).target
+

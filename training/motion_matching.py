@@ -43,8 +43,9 @@ import time
 import numpy as np
 
 from . import features as feat
-from .dataset import (DEFAULT_DATA, TEST_TAKES, VALIDATION_TAKES, DataError, discover_takes,
+from .dataset import (TEST_TAKES, VALIDATION_TAKES, DataError, discover_takes,
                       load_pair, pair_tracks, select_takes)
+from .folders import add_folder
 from .features import FUTURE_OFFSETS, KEYS, Track, output_features, trajectory_block, valid_frames
 
 FOLLOWER_IN = feat.block_slices(feat.FOLLOWER_INPUT_LAYOUT)
@@ -318,7 +319,7 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m training.motion_matching", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--bench", action="store_true", help="time brute force vs bounding boxes")
-    ap.add_argument("--data", default=DEFAULT_DATA, help="folder of SUBJECT_TAKE.bvh pairs")
+    add_folder(ap, "data", "the training takes are the database, the test takes the queries")
     ap.add_argument("--role", default="follower", choices=["follower", "leader"])
     ap.add_argument("--queries", type=int, default=300, help="queries from the test takes")
     args = ap.parse_args(argv)

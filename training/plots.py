@@ -141,14 +141,15 @@ def evenly(n: int, k: int) -> np.ndarray:
 def run_state(run: Path) -> dict | None:
     """{'stage', 'epoch', 'history', 'config'} of a training folder, or None when there is no
     readable checkpoint. history.json is preferred for a finished run (it is written last)."""
+    from .prepared import TrainError
+    from .runs import load_checkpoint
     ckpt = run / "checkpoint.pt"
     hist = run / "history.json"
     if not ckpt.exists():
         return None
-    import torch
     try:
-        ck = torch.load(ckpt, map_location="cpu", weights_only=False)
-    except Exception:   # being written right now, or damaged
+        ck = load_checkpoint(ckpt)
+    except TrainError:   # being written right now, or damaged
         return None
     history = ck.get("history", {})
     if ck.get("stage") == "done" and hist.exists():
@@ -159,20 +160,20 @@ def run_state(run: Path) -> dict | None:
     return {"stage": ck.get("stage"), "epoch": ck.get("epoch"), "history": history, "config": ck.get("config", {})}
 
 
-def load_model(runs: Path, name: str, data: str):
-    """A finished StepModel, or Skip with the reason."""
-    from .export import load_step_model
-    from .train import TrainError
+def load_model(runs: Path, name: str, prepared: str):
+    """The step model of a finished run, or Skip with the reason."""
+    from .prepared import TrainError
+    from .runs import load_run
     try:
-        return load_step_model(runs / name, data)
+        return load_run(runs / name, prepared).model
     except TrainError as e:
         raise Skip(str(e)) from None
 
 
-def load_test(data: str) -> dict[str, np.ndarray]:
-    from .train import TrainError, load_split
+def load_test(prepared: str) -> dict[str, np.ndarray]:
+    from .prepared import TrainError, load_split
     try:
-        return load_split(data, "test", "follower")
+        return load_split(prepared, "test", "follower")
     except TrainError as e:
         raise Skip(str(e)) from None
 
@@ -183,14 +184,9 @@ def encode(model, x_raw: np.ndarray, y_raw: np.ndarray | None = None):
     import torch
     with torch.no_grad():
         x = torch.from_numpy(np.asarray(x_raw, np.float32))
-        xn = (x - model.input_mean) / model.input_std
-        intention = model.predictor(xn) if model.cfg.intention else None
-        est = model.matching.estimate_logits(xn, intention).numpy()
-        tgt = None
-        if y_raw is not None:
-            y = torch.from_numpy(np.asarray(y_raw, np.float32))
-            tgt = model.matching.target_logits(xn, (y - model.output_mean) / model.output_std, intention).numpy()
-    return est, tgt
+        y = None if y_raw is None else torch.from_numpy(np.asarray(y_raw, np.float32))
+        est, tgt, _ = model.logits(x, y)
+    return est.numpy(), None if tgt is None else tgt.numpy()
 
 
 def codes_of(logits: np.ndarray, channels: int) -> np.ndarray:
@@ -222,14 +218,14 @@ def _plt():
 
 def figure_tsne(args, out: Path) -> list[str]:
     from sklearn.manifold import TSNE
-    test = load_test(args.data)
+    test = load_test(args.prepared)
     idx = evenly(len(test["input"]), args.tsne_frames)
     x, y = test["input"][idx], test["output"][idx]
     panels = []
     for name, title in (("follower", "with adversarial training (ours)"),
                         ("follower_no_gan", "without adversarial training (λG = 0)")):
         try:
-            m = load_model(Path(args.runs), name, args.data)
+            m = load_model(Path(args.runs), name, args.prepared)
         except Skip as e:
             if name == "follower":
                 raise
@@ -291,14 +287,14 @@ def motion_matching_policy(args):
     from .dataset import DataError
     from .motion_matching import build, load_tracks, training_takes
     try:
-        return build(load_tracks(training_takes(args.bvh)), "follower")
+        return build(load_tracks(training_takes(args.data)), "follower")
     except DataError as e:
         raise Skip(f"Motion Matching: {e}") from None
 
 
 def codebook_errors_under_control(args) -> tuple[dict, dict, list[str]]:
     """{method: {angle: per-frame errors}}, {method: classes*channels}, notes."""
-    test = load_test(args.data)
+    test = load_test(args.prepared)
     x, y = test["input"].astype(np.float64), test["output"]
     angles = [0.0] + CONTROL_ANGLES
     inputs = {a: rotate_partner_future(x, a) for a in angles}
@@ -307,7 +303,7 @@ def codebook_errors_under_control(args) -> tuple[dict, dict, list[str]]:
     models = {}
     for name in names:
         try:
-            models[name] = load_model(Path(args.runs), name, args.data)
+            models[name] = load_model(Path(args.runs), name, args.prepared)
         except Skip as e:
             if name == "follower":
                 raise
@@ -492,7 +488,7 @@ def figure_rollout(args, out: Path) -> list[str]:
     from .dataset import DataError
     try:
         manifest, onnx, _ = E.find_models(args.models)
-        take = E.load_eval_takes(args.bvh, [args.take], args.frames, None)[0]
+        take = E.load_eval_takes(args.data, [args.take], args.frames, None)[0]
     except (E.EvalError, DataError) as e:
         raise Skip(str(e)) from None
     methods = [(n, k) for n, k in (("ours", "follower"), ("ccm", "follower_ccm")) if n in onnx]
@@ -643,16 +639,16 @@ def figure_curves(args, out: Path) -> list[str]:
 # ---------------------------------------------------------------- main
 
 def main(argv=None) -> int:
-    from .dataset import DEFAULT_DATA
+    from .folders import add_folder
     ap = argparse.ArgumentParser(prog="python -m training.plots", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--out", default="docs", help="folder for the PNGs")
     ap.add_argument("--only", default=",".join(FIGURES), help=f"comma-separated subset of {','.join(FIGURES)}")
-    ap.add_argument("--data", default="runs/data", help="prepared data (training.prepare)")
-    ap.add_argument("--runs", default="runs/models", help="training output (checkpoints, history)")
+    add_folder(ap, "prepared", "test split for t-SNE and codebook error")
+    add_folder(ap, "runs", "checkpoints and training history")
     ap.add_argument("--sweep", default="runs/sweep", help="λG sweep: one folder per value, each with follower/")
-    ap.add_argument("--models", default="public/models", help="exported ONNX + manifest (rollout)")
-    ap.add_argument("--bvh", default=DEFAULT_DATA, help="BVH takes (rollout, Motion Matching database)")
+    add_folder(ap, "models", "rollout top view")
+    add_folder(ap, "data", "rollout take, Motion Matching database", old=("--bvh",))
     ap.add_argument("--eval", default="runs/eval/metrics.json", help="training.evaluate output (cross-checks)")
     ap.add_argument("--take", default="13", help="test take of the rollout")
     ap.add_argument("--frames", type=int, default=600, help="rollout steps at most")

@@ -1,7 +1,8 @@
 """python -m training.prepare: paired BVH takes -> feature arrays for training (git-ignored).
 
-Writes OUT/{train,validation,test}.npz (both roles, all phase offsets, mirrored copies in train)
-and OUT/stats.npz (normalization), then prints frames per split and feature sizes.
+Reads the BVH couples in --data; writes PREPARED/{train,validation,test}.npz (both roles, all phase
+offsets, mirrored copies in train) and PREPARED/stats.npz (normalization), then prints frames per
+split and feature sizes.
 """
 from __future__ import annotations
 
@@ -14,10 +15,9 @@ import numpy as np
 from tqdm import tqdm
 
 from . import features as F
-from .dataset import (DEFAULT_DATA, TEST_TAKES, VALIDATION_TAKES, DataError, discover_takes,
-                      load_pair, pair_tracks, phases, samples)
-
-DEFAULT_OUT = "runs/data"
+from .dataset import (TEST_TAKES, VALIDATION_TAKES, DataError, discover_takes, load_pair, pair_tracks,
+                      phases, samples)
+from .folders import add_folder
 
 
 def split_of(take: str, validation: list[str], test: list[str]) -> str:
@@ -90,9 +90,10 @@ def print_summary(s: dict) -> None:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m training.prepare", description=__doc__)
-    ap.add_argument("--data", default=DEFAULT_DATA, help="folder of SUBJECT_TAKE.bvh pairs")
-    ap.add_argument("--out", default=DEFAULT_OUT, help="output folder (git-ignored)")
+    ap = argparse.ArgumentParser(prog="python -m training.prepare", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    add_folder(ap, "data", "read")
+    add_folder(ap, "prepared", "written (git-ignored)", old=("--out",))
     ap.add_argument("--validation", default=",".join(VALIDATION_TAKES), help="comma-separated takes")
     ap.add_argument("--test", default=",".join(TEST_TAKES), help="comma-separated takes")
     ap.add_argument("--leader", default=None, help="subject that leads (default: first by name)")
@@ -100,13 +101,13 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     t0 = time.time()
     try:
-        s = prepare(args.data, args.out, [t for t in args.validation.split(",") if t],
+        s = prepare(args.data, args.prepared, [t for t in args.validation.split(",") if t],
                     [t for t in args.test.split(",") if t], args.leader, not args.one_phase)
     except DataError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
     print_summary(s)
-    print(f"wrote {args.out}/{{train,validation,test,stats}}.npz in {time.time() - t0:.1f} s")
+    print(f"wrote {args.prepared}/{{train,validation,test,stats}}.npz in {time.time() - t0:.1f} s")
     return 0
 
 

@@ -17,8 +17,8 @@ import numpy as np
 
 from . import features as feat
 from .contact import ContactLayer
-from .features import (FUTURE_OFFSETS, HISTORY, KEY_STEP, KEYS, Track, follower_input,
-                       from_root_space_directions, from_root_space_points, leader_input)
+from .features import (FUTURE_OFFSETS, HISTORY, KEYS, Track, follower_input, from_root_space_directions,
+                       from_root_space_points, leader_input)
 from .skeleton import FEET, FPS, KEY_JOINTS, forward_kinematics_reduced
 
 NOW = HISTORY

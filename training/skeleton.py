@@ -22,9 +22,11 @@ JOINT_NAMES = [
     "lThigh", "lShin", "lFoot", "rThigh", "rShin", "rFoot",
 ]
 PARENTS = [-1, 0, 1, 2, 3, 2, 5, 6, 2, 8, 9, 0, 11, 12, 0, 14, 15]
+HEAD = JOINT_NAMES.index("head")
+HANDS = [JOINT_NAMES.index("lHand"), JOINT_NAMES.index("rHand")]      # 7, 10
+FEET = [JOINT_NAMES.index("lFoot"), JOINT_NAMES.index("rFoot")]       # 13, 16 (the ankles)
 # Head, both hands, both feet: the paper's five key joints for trajectories and intention.
-KEY_JOINTS = [4, 7, 10, 13, 16]
-FEET = [13, 16]
+KEY_JOINTS = [HEAD, *HANDS, *FEET]                                   # 4, 7, 10, 13, 16
 # Index of each joint's left/right twin (itself for the spine).
 MIRROR = [JOINT_NAMES.index(("r" + n[1:]) if n[0] == "l" and n[1].isupper()
                             else ("l" + n[1:]) if n[0] == "r" and n[1].isupper() else n)

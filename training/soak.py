@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
+from .folders import add_folder
 from .rollout import NOW, OnnxPolicy, start_duet, step
 from . import metrics as M
 from .skeleton import FEET, FPS, PARENTS
@@ -145,7 +146,7 @@ def failures(r: dict) -> list[str]:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m training.soak", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--models", default="public/models")
+    add_folder(ap, "models", "the leader and follower that dance")
     ap.add_argument("--follower", default="follower", help="follower model name in the manifest")
     ap.add_argument("--rollouts", type=int, default=100)
     ap.add_argument("--minutes", type=float, default=10.0)

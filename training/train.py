@@ -5,16 +5,16 @@
     python -m training.train --all --smoke      # tiny run for CI (< 2 min)
     torchrun --nproc_per_node 2 -m training.train --model follower   # data parallel (DDP)
 
-Each model lives in runs/models/NAME/: checkpoint.pt (resume with --resume), losses.png,
-history.json. Bad input (no prepared data, feature sizes that do not match, a corrupt checkpoint)
-stops with a one-line error instead of quietly starting over.
+Reads the prepared arrays (--prepared, default runs/data); each model lives in --runs (default
+runs/models) as NAME/: checkpoint.pt (resume with --resume), losses.png, history.json. Bad input
+(no prepared data, feature sizes that do not match, a corrupt checkpoint) stops with a one-line
+error instead of quietly starting over.
 """
 from __future__ import annotations
 
 import argparse
 import json
 import math
-import os
 import sys
 import time
 from dataclasses import asdict, dataclass, field, replace
@@ -22,17 +22,18 @@ from pathlib import Path
 
 import numpy as np
 import torch
-import torch.distributed as dist
 import torch.nn.functional as F
 from tqdm import tqdm
 
 from . import features as feat
-from .models import CodebookMatching, Discriminator, IntentionPredictor, ModelConfig, sample_codes
+from .distributed import average_gradients, broadcast_parameters, pick_device, setup_distributed, stop_distributed
+from .folders import add_folder
+from .loss_plot import plot_history
+from .models import CodebookMatching, Discriminator, IntentionPredictor, ModelConfig, code_logits, sample_codes
+from .prepared import (TrainError, load_mirror_flags, load_offsets, load_split, load_stats, normalize,
+                       pose_error_cm)
+from .runs import load_checkpoint, save_checkpoint
 from .partner_losses import partner_terms
-from .skeleton import MIRROR
-
-DEFAULT_DATA = "runs/data"
-DEFAULT_OUT = "runs/models"
 
 
 @dataclass
@@ -92,72 +93,7 @@ MODELS = {
 SHIPPED = ["follower", "follower_ccm", "leader"]
 
 
-class TrainError(RuntimeError):
-    pass
-
-
 # ---------------------------------------------------------------- data
-
-def load_split(data: str, split: str, role: str) -> dict[str, np.ndarray]:
-    path = Path(data) / f"{split}.npz"
-    if not path.exists():
-        raise TrainError(f"{path} not found: run `python -m training.prepare --out {data}` first")
-    try:
-        with np.load(path) as z:
-            arrays = {k: z[f"{role}_{k}"] for k in ("input", "output", "intention")}
-    except Exception as e:  # zipfile, pickle and key errors all mean the same thing here
-        raise TrainError(f"{path}: unreadable or not written by training.prepare "
-                         f"({e.__class__.__name__}); re-run training.prepare") from None
-    sizes = {"input": feat.INPUT_SIZE, "output": feat.OUTPUT_SIZE, "intention": feat.INTENTION_SIZE}
-    for k, n in sizes.items():
-        if arrays[k].shape[1] != n:
-            raise TrainError(f"{path}: {role} {k} has {arrays[k].shape[1]} features, this code "
-                             f"expects {n}; re-run training.prepare")
-    return arrays
-
-
-def load_stats(data: str, role: str) -> dict[str, torch.Tensor]:
-    path = Path(data) / "stats.npz"
-    if not path.exists():
-        raise TrainError(f"{path} not found: run `python -m training.prepare --out {data}` first")
-    try:
-        with np.load(path) as z:
-            return {f"{k}_{s}": torch.from_numpy(z[f"{role}_{k}_{s}"])
-                    for k in ("input", "output", "intention") for s in ("mean", "std")}
-    except Exception as e:
-        raise TrainError(f"{path}: unreadable or not written by training.prepare "
-                         f"({e.__class__.__name__}); re-run training.prepare") from None
-
-
-def load_offsets(data: str, role: str, device) -> torch.Tensor:
-    """[2, 17, 3] bone offsets of the role: as recorded, and mirrored (prepare's mirrored samples)."""
-    with np.load(Path(data) / "stats.npz") as z:
-        if f"{role}_offsets" not in z:
-            raise TrainError(f"{data}/stats.npz has no bone offsets (written by an older training.prepare); "
-                             f"re-run training.prepare")
-        off = z[f"{role}_offsets"]
-    return torch.tensor(np.stack([off, off[MIRROR] @ np.diag([-1.0, 1.0, 1.0])]), dtype=torch.float32, device=device)
-
-
-def load_mirror_flags(data: str) -> np.ndarray:
-    """Per training sample: True where it is a mirrored copy (its skeleton is mirrored too)."""
-    with np.load(Path(data) / "train.npz") as z:
-        return z["mirror"].astype(bool)
-
-
-def normalize(a: np.ndarray, stats: dict[str, torch.Tensor], key: str) -> torch.Tensor:
-    """Raw features -> normalized float32 tensor with the prepared mean/std of `key`."""
-    return ((torch.from_numpy(a) - stats[f"{key}_mean"]) / stats[f"{key}_std"]).float()
-
-
-def pose_error_cm(y_hat: torch.Tensor, y: torch.Tensor, stats: dict[str, torch.Tensor]) -> torch.Tensor:
-    """Per-sample MPJPE in cm between two normalized outputs [B, 323]: the pose block's joint
-    positions (dancer's root space), de-normalized."""
-    pose = feat.block_slices(feat.OUTPUT_LAYOUT)["pose"]
-    mean, std = stats["output_mean"].to(y.device), stats["output_std"].to(y.device)
-    p, q = ((t * std + mean)[:, pose].reshape(len(t), feat.N_JOINTS, 12)[..., :3] for t in (y_hat, y))
-    return (p - q).norm(dim=-1).mean(-1) * 100
-
 
 def augment_control(x: torch.Tensor, cfg: TrainConfig, gen: torch.Generator) -> torch.Tensor:
     """Leader only: turn and jitter the control path (raw features) so that a steered path that
@@ -177,83 +113,10 @@ def augment_control(x: torch.Tensor, cfg: TrainConfig, gen: torch.Generator) -> 
     return x
 
 
-# ---------------------------------------------------------------- distributed
-
-def setup_distributed(device: str):
-    if "WORLD_SIZE" not in os.environ or int(os.environ["WORLD_SIZE"]) == 1:
-        return 0, 1
-    backend = "nccl" if device.startswith("cuda") else "gloo"
-    dist.init_process_group(backend)
-    return dist.get_rank(), dist.get_world_size()
-
-
-def pick_device(name: str) -> str:
-    if name == "auto":
-        if torch.cuda.is_available():
-            return f"cuda:{int(os.environ.get('LOCAL_RANK', 0))}"
-        return "cpu"
-    return name
-
-
-def average_gradients(modules, world: int):
-    """All-reduce gradients by hand: the GAN's alternating updates touch different modules per
-    step, which DistributedDataParallel's single-backward assumption does not fit."""
-    if world == 1:
-        return
-    for m in modules:
-        for p in m.parameters():
-            if p.grad is not None:
-                dist.all_reduce(p.grad)
-                p.grad /= world
-
-
-def broadcast_parameters(modules, world: int):
-    if world == 1:
-        return
-    for m in modules:
-        for p in m.state_dict().values():
-            dist.broadcast(p, 0)
-
-
 # ---------------------------------------------------------------- training
 
 def cosine(step: int, total: int, lr: float) -> float:
     return lr * 0.5 * (1 + math.cos(math.pi * min(step, total) / max(total, 1)))
-
-
-def plot_history(history: dict, path: Path, title: str):
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    keys = [k for k in history if history[k]]
-    cols = min(4, len(keys))
-    rows = (len(keys) + cols - 1) // cols
-    fig, axes = plt.subplots(rows, cols, figsize=(3.2 * cols, 2.6 * rows), squeeze=False)
-    for ax in axes.flat[len(keys):]:
-        ax.axis("off")
-    for ax, k in zip(axes.flat, keys):
-        ax.plot(np.arange(1, len(history[k]) + 1), history[k])
-        ax.set_title(k, fontsize=9)
-        ax.set_xlabel("epoch", fontsize=8)
-        ax.set_yscale("log" if min(history[k]) > 0 else "linear")
-    fig.suptitle(title, fontsize=10)
-    fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
-
-
-def save_checkpoint(path: Path, state: dict):
-    tmp = path.with_suffix(".tmp")
-    torch.save(state, tmp)
-    tmp.replace(path)   # a crash mid-write never leaves a half checkpoint behind
-
-
-def load_checkpoint(path: Path) -> dict:
-    try:
-        return torch.load(path, map_location="cpu", weights_only=False)
-    except Exception as e:  # torch raises many types for a damaged file
-        raise TrainError(f"{path}: checkpoint is unreadable ({e.__class__.__name__}); "
-                         f"delete it to train from scratch") from None
 
 
 def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = "cpu",
@@ -460,9 +323,9 @@ def validate(predictor, matching, mcfg, xv, yv, device, stats, batch=4096):
     se, cb, pe, n = 0.0, 0.0, 0.0, 0
     for s in range(0, len(xv), batch):
         x, yb = xv[s:s + batch].to(device), yv[s:s + batch].to(device)
-        intention = predictor(x) if mcfg.intention else None
-        y_hat, code_hat = matching.generate(x, intention, 0.0)
-        code = sample_codes(matching.target_logits(x, yb, intention), mcfg.channels, 0.0)
+        s_hat, s_target, _ = code_logits(predictor, matching, x, yb)
+        code_hat, code = (sample_codes(l, mcfg.channels, 0.0) for l in (s_hat, s_target))
+        y_hat = matching.decoder(code_hat)
         se += F.mse_loss(y_hat, yb, reduction="sum").item() / yb.shape[1]
         cb += F.mse_loss(code, code_hat, reduction="sum").item() / code.shape[1]
         pe += pose_error_cm(y_hat, yb, stats).sum().item()
@@ -482,15 +345,15 @@ def main(argv=None) -> int:
     ap.add_argument("--model", action="append", choices=sorted(MODELS), help="model(s) to train")
     ap.add_argument("--all", action="store_true", help=f"train the shipped models: {', '.join(SHIPPED)}")
     ap.add_argument("--ablations", action="store_true", help="train the evaluation-only models too")
-    ap.add_argument("--data", default=DEFAULT_DATA, help="prepared data (training.prepare --out)")
-    ap.add_argument("--out", default=DEFAULT_OUT)
+    add_folder(ap, "prepared", "read", old=("--data",))
+    add_folder(ap, "runs", "written, one folder per model", old=("--out",))
     ap.add_argument("--epochs", type=int, help="override matching epochs")
     ap.add_argument("--intention-epochs", type=int)
     ap.add_argument("--lambda-generator", type=float, help="override λG (λC stays as configured)")
     ap.add_argument("--seed", type=int, help="override the seed (seed-to-seed spread)")
     ap.add_argument("--channels", type=int, help="override the number of code channels C")
     ap.add_argument("--smoke", action="store_true", help="tiny sizes and 2 epochs (CI)")
-    ap.add_argument("--resume", action="store_true", help="continue from runs/models/NAME/checkpoint.pt")
+    ap.add_argument("--resume", action="store_true", help="continue from RUNS/NAME/checkpoint.pt")
     ap.add_argument("--device", default="cpu", help="cpu, cuda, cuda:N or auto")
     ap.add_argument("--threads", type=int, default=0, help="torch CPU threads (0 = torch default)")
     args = ap.parse_args(argv)
@@ -521,15 +384,14 @@ def main(argv=None) -> int:
                 cfg = replace(cfg, model=replace(cfg.model, channels=args.channels))
             if args.lambda_generator is not None:
                 cfg = replace(cfg, lambda_generator=args.lambda_generator)
-            r = train_model(name, cfg, args.data, args.out, device, args.resume, rank=rank, world=world)
+            r = train_model(name, cfg, args.prepared, args.runs, device, args.resume, rank=rank, world=world)
             if rank == 0:
                 print(f"{name}: done in {r['seconds']:.0f} s, val mse {r['val_mse']:.4f}")
     except TrainError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
     finally:
-        if world > 1:
-            dist.destroy_process_group()
+        stop_distributed(world)
     if rank == 0:
         print(f"total wall time {time.time() - t0:.0f} s on {device} x{world}")
     return 0

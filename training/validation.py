@@ -17,28 +17,25 @@ from pathlib import Path
 
 import torch
 
-from .models import CodebookMatching, IntentionPredictor, ModelConfig, sample_codes
-from .train import (DEFAULT_DATA, TrainError, load_checkpoint, load_split, load_stats, normalize,
-                    pose_error_cm, validate)
+from .folders import add_folder
+from .models import code_logits, sample_codes
+from .prepared import TrainError, load_split, normalize, pose_error_cm
+from .runs import load_run
+from .train import validate
 
 
 @torch.no_grad()
-def measure(run: Path, data: str) -> dict:
-    ck = load_checkpoint(run / "checkpoint.pt")
-    if ck.get("stage") != "done":
-        raise TrainError(f"{run}: training has not finished (stage {ck.get('stage')})")
-    cfg = ModelConfig(**ck["config"]["model"])
-    predictor, matching = IntentionPredictor(cfg), CodebookMatching(cfg)
-    predictor.load_state_dict(ck["predictor"]); matching.load_state_dict(ck["matching"])
-    stats, val = load_stats(data, cfg.role), load_split(data, "validation", cfg.role)
+def measure(run: Path, prepared: str) -> dict:
+    r = load_run(run, prepared)
+    cfg, stats = r.cfg, r.stats
+    val = load_split(prepared, "validation", cfg.role)
     x, y = normalize(val["input"], stats, "input"), normalize(val["output"], stats, "output")
-    _, codebook, mpjpe = validate(predictor, matching, cfg, x, y, "cpu", stats)
-    intention = predictor(x) if cfg.intention else None
-    target = sample_codes(matching.target_logits(x, y, intention), cfg.channels, 0.0)
-    return {"run": str(run), "intention": cfg.intention, "channels": cfg.channels, "seed": ck["config"]["seed"],
+    _, codebook, mpjpe = validate(r.predictor, r.matching, cfg, x, y, "cpu", stats)
+    target = sample_codes(code_logits(r.predictor, r.matching, x, y).target, cfg.channels, 0.0)
+    return {"run": str(run), "intention": cfg.intention, "channels": cfg.channels, "seed": r.config["seed"],
             # A wrong channel puts two mismatched ones in a row's C·D one-hot entries.
             "codebook": codebook, "wrong_channels": codebook * cfg.latent / 2,
-            "mpjpe_target_cm": float(pose_error_cm(matching.decoder(target), y, stats).mean()), "mpjpe_cm": mpjpe}
+            "mpjpe_target_cm": float(pose_error_cm(r.matching.decoder(target), y, stats).mean()), "mpjpe_cm": mpjpe}
 
 
 def table(rows: list[dict]) -> str:
@@ -54,13 +51,14 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m training.validation", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("runs", nargs="+", type=Path, help="folders with checkpoint.pt")
-    ap.add_argument("--data", default=DEFAULT_DATA, help="prepared data the runs were trained on")
+    add_folder(ap, "prepared", "the data the runs were trained on (normalization, validation split)",
+               old=("--data",))
     args = ap.parse_args(argv)
     try:
         for run in args.runs:
             if not (run / "checkpoint.pt").exists():
                 raise TrainError(f"{run}/checkpoint.pt not found")
-        rows = [measure(r, args.data) for r in args.runs]
+        rows = [measure(r, args.prepared) for r in args.runs]
     except TrainError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2

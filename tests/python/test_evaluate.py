@@ -21,7 +21,6 @@ FRAMES = 40
 
 def args(exported, data3, out, *extra):
     return ["--data", str(data3), "--takes", SMALL_TAKES["test"], "--models", str(exported["models"]),
-            "--runs", str(exported["runs"]), "--prepared", str(exported["prepared"]),
             "--train-data", str(data3), "--out", str(out), "--encoder-cache", str(out.parent / "encoder"),
             "--encoder-epochs", "2", "--max-frames", str(FRAMES), "--quiet", *extra]
 
@@ -45,7 +44,7 @@ def test_schema(result):
         for k in HEADLINE - {"codebook_error"}:
             assert isinstance(r["methods"][name][k], float), (name, k)
     assert isinstance(r["methods"]["ground_truth"]["diversity"], float)
-    # Checkpoints are there: codebook error is computed, in [0, 2/channels].
+    # The evaluation files are there: codebook error is computed, in [0, 1].
     for name in ("ours", "ccm", "motion_matching"):
         assert 0.0 <= r["methods"][name]["codebook_error"] <= 1.0
     p = r["protocols"]
@@ -82,16 +81,69 @@ def test_seeds_and_temperatures_matter(result):
     assert zero[0]["mpjpe_cm"] == pytest.approx(zero[1]["mpjpe_cm"], rel=1e-9)
 
 
-def test_codebook_is_null_without_checkpoints(exported, data3, tmp_path):
+def test_codebook_error_comes_from_the_exported_files(result, exported, data3):
+    """ours: the int8 step model's code at temperature 0 against the code of its fp32 output
+    encoder file, which is the trained output encoder (torch) to float rounding."""
+    import torch
+    from training import metrics as M
+    from training.rollout import OnnxPolicy
+    from training.runs import load_run
+    _, r = result
+    take = E.load_eval_takes(str(data3), [SMALL_TAKES["test"]], FRAMES, None)[0]
+    x = E.follower_input(take.lead, take.follow, take.frames).astype(np.float32)
+    y = E.output_features(take.follow, take.frames).astype(np.float32)
+    run = load_run(exported["runs"] / "follower", str(exported["prepared"]))
+    with torch.no_grad():
+        target = run.model.logits(torch.from_numpy(x), torch.from_numpy(y)).target.numpy()
+    c, d = run.cfg.channels, run.cfg.classes
+    target = target.reshape(len(x), c, d).argmax(-1)
+    estimate = OnnxPolicy(exported["models"] / "follower.onnx")(x, 0.0, np.random.default_rng(0))["code"]
+    expected = M.codebook_error(M.one_hot(target, d), M.one_hot(estimate, d))
+    assert r["methods"]["ours"]["codebook_error"] == pytest.approx(expected, abs=2 / (c * d) / len(x) + 1e-12)
+
+
+def copy_models(exported, tmp_path):
+    import shutil
+    dst = tmp_path / "models"
+    shutil.copytree(exported["models"], dst)
+    return dst
+
+
+def short_args(exported, data3, out, models):
+    a = args(exported, data3, out, "--seeds", "0", "--temperatures", "0.5", "--conditions", "")
+    a[a.index("--models") + 1] = str(models)
+    return a
+
+
+def test_codebook_is_null_without_evaluation_files(exported, data3, tmp_path):
+    models = copy_models(exported, tmp_path)
+    for f in (models / "eval").iterdir():
+        f.unlink()
     out = tmp_path / "out"
-    a = args(exported, data3, out, "--methods", "ours", "--seeds", "0", "--temperatures", "0.5",
-             "--conditions", "")
-    a[a.index("--runs") + 1] = str(tmp_path / "no-runs")
-    assert E.main(a) == 0
+    assert E.main(short_args(exported, data3, out, models) + ["--methods", "ours,motion_matching"]) == 0
     r = json.loads((out / "metrics.json").read_text())
-    assert set(r["methods"]) == {"ours", "ground_truth"}
     assert r["methods"]["ours"]["codebook_error"] is None
-    assert "no-runs" in (out / "metrics.md").read_text()
+    assert r["methods"]["motion_matching"]["codebook_error"] is None
+    assert isinstance(r["methods"]["ours"]["fid"], float)          # the rest is still measured
+    assert "follower.output_encoder.onnx not found" in (out / "metrics.md").read_text()
+
+
+@pytest.mark.parametrize("mix", ["eval file", "step model", "manifest"])
+def test_files_of_different_trainings_are_refused(exported, data3, tmp_path, capsys, mix):
+    """CCM's files stand in for another training of ours: each way of mixing is one error line."""
+    models = copy_models(exported, tmp_path)
+    if mix == "eval file":
+        (models / "eval" / "follower_ccm.output_encoder.onnx").replace(models / "eval" / "follower.output_encoder.onnx")
+    elif mix == "step model":
+        (models / "follower_ccm.onnx").replace(models / "follower.onnx")
+    else:
+        m = json.loads((models / "manifest.json").read_text())
+        m["models"]["follower"]["fingerprint"] = m["models"]["follower_ccm"]["fingerprint"]
+        (models / "manifest.json").write_text(json.dumps(m))
+    assert E.main(short_args(exported, data3, tmp_path / "out", models)) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err[-1].startswith("error: ") and "different trainings" in err[-1] and "python -m training.export" in err[-1]
+    assert not (tmp_path / "out" / "metrics.json").exists()
 
 
 @pytest.mark.parametrize("change, message", [
@@ -112,8 +164,8 @@ def test_bad_input_is_one_line_and_exit_2(exported, data3, tmp_path, capsys, cha
     assert not (tmp_path / "out" / "metrics.json").exists()
 
 
-def test_bend_plan_turns_and_shifts_the_future_keys(real_tracks):
-    lead, _ = real_tracks
+def test_bend_plan_turns_and_shifts_the_future_keys(take_tracks):
+    lead, _ = take_tracks
     t = 100
     w = E.window(lead, t)
     turned = E.window(lead, t)

@@ -14,12 +14,11 @@ import torch
 from training import export as E
 from training import features as feat
 from training.dataset import discover_takes, load_pair
+from training.runs import load_run
 from training.skeleton import FPS, JOINT_NAMES, KEY_JOINTS, PARENTS
 from training.train import SHIPPED
 
-from conftest import needs_data
 
-pytestmark = needs_data
 
 # Bounds for int8 against fp32 on the 362 validation frames, set from measurement with the smoke
 # models (2 channels x 4 classes, hidden 32) over two training configurations: code flips 0-2.5 %
@@ -52,7 +51,7 @@ def run_torch(model, x, temperature, noise):
 
 @pytest.fixture(scope="module")
 def models(exported):
-    return {name: E.load_step_model(exported["runs"] / name, str(exported["prepared"])) for name in SHIPPED}
+    return {name: load_run(exported["runs"] / name, str(exported["prepared"])).model for name in SHIPPED}
 
 
 @pytest.fixture(scope="module")
@@ -203,11 +202,40 @@ def test_export_refuses_unfinished_or_missing_runs(exported, data3, tmp_path, ca
     ck["stage"] = "matching"
     torch.save(ck, runs / "follower" / "checkpoint.pt")
     common = ["--runs", str(runs), "--prepared", str(exported["prepared"]), "--data", str(data3),
-              "--out", str(tmp_path / "out"), "--fp32", str(tmp_path / "fp32")]
+              "--models", str(tmp_path / "out"), "--fp32", str(tmp_path / "fp32")]
     assert E.main(["--model", "follower", *common]) == 2
     err = capsys.readouterr().err
-    assert "error:" in err and "did not finish" in err and "--resume" in err
+    assert "error:" in err and "has not finished" in err and "--resume" in err
     assert E.main(["--model", "leader", *common]) == 2
     err = capsys.readouterr().err
     assert "error:" in err and "leader" in err and "not found" in err
     assert not (tmp_path / "out" / "manifest.json").exists()
+
+
+def test_evaluation_files_share_the_training_fingerprint(exported, models, validation):
+    """Every exported file carries its training's fingerprint (also in the manifest); each
+    follower's output encoder file gives the torch output encoder's logits."""
+    from training.stamp import eval_file, read_stamp
+    out = exported["models"]
+    m = json.loads((out / "manifest.json").read_text())
+    prints = {name: entry["fingerprint"] for name, entry in m["models"].items()}
+    assert len(set(prints.values())) == len(SHIPPED)
+    for name, entry in m["models"].items():
+        stamp = read_stamp(out / entry["file"])
+        assert stamp == {"fingerprint": prints[name], "name": name, "role": entry["role"],
+                         "channels": entry["channels"], "classes": entry["classes"]}
+        if entry["role"] == "leader":
+            assert "eval" not in entry and not eval_file(out, name).exists()
+            continue
+        enc = eval_file(out, name)
+        assert entry["eval"] == {"outputEncoder": f"eval/{enc.name}", "bytes": enc.stat().st_size}
+        assert read_stamp(enc) == stamp
+        model = models[name]
+        x = validation["follower"]
+        with np.load(exported["prepared"] / "validation.npz") as z:
+            y = z["follower_output"].astype(np.float32)
+        got = session(enc).run(None, {"input": x, "output": y})[0]
+        with torch.no_grad():
+            ref = model.logits(torch.from_numpy(x), torch.from_numpy(y)).target.numpy()
+        np.testing.assert_allclose(got, ref, atol=1e-4, rtol=1e-4)
+

@@ -53,10 +53,10 @@ def test_block_sizes():
         assert sl[-1].stop == sum(s for _, s in layout)
 
 
-def test_real_feature_arrays_have_the_layout_widths(real_tracks):
-    s = samples(*real_tracks)
+def test_real_feature_arrays_have_the_layout_widths(take_tracks):
+    s = samples(*take_tracks)
     n = len(s["frame"])
-    assert n == len(F.valid_frames(real_tracks[0].frames)) > 200
+    assert n == len(F.valid_frames(take_tracks[0].frames)) > 200
     for role in ("follower", "leader"):
         assert s[f"{role}_input"].shape == (n, 660)
         assert s[f"{role}_output"].shape == (n, 323)
@@ -161,8 +161,8 @@ def test_blocks_describe_a_known_scene():
 # ---------------------------------------------------------------- invariance
 
 @pytest.mark.parametrize("angle,shift", [(2.2, (4.0, 0.0, -7.5)), (-0.9, (0.0, 0.0, 0.0)), (0.0, (-30.0, 0.0, 12.0))])
-def test_features_ignore_where_the_couple_stands(real_tracks, angle, shift):
-    lead, follow = real_tracks
+def test_features_ignore_where_the_couple_stands(take_tracks, angle, shift):
+    lead, follow = take_tracks
     a = all_features(F.Track.from_motion(Motion(lead.positions, lead.rotations, np.zeros((17, 3)), FPS)),
                      F.Track.from_motion(Motion(follow.positions, follow.rotations, np.zeros((17, 3)), FPS)))
     b = all_features(moved(lead, angle, shift), moved(follow, angle, shift))
@@ -171,10 +171,10 @@ def test_features_ignore_where_the_couple_stands(real_tracks, angle, shift):
         assert err < 1e-5, f"{k} changed by {err:.2e} when the couple was turned {angle} rad and moved {shift}"
 
 
-def test_moving_one_dancer_changes_only_partner_blocks(real_tracks):
+def test_moving_one_dancer_changes_only_partner_blocks(take_tracks):
     """Guard against the invariance test passing for a trivial reason: moving the leader alone
     0.5 m must change what the follower sees of it, and nothing of the follower's self blocks."""
-    lead, follow = real_tracks
+    lead, follow = take_tracks
     frames = F.valid_frames(lead.frames)
     a = F.follower_input(lead, follow, frames)
     b = F.follower_input(moved(lead, 0.0, (0.5, 0.0, 0.0)), follow, frames)
@@ -188,11 +188,11 @@ def test_moving_one_dancer_changes_only_partner_blocks(real_tracks):
 
 # ---------------------------------------------------------------- round trip
 
-def test_pose_block_round_trips_through_the_world(real_tracks, real_pair):
+def test_pose_block_round_trips_through_the_world(take_tracks, take_pair):
     """features -> world pose -> features: read the follower's self pose at frame t, rebuild the
     world joints and rotations (as the run time does), and compute the block again."""
-    lead, follow = real_tracks
-    offsets = real_pair[1].offsets
+    lead, follow = take_tracks
+    offsets = take_pair[1].offsets
     for t in (40, 120, follow.frames - 40):
         x = F.follower_input(lead, follow, np.array([t]))[0]
         block = x[F.block_slices(F.FOLLOWER_INPUT_LAYOUT)["self_pose"]]
@@ -210,8 +210,8 @@ def test_pose_block_round_trips_through_the_world(real_tracks, real_pair):
         np.testing.assert_allclose(forward_kinematics_reduced(offsets, world[0], rot), world, atol=1e-6)
 
 
-def test_output_root_update_integrates_to_the_next_root(real_tracks):
-    lead = real_tracks[0]
+def test_output_root_update_integrates_to_the_next_root(take_tracks):
+    lead = take_tracks[0]
     frames = F.valid_frames(lead.frames)
     out = F.output_features(lead, frames)
     ru = out[:, :3]

@@ -1,4 +1,4 @@
-"""tests/fixtures/*.json still say what training/ computes (python -m training.fixtures rewrites them).
+"""tests/fixtures/*.json still say what training/ computes (tests/python/fixtures_writer.py rewrites them).
 
 The TypeScript tests compare web/*.ts against these files; this test compares the files against
 the Python reference, so a change on either side shows up as a failing test.
@@ -10,7 +10,7 @@ import math
 
 import pytest
 
-from training import fixtures
+import fixtures_writer as fixtures
 
 
 @pytest.fixture(scope="module")
@@ -37,5 +37,5 @@ def same(a, b, path="") -> None:
 @pytest.mark.parametrize("name", ["bvh", "features", "rollout"])
 def test_fixture_file_matches_python(built, name):
     path = fixtures.OUT_DIR / f"{name}.json"
-    assert path.exists(), f"{path} missing: run python -m training.fixtures"
+    assert path.exists(), f"{path} missing: run .venv/bin/python tests/python/fixtures_writer.py"
     same(json.loads(path.read_text()), built[name], name)

@@ -105,8 +105,8 @@ def test_diversity_is_the_mean_pair_distance(rng):
     assert M.diversity(x * 2) == pytest.approx(2 * M.diversity(x))
 
 
-def test_windows_and_motion_features(real_tracks):
-    _, follow = real_tracks
+def test_windows_and_motion_features(take_tracks):
+    _, follow = take_tracks
     f = M.motion_features(follow, np.arange(1, 40))
     assert f.shape == (39, M.FRAME_FEATURES)
     w = M.windows(f)

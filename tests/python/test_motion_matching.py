@@ -95,12 +95,12 @@ def test_plan_mode_uses_the_previous_match(rng):
 # ---------------------------------------------------------------- on real data
 
 @pytest.fixture(scope="module")
-def real_mm(real_tracks):
-    return {role: MM.build([real_tracks], role) for role in ("follower", "leader")}
+def real_mm(take_tracks):
+    return {role: MM.build([take_tracks], role) for role in ("follower", "leader")}
 
 
-def test_real_database_frame_finds_itself(real_tracks, real_mm):
-    lead, follow = real_tracks
+def test_real_database_frame_finds_itself(take_tracks, real_mm):
+    lead, follow = take_tracks
     frames = feat.valid_frames(lead.frames)[[0, 50, 120]]
     x = feat.follower_input(lead, follow, frames)
     out = real_mm["follower"](x, self_future=MM.own_future(follow, frames))
@@ -108,9 +108,9 @@ def test_real_database_frame_finds_itself(real_tracks, real_mm):
     np.testing.assert_allclose(out["output"], feat.output_features(follow, frames), atol=1e-5)
 
 
-def test_real_queries_agree_with_brute_force(real_tracks, real_mm):
+def test_real_queries_agree_with_brute_force(take_tracks, real_mm):
     mm = real_mm["follower"]
-    lead, follow = real_tracks
+    lead, follow = take_tracks
     frames = feat.valid_frames(lead.frames)[::9]
     x = feat.follower_input(lead, follow, frames) + 0.05   # off the database
     q = mm.normalize(MM.query_features(x, MM.extrapolate_future(x), "follower"))

@@ -95,8 +95,8 @@ def test_evenly():
 
 def _missing_args(tmp_path):
     nowhere = tmp_path / "nowhere"
-    return ["--data", str(nowhere), "--runs", str(nowhere), "--sweep", str(nowhere), "--models", str(nowhere),
-            "--bvh", str(nowhere), "--out", str(tmp_path / "out")]
+    return ["--prepared", str(nowhere), "--runs", str(nowhere), "--sweep", str(nowhere), "--models", str(nowhere),
+            "--data", str(nowhere), "--out", str(tmp_path / "out")]
 
 
 def test_main_without_inputs_exits_with_a_message(tmp_path, capsys):

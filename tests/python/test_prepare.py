@@ -13,9 +13,7 @@ import pytest
 
 from training.prepare import main
 
-from conftest import DATA, README_FRAMES, REPO, copy_takes, needs_data
-
-pytestmark = needs_data
+from conftest import README_FRAMES, REAL_DATA, REPO, copy_takes, needs_real_data
 
 
 def run_main(capsys, *args):
@@ -40,7 +38,7 @@ def assert_nothing_written(out_dir):
 
 
 def test_missing_data_folder(tmp_path, capsys):
-    rc, _, err = run_main(capsys, "--data", tmp_path / "nowhere", "--out", tmp_path / "out")
+    rc, _, err = run_main(capsys, "--data", tmp_path / "nowhere", "--prepared", tmp_path / "out")
     assert_one_error_line(rc, err, "nowhere", "does not exist")
     assert_nothing_written(tmp_path / "out")
 
@@ -48,29 +46,29 @@ def test_missing_data_folder(tmp_path, capsys):
 def test_folder_without_bvh_files(tmp_path, capsys):
     (tmp_path / "data").mkdir()
     (tmp_path / "data" / "notes.txt").write_text("hello")
-    rc, _, err = run_main(capsys, "--data", tmp_path / "data", "--out", tmp_path / "out")
+    rc, _, err = run_main(capsys, "--data", tmp_path / "data", "--prepared", tmp_path / "out")
     assert_one_error_line(rc, err, "no .bvh files")
 
 
-def test_take_without_partner(tmp_path, capsys):
-    data = copy_takes(tmp_path / "data", ["10"])
-    (data / "60_12.bvh").write_bytes((DATA / "60_12.bvh").read_bytes())
-    rc, _, err = run_main(capsys, "--data", data, "--out", tmp_path / "out")
+def test_take_without_partner(couples, tmp_path, capsys):
+    data = copy_takes(tmp_path / "data", ["10"], couples)
+    (data / "60_12.bvh").write_bytes((couples / "60_12.bvh").read_bytes())
+    rc, _, err = run_main(capsys, "--data", data, "--prepared", tmp_path / "out")
     assert_one_error_line(rc, err, "60_12", "no partner", "61_12.bvh")
     assert_nothing_written(tmp_path / "out")
 
 
-def test_badly_named_file(tmp_path, capsys):
-    data = copy_takes(tmp_path / "data", ["10"])
-    (data / "salsa.bvh").write_bytes((DATA / "60_12.bvh").read_bytes())
-    rc, _, err = run_main(capsys, "--data", data, "--out", tmp_path / "out")
+def test_badly_named_file(couples, tmp_path, capsys):
+    data = copy_takes(tmp_path / "data", ["10"], couples)
+    (data / "salsa.bvh").write_bytes((couples / "60_12.bvh").read_bytes())
+    rc, _, err = run_main(capsys, "--data", data, "--prepared", tmp_path / "out")
     assert_one_error_line(rc, err, "salsa.bvh", "SUBJECT_TAKE")
 
 
-def test_three_subjects(tmp_path, capsys):
-    data = copy_takes(tmp_path / "data", ["10"])
-    (data / "62_10.bvh").write_bytes((DATA / "61_10.bvh").read_bytes())
-    rc, _, err = run_main(capsys, "--data", data, "--out", tmp_path / "out")
+def test_three_subjects(couples, tmp_path, capsys):
+    data = copy_takes(tmp_path / "data", ["10"], couples)
+    (data / "62_10.bvh").write_bytes((couples / "61_10.bvh").read_bytes())
+    rc, _, err = run_main(capsys, "--data", data, "--prepared", tmp_path / "out")
     assert_one_error_line(rc, err, "two subjects", "60, 61, 62")
 
 
@@ -82,46 +80,46 @@ def truncated(text: str, keep: int, fix_header: bool) -> str:
     return head + "MOTION\n" + "\n".join([header, lines[1], *frames]) + "\n"
 
 
-def test_partners_with_different_frame_counts(tmp_path, capsys):
-    data = copy_takes(tmp_path / "data", ["10"])
-    (data / "61_10.bvh").write_text(truncated((DATA / "61_10.bvh").read_text(), 1000, fix_header=True))
-    rc, _, err = run_main(capsys, "--data", data, "--out", tmp_path / "out", "--validation", "10", "--test", "10")
+def test_partners_with_different_frame_counts(couples, tmp_path, capsys):
+    data = copy_takes(tmp_path / "data", ["10"], couples)
+    (data / "61_10.bvh").write_text(truncated((couples / "61_10.bvh").read_text(), 1000, fix_header=True))
+    rc, _, err = run_main(capsys, "--data", data, "--prepared", tmp_path / "out", "--validation", "10", "--test", "10")
     assert_one_error_line(rc, err, "take 10", "different frame counts", "60_10.bvh 1197", "61_10.bvh 1000")
     assert_nothing_written(tmp_path / "out")
 
 
-def test_truncated_download(tmp_path, capsys):
+def test_truncated_download(couples, tmp_path, capsys):
     """A file cut short (its header still says 1197 frames) is a BVH error, not a crash."""
-    data = copy_takes(tmp_path / "data", ["10"])
-    (data / "61_10.bvh").write_text(truncated((DATA / "61_10.bvh").read_text(), 1000, fix_header=False))
-    rc, _, err = run_main(capsys, "--data", data, "--out", tmp_path / "out", "--validation", "10", "--test", "10")
+    data = copy_takes(tmp_path / "data", ["10"], couples)
+    (data / "61_10.bvh").write_text(truncated((couples / "61_10.bvh").read_text(), 1000, fix_header=False))
+    rc, _, err = run_main(capsys, "--data", data, "--prepared", tmp_path / "out", "--validation", "10", "--test", "10")
     assert_one_error_line(rc, err, "61_10.bvh", "1197 frames")
 
 
-def test_file_that_is_not_bvh(tmp_path, capsys):
-    data = copy_takes(tmp_path / "data", ["10"])
+def test_file_that_is_not_bvh(couples, tmp_path, capsys):
+    data = copy_takes(tmp_path / "data", ["10"], couples)
     (data / "61_10.bvh").write_bytes(b"\x89PNG\r\n\x1a\n" + bytes(range(256)) * 4)
-    rc, _, err = run_main(capsys, "--data", data, "--out", tmp_path / "out", "--validation", "10", "--test", "10")
+    rc, _, err = run_main(capsys, "--data", data, "--prepared", tmp_path / "out", "--validation", "10", "--test", "10")
     assert_one_error_line(rc, err, "61_10.bvh", "not a BVH")
     assert_nothing_written(tmp_path / "out")
 
 
-def test_skeleton_lacking_a_joint(tmp_path, capsys):
-    data = copy_takes(tmp_path / "data", ["10"])
-    (data / "60_10.bvh").write_text((DATA / "60_10.bvh").read_text().replace("lFoot", "lToe"))
-    rc, _, err = run_main(capsys, "--data", data, "--out", tmp_path / "out", "--validation", "10", "--test", "10")
+def test_skeleton_lacking_a_joint(couples, tmp_path, capsys):
+    data = copy_takes(tmp_path / "data", ["10"], couples)
+    (data / "60_10.bvh").write_text((couples / "60_10.bvh").read_text().replace("lFoot", "lToe"))
+    rc, _, err = run_main(capsys, "--data", data, "--prepared", tmp_path / "out", "--validation", "10", "--test", "10")
     assert_one_error_line(rc, err, "60_10.bvh", "lFoot")
     assert_nothing_written(tmp_path / "out")
 
 
-def test_take_too_short_for_a_sample(tmp_path, capsys):
+def test_take_too_short_for_a_sample(couples, tmp_path, capsys):
     """A take of 200 frames at 120 fps is 50 frames at 30 fps: less than the 2 s + 1 frame that one
     sample needs. prepare must say so (exit 2 naming the take) or leave it out, never crash."""
-    data = copy_takes(tmp_path / "data", ["06", "10", "12"])
+    data = copy_takes(tmp_path / "data", ["06", "10", "12"], couples)
     for s in ("60", "61"):
         p = data / f"{s}_10.bvh"
         p.write_text(truncated(p.read_text(), 200, fix_header=True))
-    rc, out, err = run_main(capsys, "--data", data, "--out", tmp_path / "out", "--validation", "12", "--test", "12")
+    rc, out, err = run_main(capsys, "--data", data, "--prepared", tmp_path / "out", "--validation", "12", "--test", "12")
     if rc == 2:
         assert_one_error_line(rc, err, "10")
     else:
@@ -130,30 +128,31 @@ def test_take_too_short_for_a_sample(tmp_path, capsys):
             assert all(np.isfinite(z[k]).all() for k in z.files)
 
 
-def test_split_take_not_in_folder(tmp_path, capsys):
-    data = copy_takes(tmp_path / "data", ["10"])
-    rc, _, err = run_main(capsys, "--data", data, "--out", tmp_path / "out")   # default validation 12
+def test_split_take_not_in_folder(couples, tmp_path, capsys):
+    data = copy_takes(tmp_path / "data", ["10"], couples)
+    rc, _, err = run_main(capsys, "--data", data, "--prepared", tmp_path / "out")   # default validation 12
     assert_one_error_line(rc, err, "split take 12")
 
 
-def test_empty_training_split(tmp_path, capsys):
-    data = copy_takes(tmp_path / "data", ["10"])
-    rc, _, err = run_main(capsys, "--data", data, "--out", tmp_path / "out", "--validation", "10", "--test", "10")
+def test_empty_training_split(couples, tmp_path, capsys):
+    data = copy_takes(tmp_path / "data", ["10"], couples)
+    rc, _, err = run_main(capsys, "--data", data, "--prepared", tmp_path / "out", "--validation", "10", "--test", "10")
     assert_one_error_line(rc, err, "split train is empty")
 
 
-def test_unknown_leader(tmp_path, capsys):
-    data = copy_takes(tmp_path / "data", ["10"])
-    rc, _, err = run_main(capsys, "--data", data, "--out", tmp_path / "out", "--leader", "99")
+def test_unknown_leader(couples, tmp_path, capsys):
+    data = copy_takes(tmp_path / "data", ["10"], couples)
+    rc, _, err = run_main(capsys, "--data", data, "--prepared", tmp_path / "out", "--leader", "99")
     assert_one_error_line(rc, err, "leader subject '99'")
 
 
 @pytest.mark.slow
+@needs_real_data
 def test_real_data(tmp_path):
     """The whole CMU folder through the real command line (a subprocess, as a user runs it)."""
     out = tmp_path / "prepared"
     try:
-        r = subprocess.run([sys.executable, "-m", "training.prepare", "--data", str(DATA), "--out", str(out)],
+        r = subprocess.run([sys.executable, "-m", "training.prepare", "--data", str(REAL_DATA), "--prepared", str(out)],
                            cwd=REPO, capture_output=True, text=True, timeout=300)
         check_real_data(r, out)
     finally:
@@ -193,3 +192,17 @@ def check_real_data(r, out):
             std = z[f"{role}_input_std"]
             assert std.shape == (660,) and np.isfinite(std).all() and std.min() >= 1e-2 - 1e-9
             assert z[f"{role}_output_mean"].shape == (323,)
+
+
+def test_files_in_other_units(tmp_path, capsys):
+    """BVH in centimetres instead of the CMU copy's units: prepare names the file and the units."""
+    from dataclasses import replace
+    from training import synthetic
+    data = tmp_path / "data"
+    data.mkdir()
+    for s, m in zip(("60", "61"), synthetic.synthetic_couple(np.random.default_rng(0), 600)):
+        cm = replace(m, positions=m.positions * 100, offsets=m.offsets * 100)
+        (data / f"{s}_10.bvh").write_text(synthetic.bvh_text(cm))
+    rc, _, err = run_main(capsys, "--data", data, "--prepared", tmp_path / "out", "--validation", "10", "--test", "10")
+    assert_one_error_line(rc, err, "60_10.bvh", "head joint", "other units")
+    assert_nothing_written(tmp_path / "out")

@@ -13,7 +13,7 @@ from training import rollout as R
 from training.features import Track
 from training.skeleton import FPS
 
-from conftest import REPO, needs_data
+from conftest import REPO
 
 OUT = feat.block_slices(feat.OUTPUT_LAYOUT)
 
@@ -48,7 +48,6 @@ def window(track: Track, t: int) -> Track:
 
 # ---------------------------------------------------------------- with the smoke models
 
-@needs_data
 def test_smoke_duet_stays_finite(exported, rng):
     folder = exported["models"]
     manifest = json.loads((folder / "manifest.json").read_text())
@@ -66,14 +65,13 @@ def test_smoke_duet_stays_finite(exported, rng):
 
 # ---------------------------------------------------------------- features <-> run time
 
-@needs_data
-def test_apply_output_replays_the_recording(real_tracks, real_pair):
+def test_apply_output_replays_the_recording(take_tracks, take_pair):
     """Feeding the training target O of frame t to a dancer that holds the recorded window around
     t moves it to exactly the recorded frame t+1 (root, heading, joints) and plans the recorded
     future root keys: training targets and run-time reconstruction agree."""
-    lead = real_tracks[0]
+    lead = take_tracks[0]
     for t in (40, 150, lead.frames - 40):
-        d = R.Dancer(real_pair[0].offsets, window(lead, t))
+        d = R.Dancer(take_pair[0].offsets, window(lead, t))
         R.apply_output(d, feat.output_features(lead, np.array([t]))[0])
         np.testing.assert_allclose(d.root, lead.root[t + 1], atol=1e-9)
         assert np.angle(np.exp(1j * (d.heading - lead.heading[t + 1]))) == pytest.approx(0, abs=1e-9)
@@ -84,10 +82,9 @@ def test_apply_output_replays_the_recording(real_tracks, real_pair):
         np.testing.assert_allclose(d.track.root[keys], lead.root[t + 1 + feat.FUTURE_OFFSETS], atol=1e-9)
 
 
-@needs_data
-def test_step_inputs_equal_training_features(real_tracks):
+def test_step_inputs_equal_training_features(take_tracks):
     """A duet holding recorded windows builds the very inputs prepare computed for that frame."""
-    lead, follow = real_tracks
+    lead, follow = take_tracks
     t = 100
     duet = R.Duet(R.Dancer(np.zeros((17, 3)), window(lead, t)), R.Dancer(np.zeros((17, 3)), window(follow, t)), {})
     xl, xf = R.step_inputs(duet)
@@ -98,15 +95,14 @@ def test_step_inputs_equal_training_features(real_tracks):
 # ---------------------------------------------------------------- absurd output and resets
 
 @pytest.fixture
-def duet_and_output(exported, real_tracks):
+def duet_and_output(exported, take_tracks):
     manifest = json.loads((exported["models"] / "manifest.json").read_text())
     duet = R.start_duet(manifest)
     # A sane output: a recorded frame's training target.
-    sane = feat.output_features(real_tracks[1], np.array([100]))[0]
+    sane = feat.output_features(take_tracks[1], np.array([100]))[0]
     return duet, sane
 
 
-@needs_data
 def test_output_is_absurd(duet_and_output):
     _, sane = duet_and_output
     assert not R.output_is_absurd(sane)
@@ -130,7 +126,6 @@ def test_output_is_absurd(duet_and_output):
     assert not R.output_is_absurd(step)
 
 
-@needs_data
 @pytest.mark.parametrize("who", ["leader", "follower"])
 @pytest.mark.parametrize("damage", ["nan", "far", "jump"])
 def test_absurd_output_resets_beside_the_partner(duet_and_output, who, damage):
@@ -176,7 +171,6 @@ def test_absurd_output_resets_beside_the_partner(duet_and_output, who, damage):
 
 # ---------------------------------------------------------------- steering
 
-@needs_data
 def test_steering_bends_the_leader_plan(duet_and_output):
     duet, _ = duet_and_output
     leader = duet.leader

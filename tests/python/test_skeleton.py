@@ -8,8 +8,6 @@ from training.bvh import BvhError, forward_kinematics, local_transforms, parse_b
 from training.skeleton import (FPS, JOINT_NAMES, MIRROR, PARENTS, SCALE, Motion, forward_kinematics_reduced,
                                gaussian_smooth, mirror_motion, reduce_bvh, resample, root_from_motion)
 
-from conftest import DATA, needs_data
-
 
 def rot_y(a):
     c, s = np.cos(a), np.sin(a)
@@ -18,13 +16,13 @@ def rot_y(a):
 
 # ---------------------------------------------------------------- reduction of a real take
 
-def test_reduce_keeps_forward_kinematics_exact(real_bvh):
-    m = reduce_bvh(real_bvh)
-    assert m.positions.shape == (real_bvh.frames, 17, 3) and m.rotations.shape == (real_bvh.frames, 17, 3, 3)
+def test_reduce_keeps_forward_kinematics_exact(take_bvh):
+    m = reduce_bvh(take_bvh)
+    assert m.positions.shape == (take_bvh.frames, 17, 3) and m.rotations.shape == (take_bvh.frames, 17, 3, 3)
     assert m.fps == pytest.approx(120, rel=1e-3)
     # Full-skeleton FK (43 joints + End Sites), independent of the reduction.
-    world_rot, world_pos = forward_kinematics(real_bvh.parents, *local_transforms(real_bvh))
-    index = [real_bvh.names.index(n) for n in JOINT_NAMES]
+    world_rot, world_pos = forward_kinematics(take_bvh.parents, *local_transforms(take_bvh))
+    index = [take_bvh.names.index(n) for n in JOINT_NAMES]
     full = world_pos[:, index] * SCALE
     hip = world_pos[:, index[0]] * SCALE
     reduced = forward_kinematics_reduced(m.offsets, hip, world_rot[:, index])
@@ -37,9 +35,9 @@ def test_reduce_keeps_forward_kinematics_exact(real_bvh):
                                m.positions, atol=1e-6)
 
 
-def test_reduced_motion_is_in_metres(real_pair):
+def test_reduced_motion_is_in_metres(take_pair):
     """SCALE puts the head joint of a standing adult at ~1.5-1.9 m and the ankles near the floor."""
-    for m in real_pair:
+    for m in take_pair:
         head = m.positions[:, JOINT_NAMES.index("head"), 1]
         assert 1.4 < np.median(head) < 1.9, np.median(head)
         feet = m.positions[:, [JOINT_NAMES.index("lFoot"), JOINT_NAMES.index("rFoot")], 1]
@@ -48,47 +46,46 @@ def test_reduced_motion_is_in_metres(real_pair):
         assert 0.05 < bones.min() and bones.max() < 0.6, bones
 
 
-def test_local_rotations_compose_back(real_pair):
-    m = resample(real_pair[0], FPS)
+def test_local_rotations_compose_back(take_pair):
+    m = resample(take_pair[0], FPS)
     local = m.local_rotations()
     for j, p in enumerate(PARENTS):
         expect = m.rotations[:, j] if p < 0 else m.rotations[:, p] @ local[:, j]
         np.testing.assert_allclose(expect, m.rotations[:, j], atol=1e-10)
 
 
-@needs_data
-def test_missing_joint_is_named():
-    text = (DATA / "60_10.bvh").read_text().replace("lFoot", "lToe")
+def test_missing_joint_is_named(couples):
+    text = (couples / "60_10.bvh").read_text().replace("lFoot", "lToe")
     with pytest.raises(BvhError) as e:
         reduce_bvh(parse_bvh(text, "60_10.bvh"), "60_10.bvh")
     msg = str(e.value)
     assert "lFoot" in msg and "60_10.bvh" in msg and "\n" not in msg, msg
 
 
-def test_rotating_dropped_joint_is_refused(real_bvh):
+def test_rotating_dropped_joint_is_refused(take_bvh):
     """rCollar is dropped (folded into rShldr's offset); that is only exact if it never rotates."""
-    j = real_bvh.names.index("rCollar")
-    col = sum(len(c) for c in real_bvh.channels[:j])
-    motion = real_bvh.motion.copy()
+    j = take_bvh.names.index("rCollar")
+    col = sum(len(c) for c in take_bvh.channels[:j])
+    motion = take_bvh.motion.copy()
     motion[10:, col] += 20.0
-    bad = type(real_bvh)(real_bvh.names, real_bvh.parents, real_bvh.offsets, real_bvh.channels,
-                         real_bvh.frame_time, motion)
+    bad = type(take_bvh)(take_bvh.names, take_bvh.parents, take_bvh.offsets, take_bvh.channels,
+                         take_bvh.frame_time, motion)
     with pytest.raises(BvhError, match="rCollar"):
         reduce_bvh(bad, "x.bvh")
 
 
 # ---------------------------------------------------------------- mirroring
 
-def test_mirror_twice_is_identity(real_pair):
-    m = real_pair[1]
+def test_mirror_twice_is_identity(take_pair):
+    m = take_pair[1]
     mm = mirror_motion(mirror_motion(m))
     np.testing.assert_allclose(mm.positions, m.positions, atol=1e-12)
     np.testing.assert_allclose(mm.rotations, m.rotations, atol=1e-12)
     np.testing.assert_allclose(mm.offsets, m.offsets, atol=1e-12)
 
 
-def test_mirror_swaps_sides_and_stays_a_skeleton(real_pair):
-    m = resample(real_pair[0], FPS)
+def test_mirror_swaps_sides_and_stays_a_skeleton(take_pair):
+    m = resample(take_pair[0], FPS)
     mi = mirror_motion(m)
     assert sorted(MIRROR) == list(range(17)) and all(MIRROR[MIRROR[j]] == j for j in range(17))
     L, R = JOINT_NAMES.index("lHand"), JOINT_NAMES.index("rHand")
@@ -102,8 +99,8 @@ def test_mirror_swaps_sides_and_stays_a_skeleton(real_pair):
 
 # ---------------------------------------------------------------- resampling
 
-def test_resample_keeps_duration_and_real_frames(real_pair):
-    m = real_pair[0]
+def test_resample_keeps_duration_and_real_frames(take_pair):
+    m = take_pair[0]
     F = m.frames
     for phase in range(4):
         r = resample(m, FPS, phase)
@@ -117,8 +114,8 @@ def test_resample_keeps_duration_and_real_frames(real_pair):
     assert frames == F
 
 
-def test_resample_refuses_impossible_rates(real_pair):
-    m = real_pair[0]
+def test_resample_refuses_impossible_rates(take_pair):
+    m = take_pair[0]
     with pytest.raises(ValueError, match="whole multiple"):
         resample(m, 50)
     with pytest.raises(ValueError, match="phase"):

@@ -18,9 +18,8 @@ import torch
 from training import features as feat
 from training import train as T
 
-from conftest import REPO, needs_data
+from conftest import REPO
 
-pytestmark = needs_data
 
 
 def run_main(capsys, *args):
@@ -69,7 +68,7 @@ def test_resume_continues_an_interrupted_run(prepared3, tmp_path, monkeypatch, c
         return real_validate(*a, **k)
 
     monkeypatch.setattr(T, "validate", crashing_validate)
-    args = ["--model", "follower", "--smoke", "--data", prepared3, "--out", tmp_path]
+    args = ["--model", "follower", "--smoke", "--prepared", prepared3, "--runs", tmp_path]
     with pytest.raises(KeyboardInterrupt):
         T.main(list(map(str, args)))
     monkeypatch.setattr(T, "validate", real_validate)
@@ -95,7 +94,7 @@ def test_resume_continues_an_interrupted_run(prepared3, tmp_path, monkeypatch, c
 def test_resume_of_a_finished_run_changes_nothing(smoke_runs, prepared3, tmp_path, capsys):
     shutil.copytree(smoke_runs / "follower_ccm", tmp_path / "follower_ccm")
     before = torch.load(tmp_path / "follower_ccm" / "checkpoint.pt", map_location="cpu", weights_only=False)
-    rc, out, _ = run_main(capsys, "--model", "follower_ccm", "--smoke", "--data", prepared3, "--out", tmp_path, "--resume")
+    rc, out, _ = run_main(capsys, "--model", "follower_ccm", "--smoke", "--prepared", prepared3, "--runs", tmp_path, "--resume")
     assert rc == 0 and "resumed at done epoch 2" in out
     after = torch.load(tmp_path / "follower_ccm" / "checkpoint.pt", map_location="cpu", weights_only=False)
     for k, v in before["matching"].items():
@@ -105,10 +104,27 @@ def test_resume_of_a_finished_run_changes_nothing(smoke_runs, prepared3, tmp_pat
 # ---------------------------------------------------------------- bad input
 
 def test_missing_prepared_data(tmp_path, capsys):
-    rc, _, err = run_main(capsys, "--model", "follower", "--smoke", "--data", tmp_path / "none", "--out", tmp_path / "out")
+    rc, _, err = run_main(capsys, "--model", "follower", "--smoke", "--prepared", tmp_path / "none", "--runs", tmp_path / "out")
     assert rc == 2
     line = error_line(err)
     assert "train.npz not found" in line and "training.prepare" in line
+
+
+def test_old_flag_names_still_work_with_a_note(tmp_path, capsys):
+    """train --data / --out were renamed --prepared / --runs (training/folders.py): the old names
+    are hidden aliases that say so."""
+    rc, _, err = run_main(capsys, "--model", "follower", "--smoke", "--data", tmp_path / "none", "--out", tmp_path / "out")
+    assert rc == 2
+    assert "note: --data is now --prepared" in err and "note: --out is now --runs" in err
+    assert "none/train.npz not found" in error_line(err)
+
+
+def test_help_shows_the_folder_vocabulary(capsys):
+    with pytest.raises(SystemExit):
+        T.main(["--help"])
+    out = capsys.readouterr().out
+    assert "--prepared DIR" in out and "--runs DIR" in out
+    assert "--data" not in out and "--out" not in out      # hidden aliases
 
 
 def test_mismatched_feature_sizes(tmp_path, capsys):
@@ -120,7 +136,7 @@ def test_mismatched_feature_sizes(tmp_path, capsys):
               for k, w in (("input", 600), ("output", feat.OUTPUT_SIZE), ("intention", feat.INTENTION_SIZE))}
     for split in ("train", "validation"):
         np.savez(data / f"{split}.npz", **arrays)
-    rc, _, err = run_main(capsys, "--model", "follower", "--smoke", "--data", data, "--out", tmp_path / "out")
+    rc, _, err = run_main(capsys, "--model", "follower", "--smoke", "--prepared", data, "--runs", tmp_path / "out")
     assert rc == 2
     line = error_line(err)
     assert "follower input has 600 features" in line and "expects 660" in line and "re-run training.prepare" in line
@@ -138,7 +154,7 @@ def test_unreadable_prepared_data(prepared3, tmp_path, capsys, damage):
         (data / "train.npz").write_bytes(good[:len(good) // 3])
     else:
         np.savez(data / "train.npz", x=np.zeros(3))
-    rc, _, err = run_main(capsys, "--model", "follower", "--smoke", "--data", data, "--out", tmp_path / "out")
+    rc, _, err = run_main(capsys, "--model", "follower", "--smoke", "--prepared", data, "--runs", tmp_path / "out")
     assert rc == 2
     assert "train.npz" in error_line(err)
 
@@ -154,7 +170,7 @@ def test_corrupt_checkpoint_is_reported_and_kept(smoke_runs, prepared3, tmp_path
         good = (smoke_runs / "follower" / "checkpoint.pt").read_bytes()
         ckpt.write_bytes(good[:len(good) // 2])
     before = ckpt.read_bytes()
-    rc, _, err = run_main(capsys, "--model", "follower", "--smoke", "--data", prepared3, "--out", tmp_path, "--resume")
+    rc, _, err = run_main(capsys, "--model", "follower", "--smoke", "--prepared", prepared3, "--runs", tmp_path, "--resume")
     assert rc == 2
     line = error_line(err)
     assert "checkpoint.pt" in line and "unreadable" in line
@@ -165,8 +181,8 @@ def test_corrupt_checkpoint_is_reported_and_kept(smoke_runs, prepared3, tmp_path
 def test_resume_with_another_configuration_is_refused(smoke_runs, prepared3, tmp_path, capsys):
     shutil.copytree(smoke_runs / "follower", tmp_path / "follower")
     before = (tmp_path / "follower" / "checkpoint.pt").read_bytes()
-    rc, _, err = run_main(capsys, "--model", "follower", "--smoke", "--epochs", "3", "--data", prepared3,
-                          "--out", tmp_path, "--resume")
+    rc, _, err = run_main(capsys, "--model", "follower", "--smoke", "--epochs", "3", "--prepared", prepared3,
+                          "--runs", tmp_path, "--resume")
     assert rc == 2
     assert "another configuration" in error_line(err)
     assert (tmp_path / "follower" / "checkpoint.pt").read_bytes() == before
@@ -211,7 +227,7 @@ def test_ddp_two_cpu_processes(prepared3, tmp_path):
     assert torchrun.exists(), torchrun
     env = {**os.environ, "OMP_NUM_THREADS": "1"}
     r = subprocess.run([str(torchrun), "--standalone", "--nproc_per_node", "2", "-m", "training.train",
-                        "--model", "follower", "--smoke", "--data", str(prepared3), "--out", str(tmp_path)],
+                        "--model", "follower", "--smoke", "--prepared", str(prepared3), "--runs", str(tmp_path)],
                        cwd=REPO, env=env, capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
     assert "on cpu x2" in r.stdout
@@ -228,7 +244,7 @@ def test_validation_table_of_smoke_runs(smoke_runs, prepared3, capsys):
     the estimated code is replaced by the target one, and both are in a plausible range."""
     from training import validation as V
     runs = [smoke_runs / "follower", smoke_runs / "follower_ccm"]
-    assert V.main([str(r) for r in runs] + ["--data", str(prepared3)]) == 0
+    assert V.main([str(r) for r in runs] + ["--prepared", str(prepared3)]) == 0
     out = capsys.readouterr().out.splitlines()
     assert len(out) == 4 and out[2].startswith(f"| {runs[0]} | yes | 2 |") and "| no | 2 |" in out[3]
     row = V.measure(runs[0], str(prepared3))
@@ -251,12 +267,12 @@ def test_validation_table_of_smoke_runs(smoke_runs, prepared3, capsys):
 
 def test_validation_refuses_unfinished_and_missing_runs(smoke_runs, prepared3, tmp_path, capsys):
     from training import validation as V
-    assert V.main([str(tmp_path / "none"), "--data", str(prepared3)]) == 2
+    assert V.main([str(tmp_path / "none"), "--prepared", str(prepared3)]) == 2
     assert "checkpoint.pt not found" in capsys.readouterr().err
     run = tmp_path / "half"
     run.mkdir()
     ck = torch.load(smoke_runs / "follower" / "checkpoint.pt", map_location="cpu", weights_only=False)
     ck["stage"] = "matching"
     torch.save(ck, run / "checkpoint.pt")
-    assert V.main([str(run), "--data", str(prepared3)]) == 2
+    assert V.main([str(run), "--prepared", str(prepared3)]) == 2
     assert "has not finished" in capsys.readouterr().err

@@ -1,4 +1,4 @@
-// Shared by the tests: read a fixture written by `python -m training.fixtures` and compare arrays.
+// Shared by the tests: read a fixture written by `tests/python/fixtures_writer.py` and compare arrays.
 
 import { readFileSync } from 'node:fs';
 import { expect } from 'vitest';

@@ -1,4 +1,4 @@
-"""Fixtures that pin web/*.ts to the Python reference: `python -m training.fixtures`.
+"""Fixtures that pin web/*.ts to the Python reference: `.venv/bin/python tests/python/fixtures_writer.py`.
 
 Writes tests/fixtures/{bvh,features,rollout}.json: inputs, and what training/bvh.py,
 skeleton.py, features.py and rollout.py compute from them. tests/web/*.test.ts run the TypeScript
@@ -15,19 +15,25 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import sys
 from pathlib import Path
 
 import numpy as np
 
-from . import features as feat
-from . import rollout as ro
-from .bvh import BvhError, axis_rotation, forward_kinematics, local_transforms, parse_bvh
-from .features import Track
-from .skeleton import (JOINT_NAMES, MIRROR, PARENTS, Motion, facing_direction,
-                       forward_kinematics_reduced, gaussian_smooth, mirror_motion, reduce_bvh,
-                       resample, root_from_motion)
+REPO = Path(__file__).resolve().parents[2]
+if str(REPO) not in sys.path:      # run as a script from anywhere
+    sys.path.insert(0, str(REPO))
 
-OUT_DIR = Path(__file__).resolve().parent.parent / "tests" / "fixtures"
+from training import features as feat  # noqa: E402
+from training import rollout as ro  # noqa: E402
+from training.bvh import BvhError, forward_kinematics, local_transforms, parse_bvh  # noqa: E402
+from training.features import Track  # noqa: E402
+from training.synthetic import OFFSETS, procedural_dancer  # noqa: E402
+from training.skeleton import (FPS, JOINT_NAMES, MIRROR, PARENTS, Motion, facing_direction,  # noqa: E402
+                               forward_kinematics_reduced, gaussian_smooth, mirror_motion, reduce_bvh,
+                               resample, root_from_motion)
+
+OUT_DIR = REPO / "tests" / "fixtures"
 FRAMES = 63            # 30 past + 2 frames t + 31 future: valid_frames(63) == [30, 31]
 SEED = 20240611
 
@@ -237,61 +243,8 @@ def bvh_fixture(rng: np.random.Generator) -> dict:
 
 # ---------------------------------------------------------------- procedural dancers
 
-# Offsets (metres) of a plausible 17-joint dancer: arms out along x (a T pose at rest), legs down.
-OFFSETS = np.array([
-    [0, 0, 0], [0, 0.10, 0], [0, 0.18, 0.01], [0, 0.25, -0.01], [0, 0.12, 0.02],
-    [0.18, 0.20, 0], [0.28, 0, 0], [0.25, 0, 0],
-    [-0.18, 0.20, 0], [-0.28, 0, 0], [-0.25, 0, 0],
-    [0.09, -0.06, 0], [0, -0.44, 0.01], [0, -0.42, -0.02],
-    [-0.09, -0.06, 0], [0, -0.44, 0.01], [0, -0.42, -0.02],
-], dtype=np.float64)
-
-
-def euler(angles_deg: np.ndarray) -> np.ndarray:
-    """[F, 3] (x, y, z) degrees -> [F, 3, 3] as Rz Rx Ry (the CMU channel order)."""
-    return (axis_rotation("Z", angles_deg[:, 2]) @ axis_rotation("X", angles_deg[:, 0])
-            @ axis_rotation("Y", angles_deg[:, 1]))
-
-
-def procedural_dancer(rng: np.random.Generator, frames: int, centre_angle: np.ndarray,
-                      offsets: np.ndarray, scale: float) -> Motion:
-    """A dancer on a circle around a drifting centre, facing the centre, stepping and swinging."""
-    t = np.arange(frames) / 30.0
-    J = len(PARENTS)
-    local = np.empty((frames, J, 3, 3))
-    # Sinusoidal joint angles with random amplitudes and phases, plus seeded random jitter.
-    amp = rng.uniform(3, 25, (J, 3))
-    freq = rng.uniform(0.5, 2.5, (J, 3))
-    phase = rng.uniform(0, 2 * np.pi, (J, 3))
-    angles = amp * np.sin(2 * np.pi * freq * t[:, None, None] + phase) + rng.normal(0, 0.3, (frames, J, 3))
-    angles[:, 5, 2] -= 70    # left arm down from the T pose
-    angles[:, 8, 2] += 70    # right arm down
-    # Legs step in turn: each swings through half a cycle and stands still (planted) the other half.
-    step = np.sin(2 * np.pi * 1.2 * t)
-    angles[:, 11:17] = 0
-    angles[:, 11, 0] = 30 * np.maximum(0, step)
-    angles[:, 14, 0] = 30 * np.maximum(0, -step)
-    angles[:, 12, 0] = -25 * np.maximum(0, step)
-    angles[:, 15, 0] = -25 * np.maximum(0, -step)
-    angles[:, 0] *= 0.1
-    for j in range(J):
-        local[:, j] = euler(angles[:, j])
-    # Circle around a drifting centre, facing it (heading = atan2 of the direction to the centre).
-    centre = np.stack([0.12 * t - 0.3, 0.05 * t + 0.2], -1)
-    pos = centre + scale * np.stack([np.cos(centre_angle), np.sin(centre_angle)], -1)
-    to_centre = centre - pos
-    facing = np.arctan2(to_centre[:, 0], to_centre[:, 1]) + 0.1 * np.sin(2 * np.pi * 0.7 * t)
-    local[:, 0] = np.stack([ro.rotation_y(h) for h in facing]) @ local[:, 0]
-    world = np.empty_like(local)
-    for j, p in enumerate(PARENTS):
-        world[:, j] = local[:, j] if p < 0 else world[:, p] @ local[:, j]
-    hip = np.stack([pos[:, 0], 1.0 + 0.02 * np.sin(2 * np.pi * 2.4 * t), pos[:, 1]], -1)
-    positions = forward_kinematics_reduced(offsets, hip, world)
-    return Motion(np.round(positions, 6), np.round(world, 6), offsets, 30.0)
-
-
 def procedural_pair(rng: np.random.Generator) -> tuple[Motion, Motion]:
-    t = np.arange(FRAMES) / 30.0
+    t = np.arange(FRAMES) / FPS
     angle = 1.3 + 0.5 * t    # the pair turns slowly; the leader's heading crosses ±pi
     lead_offsets = OFFSETS.copy()
     follow_offsets = np.round(OFFSETS * 0.94, 6)

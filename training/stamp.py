@@ -1,0 +1,41 @@
+"""Which training an exported ONNX file comes from.
+
+export writes a stamp into every file it writes (step models and their evaluation files) as ONNX
+metadata: the run's fingerprint (runs.fingerprint: weights, configuration, normalization), the
+model name, role and code size. The manifest repeats the fingerprint per model. Evaluation reads
+the stamps back and refuses to score a step model with an evaluation file of another training.
+"""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+STAMP_KEY = "duet"
+EVAL_FOLDER = "eval"                       # MODELS/eval/: evaluation only, the page never loads it
+OUTPUT_ENCODER = "{name}.output_encoder.onnx"
+
+
+def eval_file(models: str | Path, name: str) -> Path:
+    """Where the output encoder of model `name` lies next to its step model."""
+    return Path(models) / EVAL_FOLDER / OUTPUT_ENCODER.format(name=name)
+
+
+def write_stamp(path: str | Path, stamp: dict) -> None:
+    import onnx
+    model = onnx.load(str(path))
+    kept = [p for p in model.metadata_props if p.key != STAMP_KEY]
+    del model.metadata_props[:]
+    model.metadata_props.extend(kept)
+    model.metadata_props.add(key=STAMP_KEY, value=json.dumps(stamp, sort_keys=True))
+    onnx.save(model, str(path))
+
+
+def read_stamp(path: str | Path) -> dict | None:
+    """The stamp of an exported file; None for a file without one (exported before stamps, or
+    not by training.export)."""
+    import onnx
+    model = onnx.load(str(path), load_external_data=False)
+    for p in model.metadata_props:
+        if p.key == STAMP_KEY:
+            return json.loads(p.value)
+    return None
