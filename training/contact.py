@@ -127,6 +127,9 @@ class ContactLayer:
             hl, hf = leader[HANDS[i]].copy(), follower[HANDS[j]].copy()
             mid, u = (hl + hf) / 2, (hl - hf) / d
             move_hand(leader, HANDS[i], hl + (mid + u * GRIP / 2 - hl) * self.hold)
-            move_hand(follower, HANDS[j], hf + (mid - u * GRIP / 2 - hf) * self.hold)
+            # The follower's hand goes to where the leader's hand got (an arm too short to reach the
+            # midpoint leaves the rest of the way to the partner's arm).
+            reached = leader[HANDS[i]]
+            move_hand(follower, HANDS[j], hf + (reached - u * GRIP - hf) * self.hold)
         self.leader_feet.apply(leader, leader_contacts, leader_heading)
         self.follower_feet.apply(follower, follower_contacts, follower_heading)

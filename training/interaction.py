@@ -34,10 +34,11 @@ from tqdm import tqdm
 from . import features as feat
 from . import metrics as M
 from .contact import ContactLayer
-from .dataset import DEFAULT_DATA, DataError
+from .dataset import DataError
 from .evaluate import (EvalError, EvalTake, clean, find_models, load_eval_takes, load_onnx, rollout,
                        window)
 from .features import HISTORY, follower_input, foot_contacts
+from .folders import add_folder
 from .motion_matching import build, load_tracks, training_takes
 from .rollout import NOW, Dancer, OnnxPolicy, apply_output
 from .soak import soak_one, steering_trials
@@ -192,14 +193,14 @@ def write_markdown(path: Path, res: dict) -> None:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m training.interaction", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--data", default=DEFAULT_DATA, help="folder of SUBJECT_TAKE.bvh pairs")
+    add_folder(ap, "data", "the takes whose recording is the reference (and Motion Matching's database)")
     ap.add_argument("--takes", default="02,13", help="comma-separated takes (the recording's reference)")
-    ap.add_argument("--models", default="public/models", help="exported models (manifest.json)")
+    add_folder(ap, "models", "the follower and leader models measured")
     ap.add_argument("--methods", default=None, help="comma-separated subset (ours, ccm, motion_matching, ...)")
     ap.add_argument("--seeds", type=int, default=4, help="steered duets per method")
     ap.add_argument("--seconds", type=float, default=60.0, help="length of each steered duet")
     ap.add_argument("--temperature", type=float, default=None, help="default: the manifest's")
-    ap.add_argument("--out", default="runs/interaction")
+    ap.add_argument("--out", default="runs/interaction", help="where interaction.json and .md go")
     ap.add_argument("--quiet", action="store_true")
     args = ap.parse_args(argv)
     try:

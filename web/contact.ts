@@ -183,7 +183,10 @@ export class ContactLayer {
       const ux = (lx - fx) / d, uy = (ly - fy) / d, uz = (lz - fz) / d;
       const g = GRIP / 2, w = this.hold;
       moveHand(leader, hl, lx + (mx + ux * g - lx) * w, ly + (my + uy * g - ly) * w, lz + (mz + uz * g - lz) * w);
-      moveHand(follower, hf, fx + (mx - ux * g - fx) * w, fy + (my - uy * g - fy) * w, fz + (mz - uz * g - fz) * w);
+      // The follower's hand goes to where the leader's hand got (an arm too short to reach the
+      // midpoint leaves the rest of the way to the partner's arm).
+      const rx = leader[3 * hl] - ux * GRIP, ry = leader[3 * hl + 1] - uy * GRIP, rz = leader[3 * hl + 2] - uz * GRIP;
+      moveHand(follower, hf, fx + (rx - fx) * w, fy + (ry - fy) * w, fz + (rz - fz) * w);
     }
     this.leaderFeet.apply(leader, leaderContacts, leaderHeading);
     this.followerFeet.apply(follower, followerContacts, followerHeading);

@@ -26,6 +26,7 @@ if str(REPO) not in sys.path:      # run as a script from anywhere
 
 from training import features as feat  # noqa: E402
 from training import rollout as ro  # noqa: E402
+from training.contact import ContactLayer  # noqa: E402
 from training.bvh import BvhError, forward_kinematics, local_transforms, parse_bvh  # noqa: E402
 from training.features import Track  # noqa: E402
 from training.synthetic import OFFSETS, procedural_dancer  # noqa: E402
@@ -36,6 +37,7 @@ from training.skeleton import (FPS, JOINT_NAMES, MIRROR, PARENTS, Motion, facing
 OUT_DIR = REPO / "tests" / "fixtures"
 FRAMES = 63            # 30 past + 2 frames t + 31 future: valid_frames(63) == [30, 31]
 SEED = 20240611
+CONTACT_STEPS = 40     # frames of the contact layer fixture (<= FRAMES)
 
 
 # ---------------------------------------------------------------- number formatting
@@ -445,6 +447,43 @@ def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_o
     }
 
 
+def contact_fixture(rng: np.random.Generator, leader: Motion, follower: Motion) -> dict:
+    """The contact layer (training/contact.py) over CONTACT_STEPS frames of the procedural pair,
+    pushed together so the spines overlap, the hands come within reach and drift apart again, and
+    the feet touch down and lift: every branch of separation, hold and foot lock runs."""
+    steps = CONTACT_STEPS
+    lead = np.round(leader.positions[:steps], 5)
+    follow = follower.positions[:steps].copy()
+    # Walk the follower into the leader and out again: centre distance 0.6 -> 0.1 -> 0.6 m.
+    gap = np.concatenate([np.linspace(0.6, 0.1, steps // 2), np.linspace(0.1, 0.6, steps - steps // 2)])
+    toward = lead[:, :1, [0, 2]] - follow[:, :1, [0, 2]]
+    toward /= np.linalg.norm(toward, axis=-1, keepdims=True)
+    shift = toward * (np.linalg.norm(lead[:, :1, [0, 2]] - follow[:, :1, [0, 2]], axis=-1, keepdims=True)
+                      - gap[:, None, None])
+    follow[:, :, [0, 2]] += shift
+    follow = np.round(follow, 5)
+    # Foot contacts: on/off runs, with values around the 0.5 threshold.
+    lead_c = np.round(rng.uniform(0, 1, (steps, 2)) ** 0.5, 3)
+    follow_c = np.round(np.where((np.arange(steps)[:, None] // 5 + np.arange(2)) % 2 == 0, 0.9, 0.1), 3)
+    lead_h = np.round(1.3 + 0.5 * np.arange(steps) / FPS, 6)
+    follow_h = np.round(lead_h + np.pi, 6)
+    layer = ContactLayer()
+    shown_l, shown_f, hold, hands, pushed = [], [], [], [], []
+    for t in range(steps):
+        a, b = lead[t].copy(), follow[t].copy()
+        if t == steps - 5:
+            layer.clear()     # as after a reset: locks and hold start over
+        layer.apply(a, b, lead_c[t], follow_c[t], float(lead_h[t]), float(follow_h[t]))
+        shown_l.append(a); shown_f.append(b)
+        hold.append(layer.hold); hands.append(layer.hands); pushed.append(layer.pushed)
+    return {"steps": steps, "clearAt": steps - 5,
+            "leader": exact(lead), "follower": exact(follow),
+            "leaderContacts": exact(lead_c), "followerContacts": exact(follow_c),
+            "leaderHeading": exact(lead_h), "followerHeading": exact(follow_h),
+            "shownLeader": out7(shown_l), "shownFollower": out7(shown_f), "hold": out7(hold),
+            "hands": [int(v) for v in np.ravel(hands)], "pushed": out7(pushed)}
+
+
 def build() -> dict[str, dict]:
     rng = np.random.default_rng(SEED)
     bvh = bvh_fixture(rng)
@@ -454,6 +493,7 @@ def build() -> dict[str, dict]:
         "bvh": bvh,
         "features": features_fixture(rng, lead, follow),
         "rollout": rollout_fixture(rng, lead, follow, leader.offsets, follower.offsets),
+        "contact": contact_fixture(np.random.default_rng(SEED + 1), leader, follower),
     }
 
 

@@ -9,7 +9,7 @@ export type Json = any;
 const cache = new Map<string, Json>();
 
 /** tests/fixtures/<name>.json, parsed once per test file. */
-export function fixture(name: 'bvh' | 'features' | 'rollout'): Json {
+export function fixture(name: 'bvh' | 'features' | 'rollout' | 'contact'): Json {
   let data = cache.get(name);
   if (!data) {
     data = JSON.parse(readFileSync(new URL(`../fixtures/${name}.json`, import.meta.url), 'utf8'));

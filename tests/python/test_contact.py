@@ -1,0 +1,157 @@
+"""The interaction metrics, the training terms on the decoded body, and the run-time contact layer
+(training/metrics.py, partner_losses.py, footik.py, contact.py) on cases with a known answer."""
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+import torch
+
+from training import metrics as M
+from training import partner_losses as P
+from training.contact import SEPARATION, ContactLayer, separate, spine_gap
+from training.footik import ANKLE_FLOOR, FootLock, two_bone_ik
+from training.skeleton import FEET, PARENTS
+
+
+def standing(x: float = 0.0, z: float = 0.0) -> np.ndarray:
+    """A crude upright body [17, 3] at (x, z): spine up the y axis, arms out, legs down."""
+    p = np.zeros((17, 3))
+    p[:5, 1] = [0.95, 1.1, 1.3, 1.5, 1.65]
+    p[5:8] = [[0.18, 1.45, 0], [0.42, 1.45, 0.2], [0.65, 1.45, 0]]      # elbows bent forward
+    p[8:11] = [[-0.18, 1.45, 0], [-0.42, 1.45, 0.2], [-0.65, 1.45, 0]]
+    p[11:14] = [[0.1, 0.95, 0], [0.1, 0.5, 0.1], [0.1, 0.08, 0]]     # knees a little bent
+    p[14:17] = [[-0.1, 0.95, 0], [-0.1, 0.5, 0.1], [-0.1, 0.08, 0]]
+    p[:, 0] += x
+    p[:, 2] += z
+    return p
+
+
+def bone_lengths(p):
+    return np.linalg.norm(p[1:] - p[PARENTS[1:]], axis=-1)
+
+
+def test_segment_distance_matches_dense_sampling():
+    rng = np.random.default_rng(0)
+    p = rng.normal(size=(500, 4, 3))
+    p[:50, 1] = p[:50, 0]            # p is a point
+    p[50:100, 3] = p[50:100, 2]      # q is a point
+    p[100:150, 3] = p[100:150, 2] + (p[100:150, 1] - p[100:150, 0])   # parallel
+    d = M.segment_distance(p[:, 0], p[:, 1], p[:, 2], p[:, 3])
+    s = np.linspace(0, 1, 201)[None, :, None]
+    a = p[:, None, 0] + (p[:, 1] - p[:, 0])[:, None] * s
+    b = p[:, None, 2] + (p[:, 3] - p[:, 2])[:, None] * s
+    dense = np.linalg.norm(a[:, :, None] - b[:, None], axis=-1).min((1, 2))
+    assert np.all(d <= dense + 1e-9) and np.all(d > dense - 0.01)
+
+
+def test_interaction_counts_overlap_hands_and_skate():
+    lead = np.stack([standing(0, 0)] * 4)
+    # Overlapping (hands side by side too), 1.4 m apart (the leader's left hand at x 0.65 meets the
+    # follower's right hand at x 0.75), then 3 m apart.
+    close = np.stack([standing(0.1, 0)] * 2 + [standing(1.4, 0), standing(3.0, 0)])
+    r = M.interaction(lead, close)
+    assert r["interpenetration"] == 0.5
+    assert r["hand_hold"] == 0.75
+    assert r["skate_leader_cm"] == 0.0
+    slide = lead.copy()
+    slide[:, FEET, 0] += np.arange(4)[:, None] * 0.02     # 2 cm a frame, ankles low
+    assert M.interaction(slide, close)["skate_leader_cm"] == pytest.approx(2.0)
+    contacts = np.array([[1, 1], [1, 1], [0, 0], [0, 0]])
+    r = M.interaction(slide, close, contacts, contacts)
+    assert r["contact_skate_leader_cm"] == pytest.approx(2.0)   # only the step 0 -> 1 counts
+    assert M.ratio_to({"a": 2.0, "b": 0.0}, {"a": 1.0, "b": 3.0}) == {"a": 0.5, "b": None}
+
+
+def test_steering_response_time_and_speed():
+    fps = 30
+    root = np.zeros((240, 2))
+    for f in range(1, 240):   # north at 0.5 m/s, then east from frame 120 on after a 0.5 s delay
+        v = np.array([0, 0.5]) if f < 135 else np.array([0.5, 0])
+        root[f] = root[f - 1] + v / fps
+    r = M.steering_response(root, 120, np.array([1.0, 0.0]))
+    assert r["speed"] == pytest.approx(0.5)
+    assert 0.5 <= r["seconds"] <= 0.5 + 10 / fps
+
+
+def test_two_bone_ik_keeps_bones_and_reaches():
+    p = standing()
+    before = bone_lengths(p)
+    two_bone_ik(p, 11, 12, 13, np.array([0.2, 0.2, 0.1]), (0, 0, 1))
+    assert np.allclose(bone_lengths(p), before)
+    assert np.allclose(p[13], [0.2, 0.2, 0.1], atol=1e-6)
+
+
+def test_foot_lock_holds_a_planted_foot_and_never_sinks():
+    lock = FootLock()
+    p = standing()
+    lock.apply(p, [1, 0], 0.0)
+    planted = p[FEET[0]].copy()
+    moved = standing(0.05, 0)          # the model slides the body 5 cm
+    lock.apply(moved, [1, 0], 0.0)
+    assert np.allclose(moved[FEET[0]], planted, atol=1e-6)
+    low = standing()
+    low[FEET[1], 1] = 0.0
+    FootLock().apply(low, [0, 0], 0.0)
+    assert low[FEET[1], 1] >= ANKLE_FLOOR - 1e-9
+
+
+def test_separate_pushes_overlapping_spines_apart_horizontally():
+    a, b = standing(0, 0), standing(0.1, 0)
+    push = separate(a, b)
+    assert push == pytest.approx((SEPARATION - 0.1) / 2)
+    assert spine_gap(a, b)[0] == pytest.approx(SEPARATION)
+    assert a[0, 1] == 0.95                              # heights unchanged
+    assert separate(standing(0, 0), standing(1, 0)) == 0.0
+
+
+def test_contact_layer_brings_near_hands_together_and_keeps_bones():
+    lead, follow = standing(0, 0), standing(1.6, 0)   # hands 0.3 m apart
+    lengths = bone_lengths(follow)
+    layer = ContactLayer()
+    for _ in range(20):
+        a, b = lead.copy(), follow.copy()
+        layer.apply(a, b, [0, 0], [0, 0], 0.0, 0.0)
+    assert layer.hold > 0.6
+    gap = np.linalg.norm(a[7] - b[10])
+    assert gap < 0.3 * (1 - 0.6) + 0.06
+    assert np.allclose(bone_lengths(b), lengths)
+
+
+def test_partner_terms_are_zero_on_the_recording_and_bite_on_error(prepared3):
+    """On recorded samples the decoded body is the recorded one: no penetration beyond the
+    recording's, matched hand distances; shifting the output root into the partner costs."""
+    with np.load(prepared3 / "train.npz") as z:
+        x = torch.tensor(z["follower_input"][:256], dtype=torch.float64)
+        y = torch.tensor(z["follower_output"][:256], dtype=torch.float64)
+        mirror = z["mirror"][:256]
+    from training.prepared import load_offsets
+    offsets = load_offsets(str(prepared3), "follower", "cpu").double()[torch.from_numpy(mirror).long()]
+    exact = P.partner_terms(y, y, x, offsets, "follower")
+    assert float(exact["interaction"]) == 0.0
+    # FK of the decoded rotations reproduces the pose block's positions.
+    pose = y[:, P.OUT["pose"]].reshape(-1, 17, 12)[..., :3]
+    still = torch.cat([torch.zeros(len(y), 3, dtype=y.dtype), y[:, 3:]], 1)
+    assert torch.allclose(P.decoded_positions(still, offsets), pose, atol=1e-4)
+    # Move the decoded dancer onto the partner's hip: penetration and interaction both grow.
+    partner_hip = P.block_positions(x, P.input_slices("follower")["partner_pose"])[:, 0]
+    onto = y.clone()
+    onto[:, 0], onto[:, 1] = partner_hip[:, 0], partner_hip[:, 2]
+    worse = P.partner_terms(onto, y, x, offsets, "follower")
+    assert float(worse["penetration"]) > float(exact["penetration"]) + 1e-3
+    assert float(worse["interaction"]) > 0.0
+
+
+def test_interaction_command_on_fresh_models(exported, data3, tmp_path, capsys):
+    from training.interaction import main
+    rc = main(["--data", str(data3), "--takes", "06", "--models", str(exported["models"]), "--seeds", "1",
+               "--seconds", "2", "--out", str(tmp_path), "--quiet"])
+    assert rc == 0
+    res = json.loads((tmp_path / "interaction.json").read_text())
+    assert set(res["methods"]) >= {"ours", "ccm", "motion_matching"}
+    for row in res["methods"].values():
+        for proto in ("teacher_forced", "free_running", "free_running_layer", "steered", "steered_layer"):
+            assert 0.0 <= row[proto]["interpenetration"] <= 1.0
+        assert row["steering"]["trials"] == 8
+    assert "recording" in (tmp_path / "interaction.md").read_text()
