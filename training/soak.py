@@ -7,7 +7,8 @@ Runs the exported ONNX models through training/rollout.py (the loop the page mir
 steering script that changes every 0.5-3 s: random directions, sharp reversals, long holds and
 idle spells. Per rollout it reports non-finite numbers, the largest leader-follower distance,
 bone-length error, the lowest foot, the share of frozen frames and guard resets; it exits 1 when
-any rollout breaks a limit.
+any rollout breaks a limit. The summary adds how the duet reads as a couple (metrics.interaction),
+for the networks alone and with the run-time contact layer (training/contact.py).
 """
 from __future__ import annotations
 
@@ -172,7 +173,11 @@ def main(argv=None) -> int:
           f"follower {args.follower}, temperature {temperature}")
     print(" seed  nonfinite  max dist m  bone err mm  min foot cm  frozen L  frozen F  resets  result")
     for i in tqdm(range(args.rollouts), desc="soak", unit="rollout", leave=False):
-        r = soak_one(manifest, leader, follower, args.seed + i, frames, temperature)
+        rec = {}
+        r = soak_one(manifest, leader, follower, args.seed + i, frames, temperature, rec)
+        r["interaction"] = M.interaction(rec["leader"], rec["follower"], rec["leader_contacts"], rec["follower_contacts"])
+        r["interaction_layer"] = M.interaction(rec["leader_shown"], rec["follower_shown"], rec["leader_contacts"],
+                                               rec["follower_contacts"])
         r["failures"] = failures(r)
         results.append(r)
         tqdm.write(f"{r['seed']:>5} {r['nonfinite']:>10} {r['max_distance']:>11.2f} "
@@ -186,9 +191,18 @@ def main(argv=None) -> int:
                "min_foot_cm": min(r["min_foot"] for r in results) * 100,
                "frozen_max": max(max(r["frozen_leader"], r["frozen_follower"]) for r in results),
                "resets": sum(r["resets"] for r in results), "seconds": time.time() - t0}
+    for key in ("interaction", "interaction_layer"):
+        summary[key] = {k: float(np.mean([r[key][k] for r in results])) for k in results[0][key]}
     print(f"summary: {len(bad)} of {len(results)} rollouts failed; max distance {summary['max_distance']:.2f} m; "
           f"bone error {summary['bone_error_mm']:.4f} mm; lowest foot {summary['min_foot_cm']:.1f} cm; "
           f"most frozen {summary['frozen_max']:.3f}; resets {summary['resets']}; {summary['seconds']:.0f} s")
+    for key, title in (("interaction", "networks alone"), ("interaction_layer", "with the contact layer")):
+        m = summary[key]
+        print(f"interaction, {title}: torsos through each other {m['interpenetration']:.1%} of frames, "
+              f"hands within 20 cm {m['hand_hold']:.1%}, closest hands {m['closest_hand_m']:.2f} m, "
+              f"foot skate leader / follower {m['contact_skate_leader_cm']:.2f} / "
+              f"{m['contact_skate_follower_cm']:.2f} cm per contact frame "
+              f"({m['skate_leader_cm']:.2f} / {m['skate_follower_cm']:.2f} while low)")
     if args.out:
         Path(args.out).write_text(json.dumps({"summary": summary, "rollouts": results}, indent=1))
     return 1 if bad else 0

@@ -83,6 +83,8 @@ MODELS = {
     "follower_no_foot_contact": TrainConfig(model=FOLLOWER, intention_noise=0.3, **{**PARTNER, "lambda_foot_contact": 0.0}),
     "follower_no_interaction": TrainConfig(model=FOLLOWER, intention_noise=0.3, **{**PARTNER, "lambda_interaction": 0.0}),
     "follower_no_partner_terms": TrainConfig(model=FOLLOWER, intention_noise=0.3),
+    "follower_strong_penetration": TrainConfig(model=FOLLOWER, intention_noise=0.3,
+                                               **{**PARTNER, "lambda_penetration": 3000.0}),
     "follower_small": TrainConfig(model=replace(FOLLOWER, hidden=256, intention_hidden=128), intention_noise=0.3),
     "follower_ccm_large": TrainConfig(model=replace(FOLLOWER, intention=False, channels=3 * FOLLOWER.channels)),
     "follower_no_gan": TrainConfig(model=FOLLOWER, lambda_generator=0.0, intention_noise=0.3),

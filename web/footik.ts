@@ -1,5 +1,5 @@
-// Foot locking for drawing: while the model says a foot is planted (contact > 0.5), keep it where
-// the contact began, with a two-bone IK on thigh - shin - foot, and never below the floor.
+// Mirror of training/footik.py. Foot locking for drawing: while the model says a foot is planted
+// (contact > 0.5), keep it where the contact began, with a two-bone IK on thigh - shin - foot, and never below the floor.
 //
 // This touches only the DRAWN positions (DancerView.positions). The Track the features read stays
 // exactly what the model produced, so the page's features remain identical to Python's.
@@ -9,8 +9,9 @@ import { FEET, PARENTS } from './skeleton';
 /** Lowest height of the ankle joint: a flat foot's ankle sits 7-11 cm up in the data, so 6 cm
  *  keeps the sole above the floor without ever lifting a real flat foot. */
 export const ANKLE_FLOOR = 0.06;
-/** A lock further than this from the model's foot is stale (a reset, a glitch): let it go. */
-export const MAX_LOCK_DISTANCE = 0.25;
+/** A lock further than this from the model's foot is stale (a reset, a glitch, a step the model
+ *  took without lifting the foot): let it go. About a stride (training/footik.py: measured). */
+export const MAX_LOCK_DISTANCE = 0.4;
 /** After a contact ends, the lock's pull decays by this factor per step (no pop on release). */
 export const RELEASE_DECAY = 0.5;
 

@@ -54,6 +54,7 @@ const hook: DuetHook = {
   threads: 1,
   modelBytes: 0,
   firstFrameMs: null,
+  hold: 0,
 };
 window.duet = hook;
 installGlobalErrorHandlers();
@@ -203,6 +204,8 @@ class Page {
     for (let i = 0; i < simulation.followers.length; i++) this.followers[i].capture(simulation.followers[i], snap);
     publish(hook.leader, simulation.leader);
     publish(hook.follower, simulation.followers[0]);
+    const hands = simulation.leader.hands;
+    hook.hold = hands ? Math.max(hands[0], hands[1]) : 0;
     const stats = simulation.stepMs();
     hook.stepMs.median = stats.median;
     hook.stepMs.p95 = stats.p95;

@@ -146,6 +146,9 @@ export interface DuetHook {
   stepMs: { median: number; p95: number };
   /** Follower model in use: 'ours', 'ccm' or 'compare'. */
   model: string;
+  /** The contact layer's hand hold between the leader and the (first) follower, 0..1
+   *  (web/contact.ts): 1 when the closest hands meet. */
+  hold: number;
   // Extras for the bench and for debugging (not part of the contract).
   paused: boolean;
   threads: number;

@@ -152,6 +152,24 @@ describe('desktop', () => {
     assert.ok(variance > MIN_VARIANCE, `screenshot variance ${variance.toFixed(1)}`);
   });
 
+  test('hands meet: the contact layer draws the closest hands together (docs/screenshot-hands.png)', async () => {
+    await page.goto(`${server.url}?seed=1`);
+    await waitReady(page, 10_000);
+    await waitSteps(page, 90); // past the start pose: the dancers have moved on their own
+    const deadline = Date.now() + 60_000;
+    let hold = 0;
+    while (Date.now() < deadline && hold < 0.8) {
+      await sleep(30);
+      hold = await page.evaluate(() => window.duet.hold);
+    }
+    assert.ok(hold >= 0.8, `the hands never met within 60 s (hold ${hold.toFixed(2)})`);
+    await page.keyboard.press('Space'); // pause on the held frame for the picture
+    await sleep(200);
+    const png = await page.screenshot();
+    writeFileSync(join(ROOT, 'docs', 'screenshot-hands.png'), png);
+    await page.keyboard.press('Space');
+  });
+
   test('no console errors', () => {
     assert.deepEqual(browser.consoleErrors, []);
   });
