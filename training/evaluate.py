@@ -616,6 +616,16 @@ def clean(o):
     return o
 
 
+def write_report(out: Path, stem: str, res: dict, markdown) -> dict:
+    """out/STEM.json (JSON-safe) and out/STEM.md (written by `markdown`), which is printed too."""
+    out.mkdir(parents=True, exist_ok=True)
+    res = clean(res)
+    (out / f"{stem}.json").write_text(json.dumps(res, indent=1, allow_nan=False))
+    markdown(out / f"{stem}.md", res)
+    print((out / f"{stem}.md").read_text())
+    return res
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m training.evaluate", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -650,13 +660,8 @@ def main(argv=None) -> int:
     except (EvalError, DataError) as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    res = clean(res)
-    (out / "metrics.json").write_text(json.dumps(res, indent=1, allow_nan=False))
-    write_markdown(out / "metrics.md", res)
-    print((out / "metrics.md").read_text())
-    print(f"wrote {out}/metrics.json and {out}/metrics.md in {res['config']['seconds']:.0f} s")
+    res = write_report(Path(args.out), "metrics", res, write_markdown)
+    print(f"wrote {args.out}/metrics.json and {args.out}/metrics.md in {res['config']['seconds']:.0f} s")
     return 0
 
 

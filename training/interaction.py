@@ -23,7 +23,6 @@ measured for our leader with each follower.
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 import time
 from pathlib import Path
@@ -35,8 +34,8 @@ from . import features as feat
 from . import metrics as M
 from .contact import ContactLayer
 from .dataset import DataError
-from .evaluate import (EvalError, EvalTake, clean, find_models, load_eval_takes, load_onnx, rollout,
-                       window)
+from .evaluate import (EvalError, EvalTake, find_models, load_eval_takes, load_onnx, rollout, window,
+                       write_report)
 from .features import HISTORY, follower_input, foot_contacts
 from .folders import add_folder
 from .motion_matching import build, load_tracks, training_takes
@@ -186,7 +185,8 @@ def write_markdown(path: Path, res: dict) -> None:
           "| follower | seconds to within 30° | missed | speed m/s |", "|---|---|---|---|"]
     for m, row in res["methods"].items():
         s = row["steering"]
-        L.append(f"| {m} | {s['turn_seconds']:.2f} | {s['turn_missed']} of {s['trials']} | {s['speed']:.2f} |")
+        seconds = "n/a" if s["turn_seconds"] is None else f"{s['turn_seconds']:.2f}"
+        L.append(f"| {m} | {seconds} | {s['turn_missed']} of {s['trials']} | {s['speed']:.2f} |")
     path.write_text("\n".join(L) + "\n")
 
 
@@ -208,11 +208,7 @@ def main(argv=None) -> int:
     except (EvalError, DataError) as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    (out / "interaction.json").write_text(json.dumps(clean(res), indent=1))
-    write_markdown(out / "interaction.md", res)
-    print((out / "interaction.md").read_text())
+    write_report(Path(args.out), "interaction", res, write_markdown)
     return 0
 
 
