@@ -95,14 +95,15 @@ def interaction_loss(me: torch.Tensor, target: torch.Tensor, partner: torch.Tens
 
 
 def partner_terms(out: torch.Tensor, target: torch.Tensor, x: torch.Tensor, offsets: torch.Tensor,
-                  role: str) -> dict[str, torch.Tensor]:
+                  role: str, recorded_contacts: bool = False) -> dict[str, torch.Tensor]:
     """Raw decoded output, raw target output [B, 323], raw input [B, 660], offsets [B, 17, 3] ->
-    the three terms (scalars)."""
+    the three terms (scalars). The foot-contact term is weighted by the decoded contacts, or by
+    the recorded ones with `recorded_contacts`."""
     sl = input_slices(role)
     me = decoded_positions(out, offsets)
     recorded = decoded_positions(target, offsets)
     partner = block_positions(x, sl["partner_pose"])
     before = block_positions(x, sl["self_pose"])
     return {"penetration": penetration_loss(me, partner),
-            "foot_contact": foot_contact_loss(me, before, out[:, OUT["contacts"]]),
+            "foot_contact": foot_contact_loss(me, before, (target if recorded_contacts else out)[:, OUT["contacts"]]),
             "interaction": interaction_loss(me, recorded, partner)}

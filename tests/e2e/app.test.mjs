@@ -164,7 +164,12 @@ describe('desktop', () => {
     }
     assert.ok(hold >= 0.8, `the hands never met within 60 s (hold ${hold.toFixed(2)})`);
     await page.keyboard.press('Space'); // pause on the held frame for the picture
-    await sleep(200);
+    // Orbit a quarter turn so the pair is seen from the side, hands between them.
+    await page.mouse.move(640, 420);
+    await page.mouse.down();
+    await page.mouse.move(900, 420, { steps: 12 });
+    await page.mouse.up();
+    await sleep(300);
     const png = await page.screenshot();
     writeFileSync(join(ROOT, 'docs', 'screenshot-hands.png'), png);
     await page.keyboard.press('Space');
