@@ -8,8 +8,9 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 PY=.venv/bin/python
 DATA=${1:-$($PY -c "from training.folders import default_data; print(default_data())")}
-ROWS=(follower_no_partner_terms follower_no_penetration follower_penetration_100 follower_no_foot_contact
-      follower_foot_contact_10 follower_foot_contact_30 follower_no_interaction)
+ROWS=(follower_no_partner_terms follower_no_penetration follower_no_foot_contact follower_no_interaction
+      follower_recorded_contact_30 follower_decoded_contact_5 follower_decoded_contact_10
+      follower_decoded_contact_30 follower_decoded_contact_30_penetration_100)
 for m in follower follower_ccm leader "${ROWS[@]}"; do
   [ -f "runs/models/$m/checkpoint.pt" ] || $PY -m training.train --model "$m" --threads 1
 done

@@ -9,8 +9,10 @@ body and the own body of the frame before, both given in the input:
 
 - penetration: the dancer's spine (hip-abdomen-chest-neck) must stay 2 x TORSO_RADIUS from the
   partner's spine (metrics.interaction counts frames closer than that as interpenetrating);
-- foot contact: where the decoded contact says a foot is planted, the decoded foot must not move
-  horizontally from where the input says it was;
+- foot contact: where a foot is planted, the decoded foot must not move horizontally from where
+  the input says it was. "Planted" is the recorded contact label (what the decoded contact learns
+  to say); weighting by the decoded contact instead let the model stiffen its whole motion
+  (train.py, PARTNER);
 - interaction: where a joint pair of the two dancers is within reach in the recording, its
   decoded distance keeps the recorded one (hands that meet stay met).
 
@@ -79,8 +81,8 @@ def penetration_loss(me: torch.Tensor, partner: torch.Tensor) -> torch.Tensor:
 
 
 def foot_contact_loss(me: torch.Tensor, before: torch.Tensor, contacts: torch.Tensor) -> torch.Tensor:
-    """Squared horizontal foot motion (m^2) weighted by the decoded contact (not pushed lower by
-    this term: it is detached)."""
+    """Squared horizontal foot motion (m^2) weighted by the contacts [B, 2] (detached: a decoded
+    contact is never pushed lower by this term)."""
     slide = (me[:, FEET][..., [0, 2]] - before[:, FEET][..., [0, 2]]).pow(2).sum(-1)   # [B, 2]
     return (contacts.detach().clamp(0, 1) * slide).mean()
 
