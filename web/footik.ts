@@ -10,8 +10,8 @@ import { FEET, PARENTS } from './skeleton';
  *  keeps the sole above the floor without ever lifting a real flat foot. */
 export const ANKLE_FLOOR = 0.06;
 /** A lock further than this from the model's foot is stale (a reset, a glitch, a step the model
- *  took without lifting the foot): let it go. About a stride (training/footik.py: measured). */
-export const MAX_LOCK_DISTANCE = 0.4;
+ *  took without lifting the foot): let it go. A long stride (training/footik.py: measured). */
+export const MAX_LOCK_DISTANCE = 0.5;
 /** After a contact ends, the lock's pull decays by this factor per step (no pop on release). */
 export const RELEASE_DECAY = 0.5;
 
