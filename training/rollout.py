@@ -31,7 +31,7 @@ STEER_HALFLIFE = 0.25      # s for the steered velocity to get halfway to the st
 MAX_JOINT_DISTANCE = 3.0   # m from the root: beyond this the output is absurd
 MAX_ROOT_JUMP = 1.0        # m in one step
 MIN_ANKLE_HEIGHT = 0.04    # m: the lowest ankle height in the recordings
-ANCHOR_RATE = 0.15         # share of the leader's distance to its anchor closed every frame
+ANCHOR_RATE = 0.3          # share of the leader's distance to its anchor closed every frame
                            # in which neither foot is planted (scaled down by the contacts)
 LEASH_DISTANCE = 2.0       # m: beyond this a follower is drawn toward its leader ...
 LEASH_RATE = 0.1           # ... closing this share of the excess every frame
@@ -182,9 +182,10 @@ def follow_anchor(leader: Dancer, steering: Steering) -> None:
     path it wanders (about 1.7 m in 3 s here), and steered it answers only in part. Pulling the
     root toward the anchor lets it dance freely around the spot the user left it at and travel
     where the user steers. The pull moves the whole body, so it acts only as far as no foot is
-    planted (1 - the larger contact): a planted foot is never slid by it. Measured (4 x 60 s of
-    soak steering, `training.interaction`): an ungated 0.05 spring and this gated 0.15 one turn
-    the leader within 30 degrees of a 90-degree stick turn in 0.46 s and 0.51 s.
+    planted (1 - the larger contact): a planted foot is never slid by it. Measured with the
+    shipped models (training.soak.steering_trials: 8 turns of 90 degrees), seconds until the
+    leader moves within 30 degrees of the new direction: gated rate 0.15 0.77 s, 0.3 0.58 s,
+    0.5 0.53 s (the ungated 0.05 spring before it, with the models of then: 0.46 s).
     """
     free = 1.0 - float(np.clip(leader.contacts, 0.0, 1.0).max())
     shift_dancer(leader, (steering.anchor - leader.root) * ANCHOR_RATE * free)
