@@ -12,7 +12,17 @@ PROTOCOLS = [("teacher_forced", "teacher-forced"), ("free_running", "free-runnin
              ("free_running_layer", "free-running + layer"), ("steered", "steered"),
              ("steered_layer", "steered + layer")]
 NAMES = {"ours": "ours", "ccm": "CCM", "motion_matching": "Motion Matching",
-         "follower_no_partner_terms": "ours before (no partner terms)"}
+         "follower_no_partner_terms": "ours before (no partner terms)",
+         "follower_no_penetration": "w/o penetration", "follower_no_foot_contact": "w/o foot contact",
+         "follower_no_interaction": "w/o interaction",
+         "follower_recorded_contact_30": "foot contact 30 (recorded contacts)",
+         "follower_decoded_contact_5": "foot contact 5 on decoded contacts",
+         "follower_decoded_contact_10": "foot contact 10 on decoded contacts",
+         "follower_decoded_contact_30": "foot contact 30 on decoded contacts",
+         "follower_decoded_contact_30_penetration_100": "foot contact 30 on decoded, penetration 100"}
+ORDER = ["ours", "follower_no_partner_terms", "follower_no_penetration", "follower_no_foot_contact",
+         "follower_no_interaction", "follower_recorded_contact_30", "follower_decoded_contact_5",
+         "follower_decoded_contact_10", "follower_decoded_contact_30", "follower_decoded_contact_30_penetration_100"]
 
 
 def pct(v: float) -> str:
@@ -45,7 +55,7 @@ def interaction_table(res: dict, methods: list[str]) -> list[str]:
 
 def terms_table(res: dict, ev: dict, methods: list[str]) -> list[str]:
     ref = res["recording"]
-    L = ["| follower | MPJPE cm | FID | Diversity | steered: torsos through | hands within 20 cm | "
+    L = ["| follower (partner terms) | MPJPE cm | FID | Diversity | steered: torsos through | hands within 20 cm | "
          "closest hands m | follower skate in contact / while low cm | + layer: through / hands / skate in contact |",
          "|---|---|---|---|---|---|---|---|---|"]
     for m in methods:
@@ -74,7 +84,8 @@ def main(argv: list[str]) -> int:
     evals = Path(argv[1] if len(argv) > 1 else "runs/partner_eval/metrics.json")
     res, ev = json.loads(inter.read_text()), json.loads(evals.read_text())
     shipped = [m for m in ("ours", "ccm", "motion_matching", "follower_no_partner_terms") if m in res["methods"]]
-    rows = [m for m in res["methods"] if m not in ("ccm", "motion_matching") and m in ev["methods"]]
+    rows = [m for m in ORDER if m in res["methods"] and m in ev["methods"]]
+    rows += [m for m in res["methods"] if m not in rows + ["ccm", "motion_matching"] and m in ev["methods"]]
     print("\n".join(interaction_table(res, shipped)), "\n")
     print("\n".join(terms_table(res, ev, rows)), "\n")
     print("\n".join(steering_table(res, shipped)))
