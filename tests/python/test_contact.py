@@ -122,10 +122,16 @@ def test_contact_layer_brings_near_hands_together_and_keeps_bones():
 def test_partner_terms_are_zero_on_the_recording_and_bite_on_error(prepared3):
     """On recorded samples the decoded body is the recorded one: no penetration beyond the
     recording's, matched hand distances; shifting the output root into the partner costs."""
-    with np.load(prepared3 / "train.npz") as z:
-        x = torch.tensor(z["follower_input"][:256], dtype=torch.float64)
-        y = torch.tensor(z["follower_output"][:256], dtype=torch.float64)
-        mirror = z["mirror"][:256]
+    # The offsets in stats.npz are the first take's (prepare): read that take's samples, wherever
+    # the split put it (synthetic couples vary their skeletons from take to take).
+    for split in ("train", "validation", "test"):
+        with np.load(prepared3 / f"{split}.npz") as z:
+            rows = np.nonzero(z["take"] == 0)[0][:256]
+            if len(rows):
+                x = torch.tensor(z["follower_input"][rows], dtype=torch.float64)
+                y = torch.tensor(z["follower_output"][rows], dtype=torch.float64)
+                mirror = z["mirror"][rows]
+                break
     from training.prepared import load_offsets
     offsets = load_offsets(str(prepared3), "follower", "cpu").double()[torch.from_numpy(mirror).long()]
     exact = P.partner_terms(y, y, x, offsets, "follower")
