@@ -1,23 +1,5 @@
 /// <reference types="vitest/config" />
-import { rmSync } from 'node:fs';
-import { resolve } from 'node:path';
-import { defineConfig, type Plugin } from 'vite';
-
-// public/models/eval/ holds each follower's output encoder for training.evaluate (fp32, ~6 MB
-// each); the page never loads it, so the static site leaves it out.
-function dropEvaluationModels(): Plugin {
-  let outDir = 'dist';
-  return {
-    name: 'duet-drop-evaluation-models',
-    apply: 'build',
-    configResolved(config) {
-      outDir = resolve(config.root, config.build.outDir);
-    },
-    closeBundle() {
-      rmSync(resolve(outDir, 'models', 'eval'), { recursive: true, force: true });
-    },
-  };
-}
+import { defineConfig } from 'vite';
 
 // Cross-origin isolation (COOP + COEP) is what lets onnxruntime-web use SharedArrayBuffer and
 // therefore more than one WASM thread. Any static host serving dist/ needs the same two headers;
@@ -30,7 +12,6 @@ const isolationHeaders = {
 export default defineConfig({
   // Relative asset URLs so dist/ works from any sub-path (GitHub Pages, a folder on a server).
   base: './',
-  plugins: [dropEvaluationModels()],
   server: { host: '127.0.0.1', port: 5173, strictPort: false, headers: isolationHeaders },
   preview: { host: '127.0.0.1', port: 4173, strictPort: false, headers: isolationHeaders },
   // onnxruntime-web finds its .wasm/.mjs next to itself via import.meta.url; pre-bundling moves it

@@ -10,8 +10,9 @@ against). Three protocols:
 (a) teacher-forced: every input from the recording, one step; MPJPE of the t+1 pose in the
     follower's root space (codes at temperature 0). Codebook error: the step model's code at
     temperature 0 against its output encoder's code of the recorded output, read from
-    MODELS/eval/NAME.output_encoder.onnx; a step model and an evaluation file (or manifest entry)
-    of different trainings (their fingerprints differ) are refused.
+    MODELS/eval/NAME.output_encoder.onnx (models/eval/ for public/models); a step model and an
+    evaluation file (or manifest entry) of different trainings (their fingerprints differ) are
+    refused.
 (b) free-running: the leader is played back from the recording (its whole window, future keys
     included, every step); the follower starts from the recording's state and is fed its own
     output (rollout.apply_output), for each --seeds x --temperatures. MPJPE in root space against
@@ -46,7 +47,7 @@ from .dataset import (TEST_TAKES, VALIDATION_TAKES, DataError, discover_takes,
 from .folders import add_folder, add_retired
 from .features import FUTURE_OFFSETS, HISTORY, Track, follower_input, leader_input, output_features
 from .motion_matching import MotionMatching, build, load_tracks, own_future, training_takes
-from .stamp import eval_file, read_stamp
+from .stamp import eval_file, eval_folder, read_stamp
 from .rollout import NOW, Dancer, OnnxPolicy, apply_output, output_is_absurd, reset_beside
 
 OUT = feat.block_slices(feat.OUTPUT_LAYOUT)
@@ -580,7 +581,7 @@ def evaluate(args) -> dict:
                           "rollout_mpjpe_cm": roll["mpjpe_cm"], "root_error_m": roll["root_error_m"],
                           "resets": roll["resets"]}
     if any(v is None for m, v in cb.items() if m != "ground_truth"):
-        notes.append(f"codebook error is null where {args.models}/eval/ lacks the model's output encoder")
+        notes.append(f"codebook error is null where {eval_folder(args.models)} lacks the model's output encoder")
     notes.append("codebook error: the step model's own code at temperature 0 (the exported int8 file) against "
                  "the code its output encoder gives the recorded output (eval/NAME.output_encoder.onnx, fp32); "
                  "both files carry one training's fingerprint")

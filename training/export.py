@@ -8,14 +8,16 @@ sampling with temperature and noise as inputs, gather decoder, de-normalization)
 only builds features and reads results. Dynamic int8 (per channel) because static QDQ int8 runs
 6-8x slower in the browser's WASM backend.
 
-Each follower also gets MODELS/eval/NAME.output_encoder.onnx (fp32, evaluation only; the page
-never downloads it): what training.evaluate needs for the codebook error. Every file carries the
+Each follower also gets MODELS/eval/NAME.output_encoder.onnx (fp32, evaluation only; for the
+page's public/models it goes to models/eval/, outside what the site publishes: stamp.eval_folder):
+what training.evaluate needs for the codebook error. Every file carries the
 run's fingerprint (training/stamp.py), repeated in manifest.json.
 """
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 from pathlib import Path
 
@@ -111,7 +113,7 @@ def write_manifest(out: Path, models: dict[str, StepModel], data: str, prepared:
             "fingerprint": fingerprint(m)}
         e = eval_file(out, name)
         if m.cfg.role == "follower" and e.exists():
-            entry["eval"] = {"outputEncoder": str(e.relative_to(out)), "bytes": e.stat().st_size}
+            entry["eval"] = {"outputEncoder": os.path.relpath(e, out), "bytes": e.stat().st_size}
     (out / "manifest.json").write_text(json.dumps(manifest, indent=1))
     return manifest
 

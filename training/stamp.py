@@ -13,11 +13,22 @@ from pathlib import Path
 STAMP_KEY = "duet"
 EVAL_FOLDER = "eval"                       # MODELS/eval/: evaluation only, the page never loads it
 OUTPUT_ENCODER = "{name}.output_encoder.onnx"
+REPO = Path(__file__).resolve().parent.parent
+PAGE_MODELS = REPO / "public" / "models"   # what the static site publishes and the page's budget counts
+SHIPPED_EVAL = REPO / "models" / "eval"    # the shipped models' evaluation files, outside public/
+
+
+def eval_folder(models: str | Path) -> Path:
+    """Where the evaluation files of the step models in `models` lie: MODELS/eval/, except for the
+    page's own public/models, whose evaluation files (fp32, about 5 MB each) live in models/eval/
+    at the top of the repository, so that nothing the page does not load is published with it."""
+    models = Path(models)
+    return SHIPPED_EVAL if models.resolve() == PAGE_MODELS.resolve() else models / EVAL_FOLDER
 
 
 def eval_file(models: str | Path, name: str) -> Path:
-    """Where the output encoder of model `name` lies next to its step model."""
-    return Path(models) / EVAL_FOLDER / OUTPUT_ENCODER.format(name=name)
+    """Where the output encoder of model `name` lies (see eval_folder)."""
+    return eval_folder(models) / OUTPUT_ENCODER.format(name=name)
 
 
 def write_stamp(path: str | Path, stamp: dict) -> None:

@@ -241,3 +241,6 @@ def test_shipped_models_fit_the_size_budget():
     for name, entry in manifest["models"].items():
         assert entry["bytes"] == sizes[name], name
     assert sum(sizes.values()) <= 6_000_000, sizes
+    # Everything under public/ is published with the site: the evaluation files stay outside it.
+    published = {str(f.relative_to(SHIPPED)): f.stat().st_size for f in SHIPPED.rglob("*.onnx")}
+    assert sum(published.values()) <= 6_000_000, published
