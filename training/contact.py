@@ -17,8 +17,8 @@ from __future__ import annotations
 import numpy as np
 
 from .footik import FootLock, two_bone_ik
-from .metrics import HANDS, SPINE, TORSO_RADIUS
-from .skeleton import PARENTS
+from .metrics import TORSO_RADIUS, closest_on_segments
+from .skeleton import HANDS, PARENTS, SPINE
 
 SEPARATION = 2 * TORSO_RADIUS + 0.01   # m between the spines after the push (1 cm to spare)
 HAND_REACH = 0.45      # m: a hand pair closer than this starts to meet (a forearm's length)
@@ -28,33 +28,16 @@ HOLD_RATE = 0.3        # share of the way the hold weight moves to its target ev
 ELBOW_POLE = (0.0, -1.0, 0.0)   # a straight arm bends its elbow downward
 
 
-def closest_on_segments(p0, p1, q0, q1) -> tuple[float, float]:
-    """Parameters (s, t) in [0, 1] of the closest points p0 + s (p1 - p0), q0 + t (q1 - q0)."""
-    d1, d2, r = p1 - p0, q1 - q0, p0 - q0
-    a, e, b = float(d1 @ d1), float(d2 @ d2), float(d1 @ d2)
-    c, f = float(d1 @ r), float(d2 @ r)
-    denom = a * e - b * b
-    s = min(max((b * f - c * e) / denom, 0.0), 1.0) if denom > 1e-12 else 0.0
-    t = (b * s + f) / e if e > 1e-12 else 0.0
-    if t < 0.0 or t > 1.0 or e <= 1e-12:
-        t = min(max(t, 0.0), 1.0)
-        s = min(max((b * t - c) / a, 0.0), 1.0) if a > 1e-12 else 0.0
-    return s, t
-
-
 def spine_gap(a: np.ndarray, b: np.ndarray) -> tuple[float, np.ndarray]:
     """Closest distance between the two spines (positions [17, 3]) and the horizontal unit
     direction from b's closest point to a's (the way to push a; b goes the other way)."""
-    best, away = np.inf, np.zeros(3)
-    for i in range(len(SPINE) - 1):
-        for j in range(len(SPINE) - 1):
-            p0, p1 = a[SPINE[i]], a[SPINE[i + 1]]
-            q0, q1 = b[SPINE[j]], b[SPINE[j + 1]]
-            s, t = closest_on_segments(p0, p1, q0, q1)
-            diff = (p0 + s * (p1 - p0)) - (q0 + t * (q1 - q0))
-            dist = float(np.linalg.norm(diff))
-            if dist < best:
-                best, away = dist, diff
+    pa0, pa1 = a[SPINE[:-1]][:, None], a[SPINE[1:]][:, None]          # [3, 1, 3]: a's segments
+    pb0, pb1 = b[SPINE[:-1]][None], b[SPINE[1:]][None]                # [1, 3, 3]: b's
+    s, t = closest_on_segments(pa0, pa1, pb0, pb1)                    # [3, 3] pairs
+    diff = (pa0 + (pa1 - pa0) * s[..., None]) - (pb0 + (pb1 - pb0) * t[..., None])
+    dist = np.linalg.norm(diff, axis=-1)
+    i, j = np.unravel_index(np.argmin(dist), dist.shape)   # the first of equal pairs, as web/contact.ts
+    best, away = float(dist[i, j]), diff[i, j]
     away = np.array([away[0], 0.0, away[2]])
     n = float(np.linalg.norm(away))
     if n < 1e-6:   # one spine right above the other: push along the line between the hips

@@ -179,7 +179,8 @@ def write_markdown(path: Path, res: dict) -> None:
     for m, row in res["methods"].items():
         for proto in ("teacher_forced", "free_running", "free_running_layer", "steered", "steered_layer"):
             r = row[proto]
-            cells = [f"{r[k]:.3f} ({r[k] / ref[k]:.2f}×)" if ref[k] else f"{r[k]:.3f}" for k in KEYS]
+            ratio = M.ratio_to(ref, r)
+            cells = [f"{r[k]:.3f}" + (f" ({ratio[k]:.2f}×)" if ratio.get(k) is not None else "") for k in KEYS]
             L.append(f"| {m} | {proto.replace('_', ' ')} | " + " | ".join(cells) + " |")
     L += ["", "Steering response of our leader (90-degree stick turns):", "",
           "| follower | seconds to within 30° | missed | speed m/s |", "|---|---|---|---|"]

@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from .features import CONTACT_HEIGHT, POSE_SIZE, ROOT_UPDATE_SIZE, Track, pose_block, root_update
-from .skeleton import FEET, FPS, HANDS
+from .skeleton import FEET, FPS, HANDS, SPINE
 
 
 # ---------------------------------------------------------------- pose and motion quality
@@ -58,24 +58,21 @@ def foot_skate_cm(positions: np.ndarray, contacts: np.ndarray | None = None,
 def hand_distance(a: np.ndarray, b: np.ndarray) -> float:
     """Mean over frames of the smallest of the 4 hand-to-hand distances (m) between two dancers'
     world positions [T, J, 3]."""
-    ha, hb = np.asarray(a)[:, HANDS], np.asarray(b)[:, HANDS]
-    d = np.linalg.norm(ha[:, :, None] - hb[:, None, :], axis=-1)                  # [T, 2, 2]
-    return float(d.reshape(len(d), -1).min(1).mean())
+    return float(closest_hand_distance(a, b).mean())
 
 
 # ---------------------------------------------------------------- the two dancers together
 
-# The torso as a chain of capsules hip -> abdomen -> chest -> neck. 14 cm is about half a
-# torso's depth and width at the chest: two torsos whose spines come closer than twice that
-# pass through each other.
-SPINE = [0, 1, 2, 3]
+# The torso as capsules around the SPINE chain. 14 cm is about half a torso's depth and width at
+# the chest: two torsos whose spines come closer than twice that pass through each other.
 TORSO_RADIUS = 0.14
 HAND_HOLD_DISTANCE = 0.20   # m between a hand of each dancer: holding, or about to
 
 
-def segment_distance(p0: np.ndarray, p1: np.ndarray, q0: np.ndarray, q1: np.ndarray) -> np.ndarray:
-    """Closest distance between segments p0-p1 and q0-q1 ([..., 3] each, broadcast) -> [...].
-    Exact: the clamped closest-point parameters of two segments, degenerate ones included."""
+def closest_on_segments(p0: np.ndarray, p1: np.ndarray, q0: np.ndarray, q1: np.ndarray):
+    """Parameters (s, t) in [0, 1] of the closest points p0 + s (p1 - p0) and q0 + t (q1 - q0) of
+    two segments ([..., 3] each, broadcast) -> two arrays [...]. Exact, degenerate segments
+    included (web/contact.ts closestOnSegments is the same for one pair)."""
     d1, d2, r = p1 - p0, q1 - q0, p0 - q0
     a, e = (d1 * d1).sum(-1), (d2 * d2).sum(-1)
     b, c, f = (d1 * d2).sum(-1), (d1 * r).sum(-1), (d2 * r).sum(-1)
@@ -88,8 +85,13 @@ def segment_distance(p0: np.ndarray, p1: np.ndarray, q0: np.ndarray, q1: np.ndar
     t_clamped = np.clip(t, 0, 1)
     redo = (t != t_clamped) | (e <= eps)
     s = np.where(redo, np.where(a > eps, np.clip((b * t_clamped - c) / np.maximum(a, eps), 0, 1), 0.0), s)
-    closest = (p0 + d1 * s[..., None]) - (q0 + d2 * t_clamped[..., None])
-    return np.linalg.norm(closest, axis=-1)
+    return s, t_clamped
+
+
+def segment_distance(p0: np.ndarray, p1: np.ndarray, q0: np.ndarray, q1: np.ndarray) -> np.ndarray:
+    """Closest distance between segments p0-p1 and q0-q1 ([..., 3] each, broadcast) -> [...]."""
+    s, t = closest_on_segments(p0, p1, q0, q1)
+    return np.linalg.norm((p0 + (p1 - p0) * s[..., None]) - (q0 + (q1 - q0) * t[..., None]), axis=-1)
 
 
 def torso_distance(a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -23,8 +23,8 @@ from __future__ import annotations
 import torch
 
 from . import features as feat
-from .metrics import HANDS, SPINE, TORSO_RADIUS
-from .skeleton import FEET, PARENTS
+from .metrics import TORSO_RADIUS
+from .skeleton import FEET, HANDS, PARENTS, SPINE
 
 OUT = feat.block_slices(feat.OUTPUT_LAYOUT)
 REACH = 0.5              # m: joint pairs closer than this in the recording keep their distance

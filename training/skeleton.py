@@ -24,6 +24,8 @@ JOINT_NAMES = [
 PARENTS = [-1, 0, 1, 2, 3, 2, 5, 6, 2, 8, 9, 0, 11, 12, 0, 14, 15]
 HEAD = JOINT_NAMES.index("head")
 HANDS = [JOINT_NAMES.index("lHand"), JOINT_NAMES.index("rHand")]      # 7, 10
+# The torso as a chain hip -> abdomen -> chest -> neck (the partners' bodies must not cross it).
+SPINE = [JOINT_NAMES.index(n) for n in ("hip", "abdomen", "chest", "neck")]  # 0, 1, 2, 3
 FEET = [JOINT_NAMES.index("lFoot"), JOINT_NAMES.index("rFoot")]       # 13, 16 (the ankles)
 # Head, both hands, both feet: the paper's five key joints for trajectories and intention.
 KEY_JOINTS = [HEAD, *HANDS, *FEET]                                   # 4, 7, 10, 13, 16

@@ -12,24 +12,26 @@
 // hands along the forearm. Nothing here allocates per frame.
 
 import * as THREE from 'three';
+import { HEAD, JOINT_NAMES } from './skeleton';
 
 const JOINT_RADIUS = 0.055;
 const HEAD_RADIUS = 0.11;
 const BONE_RADIUS = 0.045;
 
-// Joint indices (training/skeleton.py JOINT_NAMES).
-const NECK = 3;
-const HEAD = 4;
-const L_SHOULDER = 5;
-const L_ELBOW = 6;
-const L_WRIST = 7;
-const R_SHOULDER = 8;
-const R_ELBOW = 9;
-const R_WRIST = 10;
-const L_HIP = 11;
-const L_ANKLE = 13;
-const R_HIP = 14;
-const R_ANKLE = 16;
+// Joint indices, by name (web/skeleton.ts JOINT_NAMES): the shoulder, elbow and wrist are the
+// skeleton's lShldr, lForeArm and lHand; the hip and ankle its lThigh and lFoot.
+const joint = (name: (typeof JOINT_NAMES)[number]): number => JOINT_NAMES.indexOf(name);
+const NECK = joint('neck');
+const L_SHOULDER = joint('lShldr');
+const L_ELBOW = joint('lForeArm');
+const L_WRIST = joint('lHand');
+const R_SHOULDER = joint('rShldr');
+const R_ELBOW = joint('rForeArm');
+const R_WRIST = joint('rHand');
+const L_HIP = joint('lThigh');
+const L_ANKLE = joint('lFoot');
+const R_HIP = joint('rThigh');
+const R_ANKLE = joint('rFoot');
 
 /** The extra instances after the 17 joints of each dancer, in this order. */
 const EXTRA_L_HAND = 0;

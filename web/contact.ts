@@ -11,12 +11,10 @@
 // 3. planted feet stay planted: FootLock on both dancers, last, so a body moved by 1. keeps its feet.
 
 import { FootLock, twoBoneIk } from './footik';
-import { PARENTS } from './skeleton';
+import { HANDS, PARENTS, SPINE } from './skeleton';
 
-/** Spine joints hip -> abdomen -> chest -> neck, and the hands (training/metrics.py). */
-export const SPINE = [0, 1, 2, 3];
-export const HANDS = [7, 10];
-/** About half a torso's depth at the chest: spines closer than twice this pass through each other. */
+/** About half a torso's depth at the chest: spines closer than twice this pass through each other
+ *  (training/metrics.py). */
 export const TORSO_RADIUS = 0.14;
 /** m between the spines after the push (1 cm to spare). */
 export const SEPARATION = 2 * TORSO_RADIUS + 0.01;
@@ -28,13 +26,16 @@ export const HAND_FULL = 0.25;
 export const GRIP = 0.06;
 /** Share of the way the hold weight moves to its target every step. */
 export const HOLD_RATE = 0.3;
+/** A straight arm bends its elbow downward. */
+export const ELBOW_POLE = [0, -1, 0];
 
 type Positions = Float32Array | Float64Array;
 
 const clamp01 = (v: number): number => Math.min(Math.max(v, 0), 1);
 
 /** Parameters [s, t] in [0, 1] of the closest points p0 + s (p1 - p0), q0 + t (q1 - q0) of two
- *  segments given by joint indices into a (p) and b (q); written into `out`. */
+ *  segments given by joint indices into a (p) and b (q); written into `out` (training/metrics.py
+ *  closest_on_segments, for many pairs at once). */
 export function closestOnSegments(
   a: Positions, p0: number, p1: number, b: Positions, q0: number, q1: number, out: Float64Array,
 ): void {
@@ -67,7 +68,7 @@ export function spineGap(a: Positions, b: Positions, away: Float64Array): number
     for (let j = 0; j < SPINE.length - 1; j++) {
       const p0 = SPINE[i], p1 = SPINE[i + 1], q0 = SPINE[j], q1 = SPINE[j + 1];
       closestOnSegments(a, p0, p1, b, q0, q1, st);
-      const [s, t] = st;
+      const s = st[0], t = st[1];
       const dx = a[3 * p0] + s * (a[3 * p1] - a[3 * p0]) - (b[3 * q0] + t * (b[3 * q1] - b[3 * q0]));
       const dy = a[3 * p0 + 1] + s * (a[3 * p1 + 1] - a[3 * p0 + 1]) - (b[3 * q0 + 1] + t * (b[3 * q1 + 1] - b[3 * q0 + 1]));
       const dz = a[3 * p0 + 2] + s * (a[3 * p1 + 2] - a[3 * p0 + 2]) - (b[3 * q0 + 2] + t * (b[3 * q1 + 2] - b[3 * q0 + 2]));
@@ -137,11 +138,10 @@ export function reachWeight(distance: number): number {
   return clamp01((HAND_REACH - distance) / (HAND_REACH - HAND_FULL));
 }
 
-/** Two-bone IK of the arm (shoulder - forearm - hand) that ends at `hand`; a straight arm bends
- *  its elbow downward. */
+/** Two-bone IK of the arm (shoulder - forearm - hand) that ends at `hand`. */
 export function moveHand(positions: Positions, hand: number, tx: number, ty: number, tz: number): void {
   const elbow = PARENTS[hand];
-  twoBoneIk(positions, PARENTS[elbow], elbow, hand, tx, ty, tz, 0, -1, 0);
+  twoBoneIk(positions, PARENTS[elbow], elbow, hand, tx, ty, tz, ELBOW_POLE[0], ELBOW_POLE[1], ELBOW_POLE[2]);
 }
 
 const pair = new Float64Array(3);

@@ -25,6 +25,9 @@ export const ROTATIONS_SIZE = N_JOINTS * 9; // 153
 export const KEY_JOINTS = [4, 7, 10, 13, 16];
 export const FEET = [13, 16];
 export const HEAD = JOINT_NAMES.indexOf('head'); // 4
+export const HANDS = [JOINT_NAMES.indexOf('lHand'), JOINT_NAMES.indexOf('rHand')]; // 7, 10
+/** The torso as a chain hip -> abdomen -> chest -> neck (the partners' bodies must not cross it). */
+export const SPINE = (['hip', 'abdomen', 'chest', 'neck'] as const).map((n) => JOINT_NAMES.indexOf(n)); // 0, 1, 2, 3
 
 const isUpper = (c: string) => c >= 'A' && c <= 'Z';
 /** Index of each joint's left/right twin (itself for the spine). */
