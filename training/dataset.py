@@ -16,7 +16,7 @@ import numpy as np
 from .bvh import BvhError, read_bvh
 from .features import (HISTORY, Track, follower_input, intention_target, leader_input, output_features,
                        valid_frames)
-from .skeleton import FPS, HEAD, SCALE, Motion, mirror_motion, reduce_bvh, resample
+from .skeleton import FPS, HEAD, SCALE, Motion, mirror_motion, reduce_bvh, resample, time_warp
 
 # Split by take so no validation or test frame has a near-duplicate neighbour in training.
 # 12 is clean; 02 and 13 are full-length takes without the head glitches of 06/07.
@@ -114,9 +114,13 @@ def phases(motion: Motion) -> int:
     return max(1, int(round(motion.fps / FPS)))
 
 
-def pair_tracks(leader: Motion, follower: Motion, phase: int = 0, mirror: bool = False):
-    """Both dancers at 30 fps for one phase offset, optionally mirrored left/right."""
-    lead, follow = resample(leader, FPS, phase), resample(follower, FPS, phase)
+def pair_tracks(leader: Motion, follower: Motion, phase: int = 0, mirror: bool = False, tempo: float = 1.0):
+    """Both dancers at 30 fps for one phase offset, optionally mirrored left/right, and at
+    another tempo (both partners warped together, so the couple stays in step)."""
+    if tempo == 1.0:
+        lead, follow = resample(leader, FPS, phase), resample(follower, FPS, phase)
+    else:
+        lead, follow = time_warp(leader, tempo, FPS, phase), time_warp(follower, tempo, FPS, phase)
     if mirror:
         lead, follow = mirror_motion(lead), mirror_motion(follow)
     return Track.from_motion(lead), Track.from_motion(follow)

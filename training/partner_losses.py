@@ -29,7 +29,8 @@ from .skeleton import FEET, HANDS, PARENTS, SPINE
 OUT = feat.block_slices(feat.OUTPUT_LAYOUT)
 REACH = 0.5              # m: joint pairs closer than this in the recording keep their distance
 SPINE_SAMPLES = 5        # points per spine segment for the penetration distance
-# Joints of each dancer whose mutual distances the interaction term keeps: head, chest, hands.
+# Joints of each dancer whose mutual distances the interaction term keeps: head, chest, hands
+# (a recipe can keep the hands only: TrainConfig.interaction_hands_only).
 INTERACTION_JOINTS = [4, 2, *HANDS]
 
 
@@ -87,17 +88,19 @@ def foot_contact_loss(me: torch.Tensor, before: torch.Tensor, contacts: torch.Te
     return (contacts.detach().clamp(0, 1) * slide).mean()
 
 
-def interaction_loss(me: torch.Tensor, target: torch.Tensor, partner: torch.Tensor) -> torch.Tensor:
-    """Squared error (m^2) of the distances between the two dancers' INTERACTION_JOINTS, over the
-    pairs within REACH in the recording (target = the recorded own body)."""
-    d_hat = torch.cdist(me[:, INTERACTION_JOINTS], partner[:, INTERACTION_JOINTS])
-    d = torch.cdist(target[:, INTERACTION_JOINTS], partner[:, INTERACTION_JOINTS])
+def interaction_loss(me: torch.Tensor, target: torch.Tensor, partner: torch.Tensor,
+                     joints: list[int] = INTERACTION_JOINTS) -> torch.Tensor:
+    """Squared error (m^2) of the distances between the two dancers' `joints`, over the pairs
+    within REACH in the recording (target = the recorded own body)."""
+    d_hat = torch.cdist(me[:, joints], partner[:, joints])
+    d = torch.cdist(target[:, joints], partner[:, joints])
     near = (d < REACH).float()
     return ((d_hat - d).pow(2) * near).sum() / near.sum().clamp_min(1.0)
 
 
 def partner_terms(out: torch.Tensor, target: torch.Tensor, x: torch.Tensor, offsets: torch.Tensor,
-                  role: str, recorded_contacts: bool = False) -> dict[str, torch.Tensor]:
+                  role: str, recorded_contacts: bool = False,
+                  interaction_joints: list[int] = INTERACTION_JOINTS) -> dict[str, torch.Tensor]:
     """Raw decoded output, raw target output [B, 323], raw input [B, 660], offsets [B, 17, 3] ->
     the three terms (scalars). The foot-contact term is weighted by the decoded contacts, or by
     the recorded ones with `recorded_contacts`."""
@@ -108,4 +111,4 @@ def partner_terms(out: torch.Tensor, target: torch.Tensor, x: torch.Tensor, offs
     before = block_positions(x, sl["self_pose"])
     return {"penetration": penetration_loss(me, partner),
             "foot_contact": foot_contact_loss(me, before, (target if recorded_contacts else out)[:, OUT["contacts"]]),
-            "interaction": interaction_loss(me, recorded, partner)}
+            "interaction": interaction_loss(me, recorded, partner, interaction_joints)}

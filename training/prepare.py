@@ -1,8 +1,8 @@
 """python -m training.prepare: paired BVH takes -> feature arrays for training (git-ignored).
 
 Reads the BVH couples in --data; writes PREPARED/{train,validation,test}.npz (both roles, all phase
-offsets, mirrored copies in train) and PREPARED/stats.npz (normalization), then prints frames per
-split and feature sizes.
+offsets, mirrored copies in train, and with --tempos time-warped copies in train) and
+PREPARED/stats.npz (normalization), then prints frames per split and feature sizes.
 """
 from __future__ import annotations
 
@@ -25,7 +25,7 @@ def split_of(take: str, validation: list[str], test: list[str]) -> str:
 
 
 def prepare(data: str, out: str, validation: list[str], test: list[str], leader: str | None = None,
-            all_phases: bool = True, quiet: bool = False) -> dict:
+            all_phases: bool = True, quiet: bool = False, tempos: list[float] | None = None) -> dict:
     takes = discover_takes(data, leader)
     names = [t.name for t in takes]
     for n in validation + test:
@@ -41,14 +41,18 @@ def prepare(data: str, out: str, validation: list[str], test: list[str], leader:
         # validation and test stay one clean pass so their numbers mean frames of real motion.
         n_phase = phases(lead) if (all_phases and split == "train") else 1
         mirrors = (False, True) if split == "train" else (False,)
-        for phase in range(n_phase):
-            for mirror in mirrors:
-                s = samples(*pair_tracks(lead, follow, phase, mirror))
-                n = len(s["frame"])
-                s["take"] = np.full(n, names.index(take.name), np.int16)
-                s["phase"] = np.full(n, phase, np.int8)
-                s["mirror"] = np.full(n, mirror, np.bool_)
-                parts[split].append(s)
+        # Tempo copies (train only): the couple danced faster or slower, both partners together.
+        speeds = [1.0] + (list(tempos or []) if split == "train" else [])
+        for tempo in speeds:
+            for phase in range(n_phase):
+                for mirror in mirrors:
+                    s = samples(*pair_tracks(lead, follow, phase, mirror, tempo))
+                    n = len(s["frame"])
+                    s["take"] = np.full(n, names.index(take.name), np.int16)
+                    s["phase"] = np.full(n, phase, np.int8)
+                    s["mirror"] = np.full(n, mirror, np.bool_)
+                    s["tempo"] = np.full(n, tempo, np.float32)
+                    parts[split].append(s)
     outdir = Path(out)
     outdir.mkdir(parents=True, exist_ok=True)
     summary = {"takes": {k: sorted({names[p["take"][0]] for p in v}) for k, v in parts.items()},
@@ -100,11 +104,20 @@ def main(argv=None) -> int:
     ap.add_argument("--test", default=",".join(TEST_TAKES), help="comma-separated takes")
     ap.add_argument("--leader", default=None, help="subject that leads (default: first by name)")
     ap.add_argument("--one-phase", action="store_true", help="use only phase 0 of 120 fps takes")
+    ap.add_argument("--tempos", default="", metavar="LIST",
+                    help="extra training copies at these tempos, e.g. 0.9,1.1 (1 = as recorded)")
     args = ap.parse_args(argv)
+    try:
+        tempos = [float(t) for t in args.tempos.split(",") if t]
+    except ValueError:
+        ap.error(f"--tempos: expected numbers such as 0.9,1.1, got {args.tempos!r}")
+    if any(not 0.5 <= t <= 2.0 for t in tempos):
+        ap.error(f"--tempos: each tempo must be within 0.5-2 (a salsa couple at half or double speed), got {args.tempos}")
     t0 = time.time()
     try:
         s = prepare(args.data, args.prepared, [t for t in args.validation.split(",") if t],
-                    [t for t in args.test.split(",") if t], args.leader, not args.one_phase)
+                    [t for t in args.test.split(",") if t], args.leader, not args.one_phase,
+                    tempos=[t for t in tempos if t != 1.0])
     except DataError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2

@@ -85,3 +85,10 @@ def load_mirror_flags(prepared: str) -> np.ndarray:
     """Per training sample: True where it is a mirrored copy (its skeleton is mirrored too)."""
     with np.load(Path(prepared) / "train.npz") as z:
         return z["mirror"].astype(bool)
+
+
+def load_tempos(prepared: str) -> np.ndarray:
+    """Per training sample: the tempo of its copy (1 = as recorded; prepare --tempos adds others).
+    Data prepared before tempo copies existed is all at tempo 1."""
+    with np.load(Path(prepared) / "train.npz") as z:
+        return z["tempo"] if "tempo" in z else np.ones(len(z["mirror"]), np.float32)

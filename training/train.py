@@ -30,16 +30,23 @@ from .distributed import average_gradients, broadcast_parameters, pick_device, s
 from .folders import add_folder
 from .loss_plot import plot_history
 from .models import CodebookMatching, Discriminator, IntentionPredictor, ModelConfig, code_logits, sample_codes
-from .prepared import (TrainError, load_mirror_flags, load_offsets, load_split, load_stats, normalize,
-                       pose_error_cm)
+from .prepared import (TrainError, load_mirror_flags, load_offsets, load_split, load_stats, load_tempos,
+                       normalize, pose_error_cm)
 from .runs import load_checkpoint, save_checkpoint
-from .partner_losses import partner_terms
+from .partner_losses import INTERACTION_JOINTS, partner_terms
+from .skeleton import HANDS
 
 
 @dataclass
 class TrainConfig:
     model: ModelConfig = field(default_factory=ModelConfig)
     intention_epochs: int = 20
+    # Regularizing the predictor alone (docs/results.md, "Learning more from the same frames"):
+    # its dropout and weight decay (None: the model's dropout, the shared weight decay), and
+    # whether to keep the epoch with the lowest validation MSE instead of the last one.
+    intention_dropout: float | None = None
+    intention_weight_decay: float | None = None
+    intention_best: bool = False
     epochs: int = 40
     batch_size: int = 256
     lr: float = 1e-3
@@ -59,6 +66,7 @@ class TrainConfig:
     lambda_foot_contact: float = 0.0
     lambda_interaction: float = 0.0
     recorded_contacts: bool = False       # weight the foot-contact term by the recorded contacts
+    interaction_hands_only: bool = False  # the interaction term keeps hand distances only
     seed: int = 1
 
 
@@ -110,6 +118,7 @@ MODELS = {
     "follower_no_foot_contact": partner_variant(lambda_foot_contact=0.0),
     "follower_no_interaction": partner_variant(lambda_interaction=0.0),
     "follower_recorded_contact_30": partner_variant(lambda_foot_contact=30.0),
+    "follower_interaction_hands_only": partner_variant(interaction_hands_only=True),
     "follower_decoded_contact_5": partner_variant(lambda_foot_contact=5.0, recorded_contacts=False),
     "follower_decoded_contact_10": partner_variant(lambda_foot_contact=10.0, recorded_contacts=False),
     "follower_decoded_contact_30": partner_variant(lambda_foot_contact=30.0, recorded_contacts=False),
@@ -166,10 +175,12 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
     y, j = normalize(train["output"], stats, "output"), normalize(train["intention"], stats, "intention")
     xv, yv, jv = (normalize(val[k], stats, k) for k in ("input", "output", "intention"))
     mcfg = cfg.model
-    predictor = IntentionPredictor(mcfg).to(device)
+    predictor = IntentionPredictor(mcfg if cfg.intention_dropout is None
+                                   else replace(mcfg, dropout=cfg.intention_dropout)).to(device)
     matching = CodebookMatching(mcfg).to(device)
     disc = Discriminator(mcfg).to(device)
-    opt_p = torch.optim.AdamW(predictor.parameters(), lr=cfg.lr, weight_decay=cfg.weight_decay)
+    opt_p = torch.optim.AdamW(predictor.parameters(), lr=cfg.lr, weight_decay=cfg.weight_decay
+                              if cfg.intention_weight_decay is None else cfg.intention_weight_decay)
     gen_params = list(matching.parameters()) + (list(predictor.parameters()) if cfg.end_to_end else [])
     opt_g = torch.optim.AdamW(gen_params, lr=cfg.lr, weight_decay=cfg.weight_decay)
     opt_d = torch.optim.AdamW(disc.parameters(), lr=cfg.lr, weight_decay=cfg.weight_decay)
@@ -193,7 +204,11 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
 
     gen = torch.Generator().manual_seed(cfg.seed + 1000 * rank)
     n = len(xr)
-    steps_per_epoch = max(1, n // (cfg.batch_size * world))
+    # An epoch is as many steps as one pass over the samples at the recorded tempo: with tempo
+    # copies (prepare --tempos) each epoch draws that many from the larger pool, so a recipe
+    # with them costs the same time and is compared at the same number of steps.
+    recorded = int((load_tempos(data) == 1.0).sum())
+    steps_per_epoch = max(1, recorded // (cfg.batch_size * world))
 
     def batches(epoch_seed):
         perm = torch.randperm(n, generator=torch.Generator().manual_seed(cfg.seed * 7919 + epoch_seed))
@@ -220,6 +235,7 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
     # Stage 1: the intention predictor alone (MSE), then frozen. End-to-end variants skip it.
     if mcfg.intention and not cfg.end_to_end and stage == "intention":
         total = cfg.intention_epochs * steps_per_epoch
+        best = (math.inf, None)   # validation MSE and weights of the best epoch (intention_best)
         while epoch < cfg.intention_epochs:
             t0 = time.time()
             predictor.train()
@@ -238,11 +254,16 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
                 v = F.mse_loss(predictor(xv.to(device)), jv.to(device)).item()
             history["intention_train"].append(float(np.mean(losses)))
             history["intention_val"].append(v)
+            if v < best[0]:
+                best = (v, {k: t.clone() for k, t in predictor.state_dict().items()})
             epoch += 1
             seconds += time.time() - t0
             if rank == 0 and not quiet:
                 print(f"{name} intention {epoch}/{cfg.intention_epochs}  train {np.mean(losses):.4f}  val {v:.4f}")
             save("intention", epoch)
+        if cfg.intention_best and best[1] is not None:
+            predictor.load_state_dict(best[1])
+            history["intention_kept_epoch"] = int(np.argmin(history["intention_val"])) + 1
         stage, epoch = "matching", 0
         save(stage, epoch)
     elif stage == "intention":
@@ -294,7 +315,8 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
             if any(partner_weights.values()):
                 raw = lambda t, k: t * stats[f"{k}_std"].to(device).float() + stats[f"{k}_mean"].to(device).float()
                 terms = partner_terms(raw(recon, "output"), raw(yb, "output"), raw(x, "input"),
-                                      offsets[mirrored[idx]], role, cfg.recorded_contacts)
+                                      offsets[mirrored[idx]], role, cfg.recorded_contacts,
+                                      HANDS if cfg.interaction_hands_only else INTERACTION_JOINTS)
                 for k, w in partner_weights.items():
                     if w:
                         loss = loss + w * terms[k]
@@ -378,6 +400,11 @@ def main(argv=None) -> int:
     ap.add_argument("--lambda-generator", type=float, help="override λG (λC stays as configured)")
     ap.add_argument("--seed", type=int, help="override the seed (seed-to-seed spread)")
     ap.add_argument("--channels", type=int, help="override the number of code channels C")
+    ap.add_argument("--intention-dropout", type=float, help="override the intention predictor's dropout")
+    ap.add_argument("--intention-weight-decay", type=float, help="override the predictor's weight decay")
+    ap.add_argument("--intention-hidden", type=int, help="override the predictor's width")
+    ap.add_argument("--intention-best", action="store_true",
+                    help="keep the predictor's epoch with the lowest validation MSE (early stopping)")
     ap.add_argument("--smoke", action="store_true", help="tiny sizes and 2 epochs (CI)")
     ap.add_argument("--resume", action="store_true", help="continue from RUNS/NAME/checkpoint.pt")
     ap.add_argument("--device", default="cpu", help="cpu, cuda, cuda:N or auto")
@@ -410,9 +437,18 @@ def main(argv=None) -> int:
                 cfg = replace(cfg, model=replace(cfg.model, channels=args.channels))
             if args.lambda_generator is not None:
                 cfg = replace(cfg, lambda_generator=args.lambda_generator)
+            if args.intention_dropout is not None:
+                cfg = replace(cfg, intention_dropout=args.intention_dropout)
+            if args.intention_weight_decay is not None:
+                cfg = replace(cfg, intention_weight_decay=args.intention_weight_decay)
+            if args.intention_hidden is not None:
+                cfg = replace(cfg, model=replace(cfg.model, intention_hidden=args.intention_hidden))
+            if args.intention_best:
+                cfg = replace(cfg, intention_best=True)
             r = train_model(name, cfg, args.prepared, args.runs, device, args.resume, rank=rank, world=world)
             if rank == 0:
-                print(f"{name}: done in {r['seconds']:.0f} s, val mse {r['val_mse']:.4f}")
+                mse = "" if r["val_mse"] is None else f", val mse {r['val_mse']:.4f}"
+                print(f"{name}: done in {r['seconds']:.0f} s{mse}")
     except TrainError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2

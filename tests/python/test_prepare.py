@@ -206,3 +206,25 @@ def test_files_in_other_units(tmp_path, capsys):
     rc, _, err = run_main(capsys, "--data", data, "--prepared", tmp_path / "out", "--validation", "10", "--test", "10")
     assert_one_error_line(rc, err, "60_10.bvh", "head joint", "other units")
     assert_nothing_written(tmp_path / "out")
+
+
+def test_tempo_copies_are_training_only_and_the_epoch_keeps_its_size(data3, prepared3, tmp_path):
+    from training.prepared import load_tempos
+    out = tmp_path / "tempo"
+    assert main(["--data", str(data3), "--prepared", str(out), "--validation", "12", "--test", "06",
+                 "--tempos", "0.9,1.1"]) == 0
+    tempos = load_tempos(str(out))
+    plain = load_tempos(str(prepared3))
+    assert (tempos == 1.0).sum() == len(plain) and (plain == 1.0).all()
+    # 0.9x plays longer (more samples), 1.1x shorter.
+    assert (tempos == np.float32(0.9)).sum() > len(plain) > (tempos == np.float32(1.1)).sum() > 0
+    for split in ("validation", "test"):
+        with np.load(out / f"{split}.npz") as a, np.load(prepared3 / f"{split}.npz") as b:
+            np.testing.assert_array_equal(a["follower_input"], b["follower_input"])
+
+
+@pytest.mark.parametrize("bad", ["fast", "0.1", "3"])
+def test_bad_tempos_are_refused(data3, tmp_path, capsys, bad):
+    with pytest.raises(SystemExit) as e:
+        main(["--data", str(data3), "--prepared", str(tmp_path / "out"), "--tempos", bad])
+    assert e.value.code == 2 and "--tempos" in capsys.readouterr().err

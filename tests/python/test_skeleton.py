@@ -173,3 +173,25 @@ def test_gaussian_smooth_keeps_length_and_lines():
     np.testing.assert_allclose(y[:, 0], 3.0)
     np.testing.assert_allclose(y[8:-8, 1], x[8:-8, 1], atol=1e-12)
     np.testing.assert_array_equal(gaussian_smooth(x, 0), x)
+
+
+def test_time_warp_at_tempo_1_is_resample_and_keeps_rotations_rotations(take_pair):
+    from training.skeleton import FPS, resample, time_warp
+    lead = take_pair[0]
+    for phase in (0, 3):
+        a, b = time_warp(lead, 1.0, FPS, phase), resample(lead, FPS, phase)
+        assert a.frames == b.frames
+        np.testing.assert_allclose(a.positions, b.positions, atol=1e-12)
+        np.testing.assert_allclose(a.rotations, b.rotations, atol=1e-9)
+    fast = time_warp(lead, 1.1)
+    assert abs(fast.frames - lead.frames / (lead.fps / FPS) / 1.1) <= 1
+    r = fast.rotations
+    np.testing.assert_allclose(r @ np.swapaxes(r, -1, -2), np.broadcast_to(np.eye(3), r.shape), atol=1e-9)
+    assert np.allclose(np.linalg.det(r), 1.0)
+    # 1.1x as fast: frame k of the warped motion is source time 1.1 k / 30 s (linear blend).
+    t = 1.1 * 10 * round(lead.fps / FPS)   # the file says 120.0048 fps; resample reads 120 too
+    i = int(t)
+    expect = lead.positions[i] + (t - i) * (lead.positions[i + 1] - lead.positions[i])
+    np.testing.assert_allclose(fast.positions[10], expect, atol=1e-9)
+    with pytest.raises(ValueError, match="tempo"):
+        time_warp(lead, 0.0)
