@@ -39,12 +39,13 @@ from tqdm import tqdm
 from .dataset import DataError, discover_takes
 from .folders import add_folder
 
-# Method name -> (run name = ONNX stem, shipped recipe it uses, tempo copies in training).
+# Method name -> (run name = ONNX stem, recipe in train.MODELS, tempo copies in training). The
+# recipes are the shipped pair before proximity augmentation: intention or not, all else alike.
 METHODS = {
-    "ours": ("follower", "follower", False),
-    "ccm": ("follower_ccm", "follower_ccm", False),
-    "ours_tempo": ("follower_tempo", "follower", True),
-    "ccm_tempo": ("follower_ccm_tempo", "follower_ccm", True),
+    "ours": ("follower", "follower_no_proximity", False),
+    "ccm": ("follower_ccm", "follower_ccm_no_proximity", False),
+    "ours_tempo": ("follower_tempo", "follower_no_proximity", True),
+    "ccm_tempo": ("follower_ccm_tempo", "follower_ccm_no_proximity", True),
 }
 METRICS = {"mpjpe_cm": "MPJPE cm", "fid": "FID", "codebook_error": "codebook error"}
 TEMPOS = [0.9, 1.1]

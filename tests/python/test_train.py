@@ -276,3 +276,25 @@ def test_validation_refuses_unfinished_and_missing_runs(smoke_runs, prepared3, t
     torch.save(ck, run / "checkpoint.pt")
     assert V.main([str(run), "--prepared", str(prepared3)]) == 2
     assert "has not finished" in capsys.readouterr().err
+
+
+def test_moving_the_partner_closer_shifts_its_whole_window_rigidly(prepared3):
+    from training.prepared import load_split
+    x = torch.from_numpy(load_split(str(prepared3), "train", "follower")["input"][:2000]).float()
+    xm, moved = T.move_partner_closer(x, 0.5, torch.Generator().manual_seed(0))
+    assert 0.2 < moved.float().mean() < 0.56     # half drawn, minus those already closer
+    torch.testing.assert_close(xm[~moved], x[~moved], rtol=0, atol=0)
+    sl = feat.block_slices(feat.FOLLOWER_INPUT_LAYOUT)
+    pose = lambda t, b: t[:, sl[b]].reshape(len(t), feat.N_JOINTS, 12)
+    hips = (pose(xm, "self_pose")[:, 0, [0, 2]] - pose(xm, "partner_pose")[:, 0, [0, 2]]).norm(dim=-1)[moved]
+    lo, hi = T.PROXIMITY_HIP_DISTANCE
+    assert lo - 1e-5 <= hips.min() and hips.max() <= hi + 1e-5
+    # One shift for every partner position; heights, velocities, directions and the own body stay.
+    shift = pose(xm, "partner_pose")[moved][:, 0, [0, 2]] - pose(x, "partner_pose")[moved][:, 0, [0, 2]]
+    keys = lambda t, b: t[:, sl[b]].reshape(len(t), -1, 4)[moved][..., :2]
+    torch.testing.assert_close(keys(xm, "partner_trajectory_future") - keys(x, "partner_trajectory_future"),
+                               shift[:, None].expand(-1, feat.KEYS, -1), rtol=0, atol=1e-5)
+    torch.testing.assert_close(pose(xm, "partner_pose")[..., [1] + list(range(3, 12))],
+                               pose(x, "partner_pose")[..., [1] + list(range(3, 12))], rtol=0, atol=0)
+    for block in ("self_trajectory_past", "self_key_joints_past", "self_pose"):
+        torch.testing.assert_close(xm[:, sl[block]], x[:, sl[block]], rtol=0, atol=0)
