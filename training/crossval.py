@@ -81,6 +81,8 @@ def paired(a: dict, b: dict, folds: list[int], seeds: list[int], metric: str) ->
         if len(d) != len(seeds):
             return None
         per_fold.append(float(np.mean(d)))
+    if not per_fold:
+        return None
     d = np.asarray(per_fold)
     mean = float(d.mean())
     if len(d) < 2:

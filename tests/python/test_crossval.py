@@ -72,3 +72,11 @@ def test_unknown_method_is_a_one_line_error(tmp_path, capsys):
     data = write_couples(tmp_path / "couples", {t: 720 for t in ("01", "02", "03", "04")}, seed=3)
     assert crossval.main(["--data", str(data), "--out", str(tmp_path / "cv"), "--methods", "ours,mine"]) == 2
     assert "unknown mine" in capsys.readouterr().err
+
+
+def test_a_report_before_any_fold_finished_has_no_intervals(tmp_path):
+    plan = {"folds": crossval.make_folds(TAKES, 6), "methods": ["ours", "ccm"], "seeds": [1],
+            "epochs": 20, "intention_epochs": 10, "smoke": False, "tempos": []}
+    res = crossval.report(tmp_path, plan, 0.0)
+    assert res["complete_folds"] == [] and res["comparisons"]["ours - ccm"]["fid"] is None
+    assert "0 of 6 complete" in (tmp_path / "crossval.md").read_text()
