@@ -298,3 +298,22 @@ def test_moving_the_partner_closer_shifts_its_whole_window_rigidly(prepared3):
                                pose(x, "partner_pose")[..., [1] + list(range(3, 12))], rtol=0, atol=0)
     for block in ("self_trajectory_past", "self_key_joints_past", "self_pose"):
         torch.testing.assert_close(xm[:, sl[block]], x[:, sl[block]], rtol=0, atol=0)
+
+
+def test_intention_early_stopping_keeps_the_best_validation_epoch(prepared3, tmp_path):
+    from training.models import IntentionPredictor
+    from training.prepared import load_split, load_stats, normalize
+    cfg = replace(T.smoke(T.MODELS["follower"]), intention_epochs=4, epochs=0, intention_best=True,
+                  intention_dropout=0.0, lr=3e-2)
+    T.train_model("f", cfg, str(prepared3), str(tmp_path), quiet=True)
+    h = json.loads((tmp_path / "f" / "history.json").read_text())
+    assert h["intention_kept_epoch"] == int(np.argmin(h["intention_val"])) + 1
+    ck = torch.load(tmp_path / "f" / "checkpoint.pt", weights_only=False)
+    predictor = IntentionPredictor(cfg.model)
+    predictor.load_state_dict(ck["predictor"])
+    predictor.eval()
+    val, stats = load_split(str(prepared3), "validation", "follower"), load_stats(str(prepared3), "follower")
+    with torch.no_grad():
+        mse = torch.nn.functional.mse_loss(predictor(normalize(val["input"], stats, "input")),
+                                           normalize(val["intention"], stats, "intention")).item()
+    assert mse == pytest.approx(min(h["intention_val"]), rel=1e-5)
