@@ -23,7 +23,7 @@ NAMES = {"ours": "ours", "ccm": "CCM", "motion_matching": "Motion Matching",
          "follower_no_proximity": "ours w/o proximity (shipped until this change)",
          "follower_ccm_no_proximity": "CCM w/o proximity",
          "follower_interaction_hands_only": "w/o proximity, interaction on hands only"}
-ORDER = ["ours", "follower_no_partner_terms", "follower_no_penetration", "follower_no_foot_contact",
+ORDER = ["ours", "ccm", "follower_no_partner_terms", "follower_no_penetration", "follower_no_foot_contact",
          "follower_no_interaction", "follower_recorded_contact_30", "follower_decoded_contact_5",
          "follower_decoded_contact_10", "follower_decoded_contact_30", "follower_decoded_contact_30_penetration_100"]
 
@@ -89,7 +89,7 @@ def main(argv: list[str]) -> int:
     shipped = [m for m in ("ours", "ccm", "motion_matching", "follower_no_partner_terms", "follower_no_proximity",
                            "follower_ccm_no_proximity") if m in res["methods"]]
     rows = [m for m in ORDER if m in res["methods"] and m in ev["methods"]]
-    rows += [m for m in res["methods"] if m not in rows + ["ccm", "motion_matching"] and m in ev["methods"]]
+    rows += [m for m in res["methods"] if m not in rows + ["motion_matching"] and m in ev["methods"]]
     print("\n".join(interaction_table(res, shipped)), "\n")
     print("\n".join(terms_table(res, ev, rows)), "\n")
     print("\n".join(steering_table(res, shipped)))

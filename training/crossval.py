@@ -19,8 +19,9 @@ a 95 % t-interval with folds - 1 degrees of freedom (folds are the independent u
 one fold share its test takes). An interval that excludes 0 is a difference this data can show.
 
 Resumable: finished trainings (history.json) and evaluations (metrics.json) are kept; an
-interrupted training continues from its checkpoint. Writes OUT/crossval.json and
-OUT/crossval.md (also printed).
+interrupted training continues from its checkpoint, and a later call with more seeds or methods
+adds only what is missing. Writes OUT/REPORT.json and OUT/REPORT.md (also printed; --report,
+default crossval), over the methods and seeds of this call.
 """
 from __future__ import annotations
 
@@ -225,10 +226,10 @@ def run_crossval(args) -> dict:
                 e.get()
                 bar.update(1)
             bar.close()
-    return report(out, plan, time.time() - t0)
+    return report(out, plan, time.time() - t0, args.report)
 
 
-def report(out: Path, plan: dict, seconds: float) -> dict:
+def report(out: Path, plan: dict, seconds: float, name: str = "crossval") -> dict:
     from .evaluate import NAMES
     methods, seeds = plan["methods"], plan["seeds"]
     values: dict[str, dict] = {m: {} for m in methods}
@@ -252,8 +253,8 @@ def report(out: Path, plan: dict, seconds: float) -> dict:
                          if fold_ids else None for k in METRICS} for m in methods},
            "per_fold": {m: {f"{f}/{s}": v for (f, s), v in values[m].items()} for m in methods},
            "comparisons": comparisons}
-    (out / "crossval.json").write_text(json.dumps(res, indent=1))
-    (out / "crossval.md").write_text(markdown(res))
+    (out / f"{name}.json").write_text(json.dumps(res, indent=1))
+    (out / f"{name}.md").write_text(markdown(res))
     return res
 
 
@@ -310,6 +311,7 @@ def main(argv=None) -> int:
     ap.add_argument("--eval-seeds", default="0,1,2", help="free-running seeds per evaluation")
     ap.add_argument("--jobs", type=int, default=2, help="processes side by side, one thread each")
     ap.add_argument("--report-only", action="store_true", help="only rebuild the table from OUT")
+    ap.add_argument("--report", default="crossval", help="name of the report files in OUT")
     ap.add_argument("--smoke", action="store_true", help="tiny models, 1 + 2 epochs (tests, CI)")
     ap.add_argument("--quiet", action="store_true")
     args = ap.parse_args(argv)
@@ -319,7 +321,7 @@ def main(argv=None) -> int:
         print(f"error: {e}", file=sys.stderr)
         return 2
     print(markdown(res))
-    print(f"wrote {args.out}/crossval.json and {args.out}/crossval.md ({res['seconds']:.0f} s)")
+    print(f"wrote {args.out}/{args.report}.json and {args.out}/{args.report}.md ({res['seconds']:.0f} s)")
     return 0
 
 

@@ -453,10 +453,15 @@ describe('Content-Security-Policy and crafted URLs', () => {
     const panel = await page.evaluate(() => {
       const controller = [...document.querySelectorAll('.lil-gui .lil-controller')].find((c) => c.querySelector('.lil-name')?.textContent === 'temperature');
       const select = document.querySelector('.lil-gui select');
-      return { temperature: controller?.querySelector('input')?.value, model: select?.selectedOptions[0]?.textContent };
+      return {
+        temperature: controller?.querySelector('input')?.value, model: select?.selectedOptions[0]?.textContent,
+        note: select?.closest('.lil-controller')?.title,
+      };
     });
     assert.equal(Number(panel.temperature), defaultTemperature);
     assert.equal(panel.model, 'ours (intention)');
+    // The follower menu says what the intention adds on this data (docs/results.md).
+    assert.match(panel.note ?? '', /cross-validation.*CCM/);
     // Nothing from the URL became markup: no element added, no dialog, no text of it in the DOM.
     assert.deepEqual(await page.evaluate(() => window.__injected), []);
     const html = await page.evaluate(() => document.documentElement.outerHTML);
