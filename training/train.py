@@ -441,6 +441,29 @@ def smoke(cfg: TrainConfig) -> TrainConfig:
                    model=replace(cfg.model, hidden=32, intention_hidden=32, channels=2, classes=4))
 
 
+# Flags that change a recipe: argparse name -> how its value changes the TrainConfig.
+OVERRIDES = {
+    "epochs": lambda c, v: replace(c, epochs=v),
+    "intention_epochs": lambda c, v: replace(c, intention_epochs=v),
+    "seed": lambda c, v: replace(c, seed=v),
+    "channels": lambda c, v: replace(c, model=replace(c.model, channels=v)),
+    "lambda_generator": lambda c, v: replace(c, lambda_generator=v),
+    "intention_dropout": lambda c, v: replace(c, intention_dropout=v),
+    "intention_weight_decay": lambda c, v: replace(c, intention_weight_decay=v),
+    "intention_hidden": lambda c, v: replace(c, model=replace(c.model, intention_hidden=v)),
+    "intention_best": lambda c, v: replace(c, intention_best=True),
+}
+
+
+def apply_overrides(cfg: TrainConfig, args) -> TrainConfig:
+    """The recipe with every flag given on the command line applied (unset flags change nothing)."""
+    for key, change in OVERRIDES.items():
+        value = getattr(args, key)
+        if value is not None and value is not False:
+            cfg = change(cfg, value)
+    return cfg
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m training.train", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -481,24 +504,7 @@ def main(argv=None) -> int:
             cfg = MODELS[name]
             if args.smoke:
                 cfg = smoke(cfg)
-            if args.epochs is not None:
-                cfg = replace(cfg, epochs=args.epochs)
-            if args.intention_epochs is not None:
-                cfg = replace(cfg, intention_epochs=args.intention_epochs)
-            if args.seed is not None:
-                cfg = replace(cfg, seed=args.seed)
-            if args.channels is not None:
-                cfg = replace(cfg, model=replace(cfg.model, channels=args.channels))
-            if args.lambda_generator is not None:
-                cfg = replace(cfg, lambda_generator=args.lambda_generator)
-            if args.intention_dropout is not None:
-                cfg = replace(cfg, intention_dropout=args.intention_dropout)
-            if args.intention_weight_decay is not None:
-                cfg = replace(cfg, intention_weight_decay=args.intention_weight_decay)
-            if args.intention_hidden is not None:
-                cfg = replace(cfg, model=replace(cfg.model, intention_hidden=args.intention_hidden))
-            if args.intention_best:
-                cfg = replace(cfg, intention_best=True)
+            cfg = apply_overrides(cfg, args)
             r = train_model(name, cfg, args.prepared, args.runs, device, args.resume, rank=rank, world=world)
             if rank == 0:
                 mse = "" if r["val_mse"] is None else f", val mse {r['val_mse']:.4f}"

@@ -317,3 +317,15 @@ def test_intention_early_stopping_keeps_the_best_validation_epoch(prepared3, tmp
         mse = torch.nn.functional.mse_loss(predictor(normalize(val["input"], stats, "input")),
                                            normalize(val["intention"], stats, "intention")).item()
     assert mse == pytest.approx(min(h["intention_val"]), rel=1e-5)
+
+
+def test_command_line_overrides_change_only_what_was_given():
+    import argparse
+    unset = argparse.Namespace(**{k: None for k in T.OVERRIDES}, **{"intention_best": False})
+    base = T.MODELS["follower"]
+    assert T.apply_overrides(base, unset) == base
+    given = argparse.Namespace(**{**vars(unset), "seed": 3, "channels": 8, "intention_hidden": 64,
+                                  "intention_best": True})
+    cfg = T.apply_overrides(base, given)
+    assert (cfg.seed, cfg.model.channels, cfg.model.intention_hidden, cfg.intention_best) == (3, 8, 64, True)
+    assert replace(cfg, seed=base.seed, model=base.model, intention_best=False) == base
