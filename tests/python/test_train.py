@@ -321,7 +321,7 @@ def test_intention_early_stopping_keeps_the_best_validation_epoch(prepared3, tmp
 
 def test_command_line_overrides_change_only_what_was_given():
     import argparse
-    unset = argparse.Namespace(**{k: None for k in T.OVERRIDES}, **{"intention_best": False})
+    unset = argparse.Namespace(**{**{k: None for k in T.OVERRIDES}, "intention_best": False})
     base = T.MODELS["follower"]
     assert T.apply_overrides(base, unset) == base
     given = argparse.Namespace(**{**vars(unset), "seed": 3, "channels": 8, "intention_hidden": 64,
