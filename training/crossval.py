@@ -39,8 +39,9 @@ from tqdm import tqdm
 
 from .dataset import DataError, discover_takes
 from .folders import add_folder
+from .prepare import TEMPOS
 
-# Method name -> (run name = ONNX stem, recipe in train.MODELS, tempo copies in training). The
+# Method name -> (run name = ONNX stem, recipe in train.MODELS, trained on the tempo copies). The
 # recipes are the shipped pair before proximity augmentation: intention or not, all else alike.
 METHODS = {
     "ours": ("follower", "follower_no_proximity", False),
@@ -49,7 +50,6 @@ METHODS = {
     "ccm_tempo": ("follower_ccm_tempo", "follower_ccm_no_proximity", True),
 }
 METRICS = {"mpjpe_cm": "MPJPE cm", "fid": "FID", "codebook_error": "codebook error"}
-TEMPOS = [0.9, 1.1]
 CONFIDENCE = 0.95
 
 
@@ -102,22 +102,22 @@ def _quietly(log: Path, fn, *args):
         return fn(*args)
 
 
-def prepare_job(data: str, out: str, fold: dict, tempos: list[float]) -> str:
+def prepare_job(data: str, out: str, fold: dict) -> str:
     from .prepare import prepare
-    if not (Path(out) / "stats.npz").exists():
+    if not all((Path(out) / f).exists() for f in ("stats.npz", "train_tempo.npz")):
         _quietly(Path(out).parent / "prepare.log", prepare, data, out, fold["validation"], fold["test"],
-                 None, True, True, tempos)
+                 None, True, True, TEMPOS)
     return out
 
 
-def train_job(recipe: str, run: str, prepared: str, runs: str, seed: int, epochs: int, intention_epochs: int,
-              smoke: bool = False) -> str:
+def train_job(recipe: str, run: str, tempo: bool, prepared: str, runs: str, seed: int, epochs: int,
+              intention_epochs: int, smoke: bool = False) -> str:
     import torch
     from .train import MODELS, smoke as tiny, train_model
     torch.set_num_threads(1)
     if (Path(runs) / run / "history.json").exists():
         return run
-    cfg = replace(MODELS[recipe], seed=seed, epochs=epochs, intention_epochs=intention_epochs)
+    cfg = replace(MODELS[recipe], seed=seed, epochs=epochs, intention_epochs=intention_epochs, tempo_copies=tempo)
     if smoke:
         cfg = tiny(cfg)
     resume = (Path(runs) / run / "checkpoint.pt").exists()
@@ -125,44 +125,30 @@ def train_job(recipe: str, run: str, prepared: str, runs: str, seed: int, epochs
     return run
 
 
-def evaluate_job(data: str, where: str, fold: dict, runs: list[str], prepared: dict[str, str],
-                 eval_seeds: str, smoke: bool = False) -> str:
+def evaluate_job(data: str, where: str, fold: dict, runs: list[str], eval_seeds: str, smoke: bool = False) -> str:
+    """Export each run of one fold and seed (WHERE/models_RUN) and evaluate it on the fold's test
+    takes (WHERE/eval_RUN/metrics.json); what exists is kept. Methods are evaluated one by one:
+    a method's numbers do not depend on the others (same seeds, same reference)."""
     import torch
     from . import evaluate, export
     torch.set_num_threads(1)
     where = Path(where)
-    if (where / "eval" / "metrics.json").exists():
-        return str(where)
-    for run in runs:   # each run exports with the normalization of the data it was trained on
-        if not (where / "models" / f"{run}.onnx").exists():
-            _quietly(where / "export.log", export.export_all, [run], str(where / "runs"),
-                     str(where / f"models_{run}"), data, prepared[run], str(where / "fp32"))
-            _merge_export(where, run)
-    code = _quietly(where / "evaluate.log", evaluate.main, [
-        "--data", data, "--takes", ",".join(fold["test"]), "--models", str(where / "models"),
-        "--train-takes", ",".join(fold["train"]), "--conditions", "", "--seeds", eval_seeds,
-        "--temperatures", "0.5", "--encoder-cache", str(where.parent / "eval_encoder"),
-        "--out", str(where / "eval"), "--quiet",
-        "--methods", ",".join(evaluate.NAMES.get(r, r) for r in runs)] + (["--encoder-epochs", "2"] if smoke else []))
-    if code:
-        raise CrossvalError(f"evaluation failed in {where} (see {where / 'evaluate.log'})")
+    for run in runs:
+        if (where / f"eval_{run}" / "metrics.json").exists():
+            continue
+        models = where / f"models_{run}"
+        if not (models / "manifest.json").exists():
+            _quietly(where / "export.log", export.export_all, [run], str(where / "runs"), str(models), data,
+                     str(where.parent / "data"), str(where / "fp32"))
+        code = _quietly(where / "evaluate.log", evaluate.main, [
+            "--data", data, "--takes", ",".join(fold["test"]), "--models", str(models),
+            "--train-takes", ",".join(fold["train"]), "--conditions", "", "--seeds", eval_seeds,
+            "--temperatures", "0.5", "--encoder-cache", str(where.parent / "eval_encoder"),
+            "--out", str(where / f"eval_{run}"), "--quiet", "--methods", evaluate.NAMES.get(run, run)]
+            + (["--encoder-epochs", "2"] if smoke else []))
+        if code:
+            raise CrossvalError(f"evaluation of {run} failed in {where} (see {where / 'evaluate.log'})")
     return str(where)
-
-
-def _merge_export(where: Path, run: str) -> None:
-    """Move one run's exported files into WHERE/models and add it to that folder's manifest."""
-    src, dst = where / f"models_{run}", where / "models"
-    (dst / "eval").mkdir(parents=True, exist_ok=True)
-    manifest = json.loads((src / "manifest.json").read_text())
-    target = dst / "manifest.json"
-    merged = json.loads(target.read_text()) if target.exists() else {**manifest, "models": {}}
-    merged["models"].update(manifest["models"])
-    for f in src.rglob("*"):
-        if f.is_file() and f.name != "manifest.json":
-            out = dst / f.relative_to(src)
-            out.parent.mkdir(parents=True, exist_ok=True)
-            f.replace(out)
-    target.write_text(json.dumps(merged, indent=1))
 
 
 # ---------------------------------------------------------------- driver
@@ -179,23 +165,18 @@ def run_crossval(args) -> dict:
     folds = make_folds(takes, args.folds)
     only = [int(f) for f in args.only_folds.split(",")] if args.only_folds else list(range(args.folds))
     folds = [f for f in folds if f["fold"] in only]
-    tempo_needed = any(METHODS[m][2] for m in methods)
     (out).mkdir(parents=True, exist_ok=True)
     if args.smoke:
         args.epochs, args.intention_epochs = 2, 1
     plan = {"folds": folds, "methods": methods, "seeds": seeds, "epochs": args.epochs,
-            "intention_epochs": args.intention_epochs, "smoke": args.smoke, "tempos": TEMPOS if tempo_needed else []}
+            "intention_epochs": args.intention_epochs, "smoke": args.smoke,
+            "tempos": TEMPOS if any(METHODS[m][2] for m in methods) else []}
     t0 = time.time()
     if not args.report_only:
         ctx = multiprocessing.get_context("spawn")   # torch and fork do not mix
         with ctx.Pool(args.jobs) as pool:
-            prep = []
-            for f in folds:
-                fdir = out / f"fold{f['fold']}"
-                prep.append(pool.apply_async(prepare_job, (args.data, str(fdir / "data"), f, [])))
-                if tempo_needed:
-                    prep.append(pool.apply_async(prepare_job, (args.data, str(fdir / "data_tempo"), f, TEMPOS)))
-            for p in prep:
+            for p in [pool.apply_async(prepare_job, (args.data, str(out / f"fold{f['fold']}" / "data"), f))
+                      for f in folds]:
                 p.get()
             # Fold by fold, one fold queued ahead so no process waits; each fold's evaluations are
             # queued as soon as its trainings finish, so finished folds have their numbers early
@@ -206,7 +187,7 @@ def run_crossval(args) -> dict:
             def queue_trainings(f):
                 fdir = out / f"fold{f['fold']}"
                 return [((s, m), pool.apply_async(train_job, (
-                    METHODS[m][1], METHODS[m][0], str(fdir / ("data_tempo" if METHODS[m][2] else "data")),
+                    METHODS[m][1], METHODS[m][0], METHODS[m][2], str(fdir / "data"),
                     str(fdir / f"seed{s}" / "runs"), s, args.epochs, args.intention_epochs, args.smoke)))
                     for s in seeds for m in methods]
 
@@ -218,9 +199,8 @@ def run_crossval(args) -> dict:
                     bar.update(1)
                     bar.set_postfix_str(f"trained fold {f['fold']} seed {s} {m}")
                 fdir = out / f"fold{f['fold']}"
-                prepared = {METHODS[m][0]: str(fdir / ("data_tempo" if METHODS[m][2] else "data")) for m in methods}
                 evals += [pool.apply_async(evaluate_job, (args.data, str(fdir / f"seed{s}"), f,
-                                                          [METHODS[m][0] for m in methods], prepared,
+                                                          [METHODS[m][0] for m in methods],
                                                           args.eval_seeds, args.smoke)) for s in seeds]
             for e in evals:
                 e.get()
@@ -235,13 +215,12 @@ def report(out: Path, plan: dict, seconds: float, name: str = "crossval") -> dic
     values: dict[str, dict] = {m: {} for m in methods}
     for f in plan["folds"]:
         for s in seeds:
-            path = out / f"fold{f['fold']}" / f"seed{s}" / "eval" / "metrics.json"
-            if not path.exists():
-                continue
-            res = json.loads(path.read_text())["methods"]
             for m in methods:
                 run = METHODS[m][0]
-                values[m][(f["fold"], s)] = {k: res[NAMES.get(run, run)][k] for k in METRICS}
+                path = out / f"fold{f['fold']}" / f"seed{s}" / f"eval_{run}" / "metrics.json"
+                if path.exists():
+                    res = json.loads(path.read_text())["methods"]
+                    values[m][(f["fold"], s)] = {k: res[NAMES.get(run, run)][k] for k in METRICS}
     fold_ids = [f["fold"] for f in plan["folds"] if all((f["fold"], s) in values[m] for m in methods for s in seeds)]
     comparisons = {}
     pairs = [(a, b) for a, b in (("ours", "ccm"), ("ours_tempo", "ours"), ("ccm_tempo", "ccm"), ("ours_tempo", "ccm_tempo"))

@@ -1,8 +1,10 @@
 """python -m training.prepare: paired BVH takes -> feature arrays for training (git-ignored).
 
 Reads the BVH couples in --data; writes PREPARED/{train,validation,test}.npz (both roles, all phase
-offsets, mirrored copies in train, and with --tempos time-warped copies in train) and
-PREPARED/stats.npz (normalization), then prints frames per split and feature sizes.
+offsets, mirrored copies in train), PREPARED/train_tempo.npz (the training couples time-warped to
+--tempos, read only by recipes with tempo copies) and PREPARED/stats.npz (normalization, from the
+recorded tempo: recipes with and without the copies normalize alike), then prints frames per
+split and feature sizes.
 """
 from __future__ import annotations
 
@@ -19,6 +21,9 @@ from .dataset import (TEST_TAKES, VALIDATION_TAKES, DataError, discover_takes, l
                       phases, samples)
 from .folders import add_folder
 
+# Tempo copies: the couple danced 0.9x and 1.1x as fast (cross-validated in docs/results.md).
+TEMPOS = [0.9, 1.1]
+
 
 def split_of(take: str, validation: list[str], test: list[str]) -> str:
     return "validation" if take in validation else "test" if take in test else "train"
@@ -31,7 +36,7 @@ def prepare(data: str, out: str, validation: list[str], test: list[str], leader:
     for n in validation + test:
         if n not in names:
             raise DataError(f"split take {n} is not in {data} (have {', '.join(names)})")
-    parts: dict[str, list[dict]] = {"train": [], "validation": [], "test": []}
+    parts: dict[str, list[dict]] = {"train": [], "validation": [], "test": [], "train_tempo": []}
     dancer_frames = {"train": 0, "validation": 0, "test": 0}
     for take in tqdm(takes, desc="prepare", unit="take", disable=quiet):
         lead, follow = load_pair(take)
@@ -52,13 +57,16 @@ def prepare(data: str, out: str, validation: list[str], test: list[str], leader:
                     s["phase"] = np.full(n, phase, np.int8)
                     s["mirror"] = np.full(n, mirror, np.bool_)
                     s["tempo"] = np.full(n, tempo, np.float32)
-                    parts[split].append(s)
+                    parts[split if tempo == 1.0 else "train_tempo"].append(s)
     outdir = Path(out)
     outdir.mkdir(parents=True, exist_ok=True)
     summary = {"takes": {k: sorted({names[p["take"][0]] for p in v}) for k, v in parts.items()},
                "dancer_frames_30fps": dancer_frames, "samples": {}}
     arrays = {}
+    (outdir / "train_tempo.npz").unlink(missing_ok=True)    # never a stale file of another call
     for split, plist in parts.items():
+        if split == "train_tempo" and not plist:
+            continue
         if not plist:
             raise DataError(f"split {split} is empty; choose other --validation/--test takes")
         arrays[split] = {k: np.concatenate([p[k] for p in plist]) for k in plist[0]}
@@ -85,6 +93,9 @@ def print_summary(s: dict) -> None:
     for split in ("train", "validation", "test"):
         print(f"{split:<12} {','.join(s['takes'][split]):<25} {s['dancer_frames_30fps'][split]:>21} "
               f"{s['samples'][split]:>18}")
+    if "train_tempo" in s["samples"]:
+        print(f"{'train_tempo':<12} {','.join(s['takes']['train_tempo']):<25} {'':>21} {s['samples']['train_tempo']:>18}"
+              f"  (tempo copies)")
     total = sum(s["dancer_frames_30fps"].values())
     print(f"total dancer frames at 30 fps (per dancer): {total}")
     print("feature sizes:")
@@ -104,8 +115,8 @@ def main(argv=None) -> int:
     ap.add_argument("--test", default=",".join(TEST_TAKES), help="comma-separated takes")
     ap.add_argument("--leader", default=None, help="subject that leads (default: first by name)")
     ap.add_argument("--one-phase", action="store_true", help="use only phase 0 of 120 fps takes")
-    ap.add_argument("--tempos", default="", metavar="LIST",
-                    help="extra training copies at these tempos, e.g. 0.9,1.1 (1 = as recorded)")
+    ap.add_argument("--tempos", default=",".join(map(str, TEMPOS)), metavar="LIST",
+                    help="training copies at these tempos, for recipes with tempo copies ('' for none)")
     args = ap.parse_args(argv)
     try:
         tempos = [float(t) for t in args.tempos.split(",") if t]
@@ -122,7 +133,8 @@ def main(argv=None) -> int:
         print(f"error: {e}", file=sys.stderr)
         return 2
     print_summary(s)
-    print(f"wrote {args.prepared}/{{train,validation,test,stats}}.npz in {time.time() - t0:.1f} s")
+    files = "train,train_tempo,validation,test,stats" if "train_tempo" in s["samples"] else "train,validation,test,stats"
+    print(f"wrote {args.prepared}/{{{files}}}.npz in {time.time() - t0:.1f} s")
     return 0
 
 

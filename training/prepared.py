@@ -23,8 +23,15 @@ def _unreadable(path: Path, e: Exception) -> TrainError:
                       f"({e.__class__.__name__}); re-run training.prepare")
 
 
-def load_split(prepared: str, split: str, role: str) -> dict[str, np.ndarray]:
-    """{"input", "output", "intention"} raw float32 arrays of one split and role."""
+def load_split(prepared: str, split: str, role: str, tempo_copies: bool = False) -> dict[str, np.ndarray]:
+    """{"input", "output", "intention"} raw float32 arrays of one split and role; with
+    `tempo_copies` the training split is followed by its time-warped copies (train_tempo.npz)."""
+    if tempo_copies:
+        if not (Path(prepared) / "train_tempo.npz").exists():
+            raise TrainError(f"{Path(prepared) / 'train_tempo.npz'} not found: this recipe trains on tempo "
+                             f"copies; re-run training.prepare (with its default --tempos)")
+        a, b = load_split(prepared, split, role), load_split(prepared, "train_tempo", role)
+        return {k: np.concatenate([a[k], b[k]]) for k in a}
     path = Path(prepared) / f"{split}.npz"
     if not path.exists():
         raise TrainError(f"{path} not found: run `python -m training.prepare --prepared {prepared}` first")
@@ -81,14 +88,12 @@ def load_offsets(prepared: str, role: str, device) -> torch.Tensor:
     return torch.tensor(np.stack([off, off[MIRROR] @ np.diag([-1.0, 1.0, 1.0])]), dtype=torch.float32, device=device)
 
 
-def load_mirror_flags(prepared: str) -> np.ndarray:
-    """Per training sample: True where it is a mirrored copy (its skeleton is mirrored too)."""
-    with np.load(Path(prepared) / "train.npz") as z:
-        return z["mirror"].astype(bool)
-
-
-def load_tempos(prepared: str) -> np.ndarray:
-    """Per training sample: the tempo of its copy (1 = as recorded; prepare --tempos adds others).
-    Data prepared before tempo copies existed is all at tempo 1."""
-    with np.load(Path(prepared) / "train.npz") as z:
-        return z["tempo"] if "tempo" in z else np.ones(len(z["mirror"]), np.float32)
+def load_mirror_flags(prepared: str, tempo_copies: bool = False) -> np.ndarray:
+    """Per training sample (in load_split's order): True where it is a mirrored copy (its
+    skeleton is mirrored too)."""
+    files = ["train.npz"] + (["train_tempo.npz"] if tempo_copies else [])
+    flags = []
+    for f in files:
+        with np.load(Path(prepared) / f) as z:
+            flags.append(z["mirror"].astype(bool))
+    return np.concatenate(flags)

@@ -6,6 +6,7 @@ import json
 
 import numpy as np
 import pytest
+import torch
 
 from training import crossval
 from training.synthetic import write_couples
@@ -57,14 +58,16 @@ def test_crossval_runs_every_fold_and_resumes(tmp_path):
         for metric in crossval.METRICS:
             p = res["comparisons"][name][metric]
             assert np.isfinite([p["mean"], p["low"], p["high"]]).all() and p["low"] <= p["mean"] <= p["high"]
-    # Tempo copies were prepared for the tempo method only, and only in training.
-    with np.load(out / "fold0" / "data_tempo" / "train.npz") as z:
-        assert sorted(set(z["tempo"].tolist())) == pytest.approx([0.9, 1.0, 1.1])
-    with np.load(out / "fold0" / "data" / "train.npz") as z:
-        assert set(z["tempo"].tolist()) == {1.0}
-    stamp = (out / "fold0" / "seed1" / "eval" / "metrics.json").stat().st_mtime_ns
+    # One data folder per fold; only the tempo method read its copies (it saw more samples).
+    with np.load(out / "fold0" / "data" / "train_tempo.npz") as z:
+        assert sorted(set(z["tempo"].tolist())) == pytest.approx([0.9, 1.1])
+    runs = out / "fold0" / "seed1" / "runs"
+    configs = {r: torch.load(runs / r / "checkpoint.pt", weights_only=False)["config"]["tempo_copies"]
+               for r in ("follower", "follower_ccm", "follower_tempo")}
+    assert configs == {"follower": False, "follower_ccm": False, "follower_tempo": True}
+    stamp = (out / "fold0" / "seed1" / "eval_follower" / "metrics.json").stat().st_mtime_ns
     assert crossval.main(argv) == 0                     # everything on disk: nothing is redone
-    assert (out / "fold0" / "seed1" / "eval" / "metrics.json").stat().st_mtime_ns == stamp
+    assert (out / "fold0" / "seed1" / "eval_follower" / "metrics.json").stat().st_mtime_ns == stamp
     assert json.loads((out / "crossval.json").read_text())["comparisons"] == res["comparisons"]
 
 

@@ -208,19 +208,34 @@ def test_files_in_other_units(tmp_path, capsys):
     assert_nothing_written(tmp_path / "out")
 
 
-def test_tempo_copies_are_training_only_and_the_epoch_keeps_its_size(data3, prepared3, tmp_path):
-    from training.prepared import load_tempos
-    out = tmp_path / "tempo"
-    assert main(["--data", str(data3), "--prepared", str(out), "--validation", "12", "--test", "06",
-                 "--tempos", "0.9,1.1"]) == 0
-    tempos = load_tempos(str(out))
-    plain = load_tempos(str(prepared3))
-    assert (tempos == 1.0).sum() == len(plain) and (plain == 1.0).all()
-    # 0.9x plays longer (more samples), 1.1x shorter.
+def test_tempo_copies_are_a_file_of_their_own_and_change_nothing_else(data3, prepared3, tmp_path):
+    from training.prepared import load_mirror_flags, load_split
+    none = tmp_path / "none"
+    assert main(["--data", str(data3), "--prepared", str(none), "--validation", "12", "--test", "06",
+                 "--tempos", ""]) == 0
+    assert not (none / "train_tempo.npz").exists() and (prepared3 / "train_tempo.npz").exists()
+    # The recorded tempo's arrays and statistics are the same with or without the copies.
+    for f in ("train.npz", "validation.npz", "test.npz", "stats.npz"):
+        with np.load(none / f) as a, np.load(prepared3 / f) as b:
+            for k in a.files:
+                np.testing.assert_array_equal(a[k], b[k])
+    with np.load(prepared3 / "train_tempo.npz") as z:
+        tempos = z["tempo"]
+    plain = load_split(str(prepared3), "train", "follower")["input"]
+    more = load_split(str(prepared3), "train", "follower", tempo_copies=True)["input"]
+    # 0.9x plays longer (more samples), 1.1x shorter; the copies follow the recorded samples.
     assert (tempos == np.float32(0.9)).sum() > len(plain) > (tempos == np.float32(1.1)).sum() > 0
-    for split in ("validation", "test"):
-        with np.load(out / f"{split}.npz") as a, np.load(prepared3 / f"{split}.npz") as b:
-            np.testing.assert_array_equal(a["follower_input"], b["follower_input"])
+    assert len(more) == len(plain) + len(tempos) and np.array_equal(more[:len(plain)], plain)
+    assert len(load_mirror_flags(str(prepared3), tempo_copies=True)) == len(more)
+
+
+def test_a_tempo_recipe_without_copies_is_a_one_line_error(data3, tmp_path):
+    from training.prepared import TrainError, load_split
+    none = tmp_path / "none"
+    assert main(["--data", str(data3), "--prepared", str(none), "--validation", "12", "--test", "06",
+                 "--tempos", ""]) == 0
+    with pytest.raises(TrainError, match="tempo"):
+        load_split(str(none), "train", "follower", tempo_copies=True)
 
 
 @pytest.mark.parametrize("bad", ["fast", "0.1", "3"])
