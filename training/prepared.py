@@ -27,10 +27,11 @@ def load_split(prepared: str, split: str, role: str, tempo_copies: bool = False)
     """{"input", "output", "intention"} raw float32 arrays of one split and role; with
     `tempo_copies` the training split is followed by its time-warped copies (train_tempo.npz)."""
     if tempo_copies:
+        a = load_split(prepared, split, role)    # the recorded samples first (and their checks)
         if not (Path(prepared) / "train_tempo.npz").exists():
             raise TrainError(f"{Path(prepared) / 'train_tempo.npz'} not found: this recipe trains on tempo "
                              f"copies; re-run training.prepare (with its default --tempos)")
-        a, b = load_split(prepared, split, role), load_split(prepared, "train_tempo", role)
+        b = load_split(prepared, "train_tempo", role)
         return {k: np.concatenate([a[k], b[k]]) for k in a}
     path = Path(prepared) / f"{split}.npz"
     if not path.exists():
