@@ -20,10 +20,10 @@ NAMES = {"ours": "ours", "ccm": "CCM", "motion_matching": "Motion Matching",
          "follower_decoded_contact_10": "foot contact 10 on decoded contacts",
          "follower_decoded_contact_30": "foot contact 30 on decoded contacts",
          "follower_decoded_contact_30_penetration_100": "foot contact 30 on decoded, penetration 100",
-         "follower_no_tempo": "ours w/o tempo copies",
-         "follower_ccm_no_tempo": "CCM w/o tempo copies",
-         "follower_no_proximity": "ours w/o tempo copies and proximity",
-         "follower_ccm_no_proximity": "CCM w/o tempo copies and proximity",
+         "follower_tempo": "ours + tempo copies",
+         "follower_ccm_tempo": "CCM + tempo copies",
+         "follower_no_proximity": "ours w/o proximity",
+         "follower_ccm_no_proximity": "CCM w/o proximity",
          "follower_interaction_hands_only": "w/o proximity, interaction on hands only"}
 ORDER = ["ours", "ccm", "follower_no_partner_terms", "follower_no_penetration", "follower_no_foot_contact",
          "follower_no_interaction", "follower_recorded_contact_30", "follower_decoded_contact_5",
@@ -88,8 +88,8 @@ def main(argv: list[str]) -> int:
     inter = Path(argv[0] if argv else "runs/partner_interaction/interaction.json")
     evals = Path(argv[1] if len(argv) > 1 else "runs/partner_eval/metrics.json")
     res, ev = json.loads(inter.read_text()), json.loads(evals.read_text())
-    shipped = [m for m in ("ours", "ccm", "motion_matching", "follower_no_partner_terms", "follower_no_tempo",
-                           "follower_ccm_no_tempo", "follower_no_proximity", "follower_ccm_no_proximity")
+    shipped = [m for m in ("ours", "ccm", "motion_matching", "follower_no_partner_terms", "follower_no_proximity",
+                           "follower_ccm_no_proximity", "follower_tempo", "follower_ccm_tempo")
                if m in res["methods"]]
     rows = [m for m in ORDER if m in res["methods"] and m in ev["methods"]]
     rows += [m for m in res["methods"] if m not in rows + ["motion_matching"] and m in ev["methods"]]
