@@ -20,7 +20,8 @@ export interface PanelOptions {
  * cross-validated by take" and "Proximity augmentation"); shown on the follower menu. */
 export const INTENTION_NOTE =
   'Measured on the CMU salsa takes: the intention does not make the follower more accurate here ' +
-  '(6-fold cross-validation: same pose error as CCM, ±0.1 cm). In steered duets (8 × 60 s) ours meets ' +
+  '(6-fold cross-validation: same pose error as CCM within 0.1 cm; CCM has the better FID). ' +
+  'In steered duets (8 × 60 s) ours meets ' +
   "the leader's hands more often than CCM (28.7 % against 22.0 % of frames) and its leader turns faster " +
   '(0.51 against 0.59 s). Details: docs/results.md.';
 
