@@ -112,8 +112,10 @@ def time_warp(motion: Motion, tempo: float, fps: float = FPS, phase: int = 0) ->
 
     Tempo augmentation for training: a frame falls between two source frames, so positions
     are blended linearly and rotations blended and re-orthonormalized (nearest polar rotation).
-    Between neighbouring 120 fps frames a joint turns by a few degrees at most, where this is
-    as good as slerp. At tempo 1 with a whole-multiple rate it is `resample`, frame for frame.
+    That rotation lies on slerp's arc, a little off its timing: between neighbouring 120 fps
+    frames of the CMU takes a joint turns by up to about 40 degrees (99.9th percentile of each
+    take; glitches reach 87), where the blend is at most 0.32 degrees off slerp (3.6 at 87).
+    At tempo 1 with a whole-multiple rate it is `resample`, frame for frame.
     """
     if tempo <= 0:
         raise ValueError(f"tempo must be positive, got {tempo}")

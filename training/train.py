@@ -105,9 +105,17 @@ PROXIMITY = dict(proximity_share=0.25, lambda_proximity=100.0)
 LEADER_PARTNER = dict(lambda_penetration=100.0, lambda_foot_contact=30.0, lambda_interaction=10.0)
 
 
+# The follower pair with the partner terms and without proximity (shipped until proximity came;
+# training.crossval compares them), and the shipped pair.
+OURS_NO_PROXIMITY = TrainConfig(model=FOLLOWER, intention_noise=0.3, **PARTNER)
+CCM_NO_PROXIMITY = TrainConfig(model=replace(FOLLOWER, intention=False), **PARTNER)
+OURS = replace(OURS_NO_PROXIMITY, **PROXIMITY)
+CCM = replace(CCM_NO_PROXIMITY, **PROXIMITY)
+
+
 def partner_variant(**changes) -> TrainConfig:
-    """The shipped follower's recipe with some partner-term settings changed (ablation rows)."""
-    return TrainConfig(model=FOLLOWER, intention_noise=0.3, **{**PARTNER, **changes})
+    """The follower's partner-term recipe (before proximity) with some settings changed (ablation rows)."""
+    return replace(OURS_NO_PROXIMITY, **changes)
 
 
 # The models `--all` trains (shipped), and the ones evaluation adds (ablations, larger CCM).
@@ -115,8 +123,8 @@ MODELS = {
     # The predictor fits training frames better than new ones (MSE 0.14 vs 0.23): noise of the
     # size of that gap keeps the encoders from trusting its training-set accuracy, which buys
     # FID and Diversity on the test takes (docs/results.md, w/o intention noise).
-    "follower": TrainConfig(model=FOLLOWER, intention_noise=0.3, **PARTNER, **PROXIMITY),
-    "follower_ccm": TrainConfig(model=replace(FOLLOWER, intention=False), **PARTNER, **PROXIMITY),
+    "follower": OURS,
+    "follower_ccm": CCM,
     # The leader's partner is the follower: it gets the same terms (its own weights, above).
     "leader": TrainConfig(model=ModelConfig(role="leader"), **LEADER_PARTNER),
     "follower_small": TrainConfig(model=replace(FOLLOWER, hidden=256, intention_hidden=128), intention_noise=0.3),
@@ -128,12 +136,11 @@ MODELS = {
     # The shipped pair trained on the tempo copies too: measured, not kept (docs/results.md,
     # "Learning more from the same frames": FID 89.7 against 107.6, but the follower's feet slide
     # more in the steered duet, and cross-validated no metric moves outside its interval).
-    "follower_tempo": TrainConfig(model=FOLLOWER, intention_noise=0.3, **PARTNER, **PROXIMITY, tempo_copies=True),
-    "follower_ccm_tempo": TrainConfig(model=replace(FOLLOWER, intention=False), **PARTNER, **PROXIMITY,
-                                      tempo_copies=True),
+    "follower_tempo": replace(OURS, tempo_copies=True),
+    "follower_ccm_tempo": replace(CCM, tempo_copies=True),
     # The shipped pair before proximity augmentation (the recipes training.crossval compares).
-    "follower_no_proximity": TrainConfig(model=FOLLOWER, intention_noise=0.3, **PARTNER),
-    "follower_ccm_no_proximity": TrainConfig(model=replace(FOLLOWER, intention=False), **PARTNER),
+    "follower_no_proximity": OURS_NO_PROXIMITY,
+    "follower_ccm_no_proximity": CCM_NO_PROXIMITY,
     # Partner terms (scripts/partner_terms.sh): one switched off, or another weight or weighting.
     "follower_no_partner_terms": TrainConfig(model=FOLLOWER, intention_noise=0.3),
     "follower_no_penetration": partner_variant(lambda_penetration=0.0),
@@ -328,6 +335,9 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
             p.requires_grad_(False)
     total = cfg.epochs * steps_per_epoch
     bce = F.binary_cross_entropy_with_logits
+    # Raw features back from normalized ones, for the terms on the decoded body (set up once).
+    scale = {k: (stats[f"{k}_std"].to(device).float(), stats[f"{k}_mean"].to(device).float()) for k in ("input", "output")}
+    raw = lambda t, k: t * scale[k][0] + scale[k][1]
     while epoch < cfg.epochs:
         t0 = time.time()
         matching.train(); disc.train()
@@ -365,7 +375,6 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
             l_c = F.mse_loss(code, code_hat)
             loss = cfg.lambda_reconstruction * l_r + cfg.lambda_codebook * l_c + extra
             if any(partner_weights.values()):
-                raw = lambda t, k: t * stats[f"{k}_std"].to(device).float() + stats[f"{k}_mean"].to(device).float()
                 keep = slice(None) if moved is None else ~moved.to(device)   # recorded relations only
                 off = offsets[mirrored[idx]]
                 terms = partner_terms(raw(recon[keep], "output"), raw(yb[keep], "output"), raw(x[keep], "input"),
