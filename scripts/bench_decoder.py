@@ -11,9 +11,9 @@ import onnxruntime as ort
 import torch
 from pathlib import Path
 
-from training.export import export_onnx, quantize
-from training.models import StepModel
-from training.runs import load_run
+from training.learning.export import export_onnx, quantize
+from training.learning.models import StepModel
+from training.learning.runs import load_run
 torch.set_num_threads(1)
 m = load_run(Path('runs/models/follower'), 'runs/data').model
 class FullDecode(StepModel):

@@ -5,11 +5,11 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 PY=.venv/bin/python
-DATA=${1:-$($PY -c "from training.folders import default_data; print(default_data())")}
+DATA=${1:-$($PY -c "from training.data.folders import default_data; print(default_data())")}
 MODELS=runs/eval_models
 rm -rf "$MODELS" && mkdir -p "$MODELS"
 finished() {   # a run whose training reached the end (export refuses the others)
-  [ -f "$1/checkpoint.pt" ] && $PY -c "import sys; from training.runs import load_checkpoint; sys.exit(load_checkpoint('$1/checkpoint.pt')['stage'] != 'done')"
+  [ -f "$1/checkpoint.pt" ] && $PY -c "import sys; from training.learning.runs import load_checkpoint; sys.exit(load_checkpoint('$1/checkpoint.pt')['stage'] != 'done')"
 }
 
 # Every finished follower variant, exported like the shipped ones (the manifest comes along).
@@ -18,17 +18,17 @@ for m in follower follower_ccm leader follower_small follower_ccm_large follower
          follower_no_intention_noise follower_end_to_end follower_end_to_end_no_ss; do
   if finished "runs/models/$m"; then names+=(--model "$m"); fi
 done
-$PY -m training.export "${names[@]}" --models "$MODELS" --fp32 runs/eval_fp32 --data "$DATA"
+$PY -m training.learning.export "${names[@]}" --models "$MODELS" --fp32 runs/eval_fp32 --data "$DATA"
 # The λG sweep lives in runs/sweep/lgG/follower: export each under its own name.
 for dir in runs/sweep/lg*; do
   finished "$dir/follower" || continue
   g=$(basename "$dir")
-  $PY -m training.export --runs "$dir" --model follower --models "runs/sweep_export/$g" --fp32 "runs/sweep_export/$g/fp32" --data "$DATA"
+  $PY -m training.learning.export --runs "$dir" --model follower --models "runs/sweep_export/$g" --fp32 "runs/sweep_export/$g/fp32" --data "$DATA"
   cp "runs/sweep_export/$g/follower.onnx" "$MODELS/follower_$g.onnx"
   # Its evaluation file under the same name (both carry the same training fingerprint).
   cp "runs/sweep_export/$g/eval/follower.output_encoder.onnx" "$MODELS/eval/follower_$g.output_encoder.onnx"
 done
 
-$PY -m training.evaluate --data "$DATA" --takes 02,13 --models "$MODELS" --out runs/eval_all \
+$PY -m training.evaluation.evaluate --data "$DATA" --takes 02,13 --models "$MODELS" --out runs/eval_all \
     --seeds 0,1,2 --temperatures 0.5,1 --quiet
-$PY -m training.plots --out docs --eval runs/eval_all/metrics.json
+$PY -m training.evaluation.plots --out docs --eval runs/eval_all/metrics.json

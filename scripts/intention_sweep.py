@@ -18,7 +18,7 @@ from pathlib import Path
 import torch
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from training.train import MODELS, train_model  # noqa: E402
+from training.learning.train import MODELS, train_model  # noqa: E402
 
 BASE = replace(MODELS["follower"], epochs=0)
 ROWS = {

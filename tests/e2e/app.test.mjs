@@ -1,7 +1,7 @@
 // End-to-end tests of the page on the Vite dev server, in headless Chromium.
 // Run: npm run test:e2e   (node --test; needs /usr/bin/chromium and models in public/models/)
 //
-// Every assertion reads window.duet (the DuetHook in web/types.ts), never the page's internals.
+// Every assertion reads window.duet (the DuetHook in web/engine/types.ts), never the page's internals.
 
 import { after, before, describe, test } from 'node:test';
 import assert from 'node:assert/strict';

@@ -27,7 +27,7 @@ const JOINTS = [
   ['rShin', 14, [0, -0.42, 0]],
   ['rFoot', 15, [0, -0.42, 0]],
 ];
-const UNITS_PER_METRE = 1 / 1.5; // the page's BVH units (web/skeleton.ts SCALE)
+const UNITS_PER_METRE = 1 / 1.5; // the page's BVH units (web/mirror/skeleton.ts SCALE)
 
 /**
  * A hand-made BVH of the 17-joint dancer walking forward (+Z) at `speed` m/s, legs and arms

@@ -18,7 +18,7 @@ import {
 
 /**
  * How long the tab stays hidden. A real minute (DUET_HIDDEN_SECONDS=60) behaves exactly like the
- * 20 s default: the page counts any stall as at most 0.5 s (MAX_FRAME_SECONDS in web/main.ts), so
+ * 20 s default: the page counts any stall as at most 0.5 s (MAX_FRAME_SECONDS in web/ui/main.ts), so
  * the length of the gap does not change the outcome; 20 s keeps the default suite shorter.
  */
 const HIDDEN_SECONDS = Number(process.env.DUET_HIDDEN_SECONDS ?? 20);

@@ -1,8 +1,8 @@
 """Shared fixtures for the Python tests.
 
-BVH couples come from the CMU salsa takes where they are (training.folders.default_data():
+BVH couples come from the CMU salsa takes where they are (training.data.folders.default_data():
 $DUET_DATA, else data/cmu-salsa, else ../shared/data/cmu-salsa) and from synthetic couples
-(training.synthetic, written to a tmp folder) where they are not, so the data tests run on a
+(training.data.synthetic, written to a tmp folder) where they are not, so the data tests run on a
 fresh clone too. The few tests that check the real takes themselves are marked `needs_real_data`.
 Everything derived from the data (copies, prepared arrays, checkpoints, ONNX files) is written
 under pytest's tmp folders, never into the repository.
@@ -23,8 +23,8 @@ REPO = Path(__file__).resolve().parents[2]
 if str(REPO) not in sys.path:
     sys.path.insert(0, str(REPO))
 
-from training.folders import default_data  # noqa: E402
-from training.synthetic import CMU_TAKES, write_couples  # noqa: E402
+from training.data.folders import default_data  # noqa: E402
+from training.data.synthetic import CMU_TAKES, write_couples  # noqa: E402
 
 REAL_DATA = Path(default_data()).resolve()
 # The three shortest clean-enough takes: 10 trains, 12 validates, 06 tests (see dataset.py).
@@ -50,7 +50,7 @@ def pytest_configure(config):
 
 def pytest_report_header(config):
     return (f"BVH couples: CMU salsa takes in {REAL_DATA}" if have_real_data() else
-            f"BVH couples: synthetic (training.synthetic); no CMU salsa takes in {REAL_DATA}")
+            f"BVH couples: synthetic (training.data.synthetic); no CMU salsa takes in {REAL_DATA}")
 
 
 def copy_takes(dst: Path, takes, data: Path) -> Path:
@@ -76,14 +76,14 @@ def couples(tmp_path_factory) -> Path:
 @pytest.fixture(scope="session")
 def take_bvh(couples):
     """The lead of take 10 (shortest take) as parsed BVH."""
-    from training.bvh import read_bvh
+    from training.mirror.bvh import read_bvh
     return read_bvh(couples / "60_10.bvh")
 
 
 @pytest.fixture(scope="session")
 def take_pair(couples):
     """Leader and follower Motion of take 10 at 120 fps."""
-    from training.dataset import discover_takes, load_pair, select_takes
+    from training.data.dataset import discover_takes, load_pair, select_takes
     take = select_takes(discover_takes(couples), ["10"])[0]
     return load_pair(take)
 
@@ -91,7 +91,7 @@ def take_pair(couples):
 @pytest.fixture(scope="session")
 def take_tracks(take_pair):
     """(leader Track, follower Track) of take 10 at 30 fps, phase 0, as training builds them."""
-    from training.dataset import pair_tracks
+    from training.data.dataset import pair_tracks
     return pair_tracks(*take_pair)
 
 
@@ -104,8 +104,8 @@ def data3(couples, tmp_path_factory):
 
 @pytest.fixture(scope="session")
 def prepared3(data3, tmp_path_factory):
-    """training.prepare on 3 takes (all phases, mirrored train): train 10, validation 12, test 06."""
-    from training.prepare import main
+    """training.data.prepare on 3 takes (all phases, mirrored train): train 10, validation 12, test 06."""
+    from training.data.prepare import main
     out = tmp_path_factory.mktemp("prepared3")
     rc = main(["--data", str(data3), "--prepared", str(out), "--validation", SMALL_TAKES["validation"],
                "--test", SMALL_TAKES["test"]])
@@ -115,8 +115,8 @@ def prepared3(data3, tmp_path_factory):
 
 @pytest.fixture(scope="session")
 def smoke_runs(prepared3, tmp_path_factory):
-    """`training.train --all --smoke` on the 3-take data: one folder per shipped model."""
-    from training.train import main
+    """`training.learning.train --all --smoke` on the 3-take data: one folder per shipped model."""
+    from training.learning.train import main
     out = tmp_path_factory.mktemp("runs")
     rc = main(["--all", "--smoke", "--prepared", str(prepared3), "--runs", str(out)])
     assert rc == 0
@@ -125,8 +125,8 @@ def smoke_runs(prepared3, tmp_path_factory):
 
 @pytest.fixture(scope="session")
 def exported(smoke_runs, prepared3, data3, tmp_path_factory):
-    """`training.export` of the smoke models: int8 models + manifest in `models`, fp32 in `fp32`."""
-    from training.export import main
+    """`training.learning.export` of the smoke models: int8 models + manifest in `models`, fp32 in `fp32`."""
+    from training.learning.export import main
     root = tmp_path_factory.mktemp("exported")
     models, fp32 = root / "models", root / "fp32"
     rc = main(["--runs", str(smoke_runs), "--prepared", str(prepared3), "--data", str(data3),

@@ -1,6 +1,6 @@
-"""Fixtures that pin web/*.ts to the Python reference: `.venv/bin/python tests/python/fixtures_writer.py`.
+"""Fixtures that pin web/mirror/*.ts to the Python reference: `.venv/bin/python tests/python/fixtures_writer.py`.
 
-Writes tests/fixtures/{bvh,features,rollout}.json: inputs, and what training/bvh.py,
+Writes tests/fixtures/{bvh,features,rollout}.json: inputs, and what training/mirror/bvh.py,
 skeleton.py, features.py and rollout.py compute from them. tests/web/*.test.ts run the TypeScript
 mirror on the same inputs and compare every number (1e-5, relative for large values);
 tests/python/test_fixtures.py checks that the files still match this code.
@@ -24,13 +24,13 @@ REPO = Path(__file__).resolve().parents[2]
 if str(REPO) not in sys.path:      # run as a script from anywhere
     sys.path.insert(0, str(REPO))
 
-from training import features as feat  # noqa: E402
-from training import rollout as ro  # noqa: E402
-from training.contact import ContactLayer  # noqa: E402
-from training.bvh import BvhError, forward_kinematics, local_transforms, parse_bvh  # noqa: E402
-from training.features import Track  # noqa: E402
-from training.synthetic import OFFSETS, procedural_dancer  # noqa: E402
-from training.skeleton import (FPS, JOINT_NAMES, MIRROR, PARENTS, Motion, facing_direction,  # noqa: E402
+from training.mirror import features as feat  # noqa: E402
+from training.mirror import rollout as ro  # noqa: E402
+from training.mirror.contact import ContactLayer  # noqa: E402
+from training.mirror.bvh import BvhError, forward_kinematics, local_transforms, parse_bvh  # noqa: E402
+from training.mirror.features import Track  # noqa: E402
+from training.data.synthetic import OFFSETS, procedural_dancer  # noqa: E402
+from training.mirror.skeleton import (FPS, JOINT_NAMES, MIRROR, PARENTS, Motion, facing_direction,  # noqa: E402
                                forward_kinematics_reduced, gaussian_smooth, mirror_motion, reduce_bvh,
                                resample, root_from_motion)
 
@@ -355,7 +355,7 @@ def features_fixture(rng: np.random.Generator, lead: Track, follow: Track) -> di
 # ---------------------------------------------------------------- rollout
 
 def start_pose_of(track: Track, t: int, fps: float = 30.0) -> dict:
-    """A start pose like training/export.py's: a pose block (own root space), 4 decimals."""
+    """A start pose like training/learning/export.py's: a pose block (own root space), 4 decimals."""
     pose = feat.pose_block(track.positions[t], track.positions[t - 1], track.rotations[t],
                            track.root[t], track.heading[t], fps).reshape(feat.N_JOINTS, 12)
     return {"hip": np.round(pose[0, :3], 4).tolist(), "forward": np.round(pose[:, 6:9], 4).tolist(),
@@ -448,7 +448,7 @@ def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_o
 
 
 def contact_fixture(rng: np.random.Generator, leader: Motion, follower: Motion) -> dict:
-    """The contact layer (training/contact.py) over CONTACT_STEPS frames of the procedural pair,
+    """The contact layer (training/mirror/contact.py) over CONTACT_STEPS frames of the procedural pair,
     pushed together so the spines overlap, the hands come within reach and drift apart again, and
     the feet touch down and lift: every branch of separation, hold and foot lock runs."""
     steps = CONTACT_STEPS

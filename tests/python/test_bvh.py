@@ -1,4 +1,4 @@
-"""training/bvh.py: parsing, channel order, forward kinematics, user-facing errors.
+"""training/mirror/bvh.py: parsing, channel order, forward kinematics, user-facing errors.
 
 The hand-written file below has 4 joints and 2 End Sites with four different rotation channel
 orders. Its world positions were worked out on paper with 90-degree rotations:
@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from training.bvh import BvhError, axis_rotation, forward_kinematics, local_transforms, parse_bvh, read_bvh
+from training.mirror.bvh import BvhError, axis_rotation, forward_kinematics, local_transforms, parse_bvh, read_bvh
 
 TINY = """HIERARCHY
 ROOT hip

@@ -1,9 +1,9 @@
-"""training.check_retrain: the comparison and its verdict (the retrain itself is not run here)."""
+"""training.evaluation.check_retrain: the comparison and its verdict (the retrain itself is not run here)."""
 from __future__ import annotations
 
 import json
 
-from training import check_retrain as C
+from training.evaluation import check_retrain as C
 
 
 def metrics(**ours):
@@ -33,7 +33,7 @@ def test_identical_numbers_pass_and_bad_files_are_an_error(tmp_path, capsys):
 
 
 def test_models_compared_with_themselves(exported, data3, tmp_path, monkeypatch, capsys):
-    """Both sides evaluated by training.evaluate: the same files give the same numbers, and the
+    """Both sides evaluated by training.evaluation.evaluate: the same files give the same numbers, and the
     manifests' fingerprints say the weights are identical."""
     from conftest import SMALL_TAKES
     monkeypatch.setattr(C, "EVALUATE", ["--takes", SMALL_TAKES["test"], "--methods", "ours,ccm", "--seeds", "0",

@@ -1,5 +1,5 @@
 """The interaction metrics, the training terms on the decoded body, and the run-time contact layer
-(training/metrics.py, partner_losses.py, footik.py, contact.py) on cases with a known answer."""
+(training/evaluation/metrics.py, partner_losses.py, footik.py, contact.py) on cases with a known answer."""
 from __future__ import annotations
 
 import json
@@ -8,11 +8,11 @@ import numpy as np
 import pytest
 import torch
 
-from training import metrics as M
-from training import partner_losses as P
-from training.contact import SEPARATION, ContactLayer, separate, spine_gap
-from training.footik import ANKLE_FLOOR, FootLock, two_bone_ik
-from training.skeleton import FEET, PARENTS
+from training.evaluation import metrics as M
+from training.learning import partner_losses as P
+from training.mirror.contact import SEPARATION, ContactLayer, separate, spine_gap
+from training.mirror.footik import ANKLE_FLOOR, FootLock, two_bone_ik
+from training.mirror.skeleton import FEET, PARENTS
 
 
 def standing(x: float = 0.0, z: float = 0.0) -> np.ndarray:
@@ -132,7 +132,7 @@ def test_partner_terms_are_zero_on_the_recording_and_bite_on_error(prepared3):
                 y = torch.tensor(z["follower_output"][rows], dtype=torch.float64)
                 mirror = z["mirror"][rows]
                 break
-    from training.prepared import load_offsets
+    from training.data.prepared import load_offsets
     offsets = load_offsets(str(prepared3), "follower", "cpu").double()[torch.from_numpy(mirror).long()]
     exact = P.partner_terms(y, y, x, offsets, "follower")
     assert float(exact["interaction"]) == 0.0
@@ -150,7 +150,7 @@ def test_partner_terms_are_zero_on_the_recording_and_bite_on_error(prepared3):
 
 
 def test_interaction_command_on_fresh_models(exported, data3, tmp_path, capsys):
-    from training.interaction import main
+    from training.evaluation.interaction import main
     rc = main(["--data", str(data3), "--takes", "06", "--models", str(exported["models"]), "--seeds", "1",
                "--seconds", "2", "--out", str(tmp_path), "--quiet"])
     assert rc == 0

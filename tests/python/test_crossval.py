@@ -1,4 +1,4 @@
-"""training.crossval: folds that test every take once, the paired interval, and the whole loop
+"""training.evaluation.crossval: folds that test every take once, the paired interval, and the whole loop
 (prepare, train, export, evaluate, report) on small synthetic couples, resumed."""
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 import torch
 
-from training import crossval
-from training.synthetic import write_couples
+from training.evaluation import crossval
+from training.data.synthetic import write_couples
 
 TAKES = [f"{i:02d}" for i in (1, 2, 3, 4, 6, 7, 9, 10, 11, 12, 13, 15)]
 

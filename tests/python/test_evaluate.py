@@ -1,4 +1,4 @@
-"""python -m training.evaluate end to end on one short take with the smoke models.
+"""python -m training.evaluation.evaluate end to end on one short take with the smoke models.
 
 The ground-truth row runs through the very same loop (recorded outputs fed to apply_output), so
 it must reproduce the recording: MPJPE 0 and FID ~0. That checks the rollout bookkeeping, the
@@ -11,7 +11,7 @@ import json
 import numpy as np
 import pytest
 
-from training import evaluate as E
+from training.evaluation import evaluate as E
 
 from conftest import SMALL_TAKES
 
@@ -85,9 +85,9 @@ def test_codebook_error_comes_from_the_exported_files(result, exported, data3):
     """ours: the int8 step model's code at temperature 0 against the code of its fp32 output
     encoder file, which is the trained output encoder (torch) to float rounding."""
     import torch
-    from training import metrics as M
-    from training.rollout import OnnxPolicy
-    from training.runs import load_run
+    from training.evaluation import metrics as M
+    from training.mirror.rollout import OnnxPolicy
+    from training.learning.runs import load_run
     _, r = result
     take = E.load_eval_takes(str(data3), [SMALL_TAKES["test"]], FRAMES, None)[0]
     x = E.follower_input(take.lead, take.follow, take.frames).astype(np.float32)
@@ -142,7 +142,7 @@ def test_files_of_different_trainings_are_refused(exported, data3, tmp_path, cap
         (models / "manifest.json").write_text(json.dumps(m))
     assert E.main(short_args(exported, data3, tmp_path / "out", models)) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert err[-1].startswith("error: ") and "different trainings" in err[-1] and "python -m training.export" in err[-1]
+    assert err[-1].startswith("error: ") and "different trainings" in err[-1] and "python -m training.learning.export" in err[-1]
     assert not (tmp_path / "out" / "metrics.json").exists()
 
 

@@ -1,4 +1,4 @@
-"""python -m training.export: ONNX step models (fp32 and dynamic int8) against the torch
+"""python -m training.learning.export: ONNX step models (fp32 and dynamic int8) against the torch
 StepModel, sampling inputs, the manifest. Uses the session's smoke models (conftest.exported)."""
 from __future__ import annotations
 
@@ -11,12 +11,12 @@ import onnxruntime as ort
 import pytest
 import torch
 
-from training import export as E
-from training import features as feat
-from training.dataset import discover_takes, load_pair
-from training.runs import load_run
-from training.skeleton import FPS, JOINT_NAMES, KEY_JOINTS, PARENTS
-from training.train import SHIPPED
+from training.learning import export as E
+from training.mirror import features as feat
+from training.data.dataset import discover_takes, load_pair
+from training.learning.runs import load_run
+from training.mirror.skeleton import FPS, JOINT_NAMES, KEY_JOINTS, PARENTS
+from training.learning.train import SHIPPED
 
 
 
@@ -215,7 +215,7 @@ def test_export_refuses_unfinished_or_missing_runs(exported, data3, tmp_path, ca
 def test_evaluation_files_share_the_training_fingerprint(exported, models, validation):
     """Every exported file carries its training's fingerprint (also in the manifest); each
     follower's output encoder file gives the torch output encoder's logits."""
-    from training.stamp import eval_file, read_stamp
+    from training.learning.stamp import eval_file, read_stamp
     out = exported["models"]
     m = json.loads((out / "manifest.json").read_text())
     prints = {name: entry["fingerprint"] for name, entry in m["models"].items()}

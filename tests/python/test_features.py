@@ -1,13 +1,13 @@
-"""training/features.py: layouts, root-space conventions, invariance, round trips, normalization."""
+"""training/mirror/features.py: layouts, root-space conventions, invariance, round trips, normalization."""
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from training import features as F
-from training.dataset import samples
-from training.rollout import rotations_from_vectors
-from training.skeleton import FPS, Motion, forward_kinematics_reduced
+from training.mirror import features as F
+from training.data.dataset import samples
+from training.mirror.rollout import rotations_from_vectors
+from training.mirror.skeleton import FPS, Motion, forward_kinematics_reduced
 
 FEATURE_FUNCTIONS = ("follower_input", "leader_input", "output_features", "intention_target")
 

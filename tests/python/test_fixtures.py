@@ -1,6 +1,6 @@
 """tests/fixtures/*.json still say what training/ computes (tests/python/fixtures_writer.py rewrites them).
 
-The TypeScript tests compare web/*.ts against these files; this test compares the files against
+The TypeScript tests compare web/mirror/*.ts against these files; this test compares the files against
 the Python reference, so a change on either side shows up as a failing test.
 """
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""training/metrics.py on cases whose answer is known by hand, and the evaluation encoder's
+"""training/evaluation/metrics.py on cases whose answer is known by hand, and the evaluation encoder's
 determinism and cache."""
 from __future__ import annotations
 
@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 import torch
 
-from training import metrics as M
-from training.features import CONTACT_HEIGHT, Track
-from training.skeleton import FEET, FPS
+from training.evaluation import metrics as M
+from training.mirror.features import CONTACT_HEIGHT, Track
+from training.mirror.skeleton import FEET, FPS
 
 
 def test_fid_of_a_set_with_itself_is_zero(rng):

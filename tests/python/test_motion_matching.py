@@ -1,4 +1,4 @@
-"""training/motion_matching.py: feature groups, exact accelerated search, the policy contract."""
+"""training/evaluation/motion_matching.py: feature groups, exact accelerated search, the policy contract."""
 from __future__ import annotations
 
 import json
@@ -6,9 +6,9 @@ import json
 import numpy as np
 import pytest
 
-from training import features as feat
-from training import motion_matching as MM
-from training.features import FUTURE_OFFSETS, KEYS
+from training.mirror import features as feat
+from training.evaluation import motion_matching as MM
+from training.mirror.features import FUTURE_OFFSETS, KEYS
 
 
 def synthetic(rng, n=700, role="follower", **kw):
@@ -120,7 +120,7 @@ def test_real_queries_agree_with_brute_force(take_tracks, real_mm):
 
 def test_policy_drives_the_rollout_loop(real_mm, exported):
     """MotionMatching stands in for an OnnxPolicy in rollout.step, for either dancer."""
-    from training import rollout as R
+    from training.mirror import rollout as R
     manifest = json.loads((exported["models"] / "manifest.json").read_text())
     duet = R.start_duet(manifest)
     rng = np.random.default_rng(0)

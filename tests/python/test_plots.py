@@ -1,4 +1,4 @@
-"""training.plots: the pure helpers, and main() on missing / partial inputs (no real models needed)."""
+"""training.evaluation.plots: the pure helpers, and main() on missing / partial inputs (no real models needed)."""
 from __future__ import annotations
 
 import json
@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 import torch
 
-from training import features as feat
-from training import metrics as M
-from training import plots as P
+from training.mirror import features as feat
+from training.evaluation import metrics as M
+from training.evaluation import plots as P
 
 SL = P.FOLLOWER_IN["partner_trajectory_future"]
 

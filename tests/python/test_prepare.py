@@ -1,4 +1,4 @@
-"""python -m training.prepare: bad input folders fail with exit 2 and one 'error:' line; the real
+"""python -m training.data.prepare: bad input folders fail with exit 2 and one 'error:' line; the real
 data prints per-split frame counts and feature sizes and writes the arrays (in tmp only)."""
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ import sys
 import numpy as np
 import pytest
 
-from training.prepare import main
+from training.data.prepare import main
 
 from conftest import README_FRAMES, REAL_DATA, REPO, copy_takes, needs_real_data
 
@@ -152,7 +152,7 @@ def test_real_data(tmp_path):
     """The whole CMU folder through the real command line (a subprocess, as a user runs it)."""
     out = tmp_path / "prepared"
     try:
-        r = subprocess.run([sys.executable, "-m", "training.prepare", "--data", str(REAL_DATA), "--prepared", str(out)],
+        r = subprocess.run([sys.executable, "-m", "training.data.prepare", "--data", str(REAL_DATA), "--prepared", str(out)],
                            cwd=REPO, capture_output=True, text=True, timeout=300)
         check_real_data(r, out)
     finally:
@@ -197,7 +197,7 @@ def check_real_data(r, out):
 def test_files_in_other_units(tmp_path, capsys):
     """BVH in centimetres instead of the CMU copy's units: prepare names the file and the units."""
     from dataclasses import replace
-    from training import synthetic
+    from training.data import synthetic
     data = tmp_path / "data"
     data.mkdir()
     for s, m in zip(("60", "61"), synthetic.synthetic_couple(np.random.default_rng(0), 600)):
@@ -209,7 +209,7 @@ def test_files_in_other_units(tmp_path, capsys):
 
 
 def test_tempo_copies_are_a_file_of_their_own_and_change_nothing_else(data3, prepared3, tmp_path):
-    from training.prepared import load_mirror_flags, load_split
+    from training.data.prepared import load_mirror_flags, load_split
     none = tmp_path / "none"
     assert main(["--data", str(data3), "--prepared", str(none), "--validation", "12", "--test", "06",
                  "--tempos", ""]) == 0
@@ -230,7 +230,7 @@ def test_tempo_copies_are_a_file_of_their_own_and_change_nothing_else(data3, pre
 
 
 def test_a_tempo_recipe_without_copies_is_a_one_line_error(data3, tmp_path):
-    from training.prepared import TrainError, load_split
+    from training.data.prepared import TrainError, load_split
     none = tmp_path / "none"
     assert main(["--data", str(data3), "--prepared", str(none), "--validation", "12", "--test", "06",
                  "--tempos", ""]) == 0

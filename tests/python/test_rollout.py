@@ -1,4 +1,4 @@
-"""training/rollout.py: the run-time duet loop (what the page runs), with the exported smoke
+"""training/mirror/rollout.py: the run-time duet loop (what the page runs), with the exported smoke
 models, the absurd-output guard and resets, and a 5-minute duet of the shipped models."""
 from __future__ import annotations
 
@@ -8,10 +8,10 @@ from copy import deepcopy
 import numpy as np
 import pytest
 
-from training import features as feat
-from training import rollout as R
-from training.features import Track
-from training.skeleton import FPS
+from training.mirror import features as feat
+from training.mirror import rollout as R
+from training.mirror.features import Track
+from training.mirror.skeleton import FPS
 
 from conftest import REPO
 
@@ -207,7 +207,7 @@ def test_shipped_models_dance_five_minutes():
             not all(isinstance(manifest.get("skeleton", {}).get("offsets"), dict) and r in manifest["skeleton"]["offsets"]
                     for r in ("leader", "follower")):
         pytest.fail("public/models/manifest.json lacks startPose/offsets per role: it was not written by this "
-                    "training.export; re-export the shipped models (python -m training.export)")
+                    "training.learning.export; re-export the shipped models (python -m training.learning.export)")
     lead, follow = policies(SHIPPED, manifest)
     rng = np.random.default_rng(2024)
     temperature = manifest["defaultTemperature"]

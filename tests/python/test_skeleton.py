@@ -1,11 +1,11 @@
-"""training/skeleton.py: 17-joint reduction, metres, resampling, root/heading, mirroring."""
+"""training/mirror/skeleton.py: 17-joint reduction, metres, resampling, root/heading, mirroring."""
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from training.bvh import BvhError, forward_kinematics, local_transforms, parse_bvh
-from training.skeleton import (FPS, JOINT_NAMES, MIRROR, PARENTS, SCALE, Motion, forward_kinematics_reduced,
+from training.mirror.bvh import BvhError, forward_kinematics, local_transforms, parse_bvh
+from training.mirror.skeleton import (FPS, JOINT_NAMES, MIRROR, PARENTS, SCALE, Motion, forward_kinematics_reduced,
                                gaussian_smooth, mirror_motion, reduce_bvh, resample, root_from_motion)
 
 
@@ -176,7 +176,7 @@ def test_gaussian_smooth_keeps_length_and_lines():
 
 
 def test_time_warp_at_tempo_1_is_resample_and_keeps_rotations_rotations(take_pair):
-    from training.skeleton import FPS, resample, time_warp
+    from training.mirror.skeleton import FPS, resample, time_warp
     lead = take_pair[0]
     for phase in (0, 3):
         a, b = time_warp(lead, 1.0, FPS, phase), resample(lead, FPS, phase)

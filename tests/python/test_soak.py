@@ -6,8 +6,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from training import soak
-from training.skeleton import FPS
+from training.evaluation import soak
+from training.mirror.skeleton import FPS
 
 MODELS = Path(__file__).resolve().parents[2] / "public" / "models"
 

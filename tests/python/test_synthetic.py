@@ -1,5 +1,5 @@
-"""training.synthetic: procedural couples written as BVH the loader reads back exactly, in the
-data layout every command accepts; and where the data folder comes from (training.folders)."""
+"""training.data.synthetic: procedural couples written as BVH the loader reads back exactly, in the
+data layout every command accepts; and where the data folder comes from (training.data.folders)."""
 from __future__ import annotations
 
 import re
@@ -7,11 +7,11 @@ import re
 import numpy as np
 import pytest
 
-from training import folders, synthetic
-from training.bvh import parse_bvh
-from training.dataset import discover_takes, load_pair
-from training.prepare import main as prepare_main
-from training.skeleton import JOINT_NAMES, reduce_bvh
+from training.data import folders, synthetic
+from training.mirror.bvh import parse_bvh
+from training.data.dataset import discover_takes, load_pair
+from training.data.prepare import main as prepare_main
+from training.mirror.skeleton import JOINT_NAMES, reduce_bvh
 
 
 def test_euler_round_trip(rng):

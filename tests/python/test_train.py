@@ -1,4 +1,4 @@
-"""python -m training.train: smoke runs of the shipped models, resume, bad input, DDP (2 CPU
+"""python -m training.learning.train: smoke runs of the shipped models, resume, bad input, DDP (2 CPU
 processes). All on 3 prepared takes in tmp (conftest.prepared3)."""
 from __future__ import annotations
 
@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 import torch
 
-from training import features as feat
-from training import train as T
+from training.mirror import features as feat
+from training.learning import train as T
 
 from conftest import REPO
 
@@ -107,11 +107,11 @@ def test_missing_prepared_data(tmp_path, capsys):
     rc, _, err = run_main(capsys, "--model", "follower", "--smoke", "--prepared", tmp_path / "none", "--runs", tmp_path / "out")
     assert rc == 2
     line = error_line(err)
-    assert "train.npz not found" in line and "training.prepare" in line
+    assert "train.npz not found" in line and "training.data.prepare" in line
 
 
 def test_old_flag_names_still_work_with_a_note(tmp_path, capsys):
-    """train --data / --out were renamed --prepared / --runs (training/folders.py): the old names
+    """train --data / --out were renamed --prepared / --runs (training/data/folders.py): the old names
     are hidden aliases that say so."""
     rc, _, err = run_main(capsys, "--model", "follower", "--smoke", "--data", tmp_path / "none", "--out", tmp_path / "out")
     assert rc == 2
@@ -139,7 +139,7 @@ def test_mismatched_feature_sizes(tmp_path, capsys):
     rc, _, err = run_main(capsys, "--model", "follower", "--smoke", "--prepared", data, "--runs", tmp_path / "out")
     assert rc == 2
     line = error_line(err)
-    assert "follower input has 600 features" in line and "expects 660" in line and "re-run training.prepare" in line
+    assert "follower input has 600 features" in line and "expects 660" in line and "re-run training.data.prepare" in line
 
 
 @pytest.mark.parametrize("damage", ["truncated", "foreign"])
@@ -226,7 +226,7 @@ def test_ddp_two_cpu_processes(prepared3, tmp_path):
     torchrun = Path(sys.executable).with_name("torchrun")
     assert torchrun.exists(), torchrun
     env = {**os.environ, "OMP_NUM_THREADS": "1"}
-    r = subprocess.run([str(torchrun), "--standalone", "--nproc_per_node", "2", "-m", "training.train",
+    r = subprocess.run([str(torchrun), "--standalone", "--nproc_per_node", "2", "-m", "training.learning.train",
                         "--model", "follower", "--smoke", "--prepared", str(prepared3), "--runs", str(tmp_path)],
                        cwd=REPO, env=env, capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stdout[-3000:] + r.stderr[-3000:]
@@ -240,9 +240,9 @@ def test_ddp_two_cpu_processes(prepared3, tmp_path):
 # ---------------------------------------------------------------- validation table
 
 def test_validation_table_of_smoke_runs(smoke_runs, prepared3, capsys):
-    """training.validation: one row per run; the target-code MPJPE equals train.validate's when
+    """training.learning.validation: one row per run; the target-code MPJPE equals train.validate's when
     the estimated code is replaced by the target one, and both are in a plausible range."""
-    from training import validation as V
+    from training.learning import validation as V
     runs = [smoke_runs / "follower", smoke_runs / "follower_ccm"]
     assert V.main([str(r) for r in runs] + ["--prepared", str(prepared3)]) == 0
     out = capsys.readouterr().out.splitlines()
@@ -254,7 +254,7 @@ def test_validation_table_of_smoke_runs(smoke_runs, prepared3, capsys):
     assert math.isclose(row["codebook"], 2 * row["wrong_channels"] / 8, rel_tol=1e-5)
     # train.validate's MPJPE is the estimated-code one.
     import torch as _t
-    from training.models import CodebookMatching, IntentionPredictor, ModelConfig
+    from training.learning.models import CodebookMatching, IntentionPredictor, ModelConfig
     ck = _t.load(runs[0] / "checkpoint.pt", map_location="cpu", weights_only=False)
     cfg = ModelConfig(**ck["config"]["model"])
     p, m = IntentionPredictor(cfg), CodebookMatching(cfg)
@@ -266,7 +266,7 @@ def test_validation_table_of_smoke_runs(smoke_runs, prepared3, capsys):
 
 
 def test_validation_refuses_unfinished_and_missing_runs(smoke_runs, prepared3, tmp_path, capsys):
-    from training import validation as V
+    from training.learning import validation as V
     assert V.main([str(tmp_path / "none"), "--prepared", str(prepared3)]) == 2
     assert "checkpoint.pt not found" in capsys.readouterr().err
     run = tmp_path / "half"
@@ -279,7 +279,7 @@ def test_validation_refuses_unfinished_and_missing_runs(smoke_runs, prepared3, t
 
 
 def test_moving_the_partner_closer_shifts_its_whole_window_rigidly(prepared3):
-    from training.prepared import load_split
+    from training.data.prepared import load_split
     x = torch.from_numpy(load_split(str(prepared3), "train", "follower")["input"][:2000]).float()
     xm, moved = T.move_partner_closer(x, 0.5, torch.Generator().manual_seed(0))
     assert 0.2 < moved.float().mean() < 0.56     # half drawn, minus those already closer
@@ -301,8 +301,8 @@ def test_moving_the_partner_closer_shifts_its_whole_window_rigidly(prepared3):
 
 
 def test_intention_early_stopping_keeps_the_best_validation_epoch(prepared3, tmp_path):
-    from training.models import IntentionPredictor
-    from training.prepared import load_split, load_stats, normalize
+    from training.learning.models import IntentionPredictor
+    from training.data.prepared import load_split, load_stats, normalize
     cfg = replace(T.smoke(T.MODELS["follower"]), intention_epochs=4, epochs=0, intention_best=True,
                   intention_dropout=0.0, lr=3e-2)
     T.train_model("f", cfg, str(prepared3), str(tmp_path), quiet=True)

@@ -1,10 +1,10 @@
-// web/body.ts: hands, feet and face follow the joint rotations (or the body's facing without
+// web/draw/body.ts: hands, feet and face follow the joint rotations (or the body's facing without
 // them), shoes stay above the floor, and contact marks appear only for contacts.
 
 import * as THREE from 'three';
 import { describe, expect, it } from 'vitest';
-import { ContactMarks, DancerMeshes } from '../../web/body';
-import { PARENTS } from '../../web/skeleton';
+import { ContactMarks, DancerMeshes } from '../../web/draw/body';
+import { PARENTS } from '../../web/mirror/skeleton';
 
 /** A standing dancer facing +z (left side at +x), arms hanging, ankles 8 cm up. */
 function standing(): Float32Array {

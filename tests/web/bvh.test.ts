@@ -1,8 +1,8 @@
-// web/bvh.ts against training/bvh.py: parsing (channel orders, End Sites, errors), local
+// web/mirror/bvh.ts against training/mirror/bvh.py: parsing (channel orders, End Sites, errors), local
 // transforms and forward kinematics of a hand-written BVH and of a generated 21-joint one.
 
 import { describe, expect, it } from 'vitest';
-import { BvhError, forwardKinematics, localTransforms, parseBvh } from '../../web/bvh';
+import { BvhError, forwardKinematics, localTransforms, parseBvh } from '../../web/mirror/bvh';
 import { expectClose, fixture } from './fixture';
 
 const data = fixture('bvh');

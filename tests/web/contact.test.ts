@@ -1,16 +1,16 @@
-// web/contact.ts against training/contact.py: the contact layer over the fixture's 40 frames of two
+// web/mirror/contact.ts against training/mirror/contact.py: the contact layer over the fixture's 40 frames of two
 // procedural dancers walked into each other and apart (spines pushed apart, hands drawn together
 // and let go, feet locked and released, one clear() as after a reset), plus the geometry alone.
 
 import { describe, expect, it } from 'vitest';
 import {
   ContactLayer, HAND_FULL, HAND_REACH, SEPARATION, closestOnSegments, reachWeight, separate, spineGap,
-} from '../../web/contact';
+} from '../../web/mirror/contact';
 import { expectClose, fixture } from './fixture';
 
 const J3 = 17 * 3;
 
-describe('ContactLayer mirrors training/contact.py', () => {
+describe('ContactLayer mirrors training/mirror/contact.py', () => {
   const data = fixture('contact');
 
   it('shows the same poses, hold, hands and push at every step', () => {

@@ -1,8 +1,8 @@
-// web/features.ts against training/features.py: constants and layouts, root space, every block,
+// web/mirror/features.ts against training/mirror/features.py: constants and layouts, root space, every block,
 // the model inputs, outputs and intention targets of two procedural dancers circling each other.
 
 import { describe, expect, it } from 'vitest';
-import * as F from '../../web/features';
+import * as F from '../../web/mirror/features';
 import { expectClose, fixture, trackOf } from './fixture';
 
 const data = fixture('features');

@@ -2,7 +2,7 @@
 
 import { readFileSync } from 'node:fs';
 import { expect } from 'vitest';
-import { Track } from '../../web/features';
+import { Track } from '../../web/mirror/features';
 
 export type Json = any;
 

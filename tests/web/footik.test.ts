@@ -1,8 +1,8 @@
-// web/footik.ts: the two-bone IK keeps bone lengths and reaches what it can; the lock keeps a
+// web/mirror/footik.ts: the two-bone IK keeps bone lengths and reaches what it can; the lock keeps a
 // planted foot still, re-plants a stale lock, and holds ankles above the floor.
 
 import { describe, expect, it } from 'vitest';
-import { ANKLE_FLOOR, FootLock, MAX_LOCK_DISTANCE, twoBoneIk } from '../../web/footik';
+import { ANKLE_FLOOR, FootLock, MAX_LOCK_DISTANCE, twoBoneIk } from '../../web/mirror/footik';
 
 /** A left leg: thigh (11) at hip height, knee (12) slightly forward, foot (13) below. */
 function leg(): Float64Array {

@@ -1,12 +1,12 @@
-// web/manifest.ts: the page refuses a manifest whose feature layout differs from its own tables
-// (web/features.ts), naming the first block that differs. The shipped manifest must pass.
+// web/engine/manifest.ts: the page refuses a manifest whose feature layout differs from its own tables
+// (web/mirror/features.ts), naming the first block that differs. The shipped manifest must pass.
 
 import { readFileSync } from 'node:fs';
 import { describe, expect, it } from 'vitest';
-import { firstDifference, validateManifest } from '../../web/manifest';
-import { DuetError } from '../../web/errors';
-import { FOLLOWER_INPUT_LAYOUT } from '../../web/features';
-import type { Manifest } from '../../web/types';
+import { firstDifference, validateManifest } from '../../web/engine/manifest';
+import { DuetError } from '../../web/ui/errors';
+import { FOLLOWER_INPUT_LAYOUT } from '../../web/mirror/features';
+import type { Manifest } from '../../web/engine/types';
 
 const shipped = () => JSON.parse(readFileSync(new URL('../../public/models/manifest.json', import.meta.url), 'utf8')) as Manifest;
 

@@ -1,19 +1,19 @@
-// BVH writing (web/bvhwriter.ts) and recording (web/record.ts): a file written from world rotations
+// BVH writing (web/ui/bvhwriter.ts) and recording (web/ui/record.ts): a file written from world rotations
 // and a hip path, read back with the page's own reader (parseBvh + reduceBvh), gives the same
 // skeleton -- FK positions within 1e-4 m, world rotations within 1e-4 -- including rotations at
 // and near gimbal lock; the recorder keeps every frame up to its cap and says when it stops.
 
 import { describe, expect, it } from 'vitest';
-import { axisRotation, matmul3, parseBvh } from '../../web/bvh';
+import { axisRotation, matmul3, parseBvh } from '../../web/mirror/bvh';
 import {
   BVH_UNITS_PER_METRE, BvhWriteError, CHANNELS_PER_FRAME, eulerZXY, frameChannels, writeBvh, writeBvhFromWorld,
-} from '../../web/bvhwriter';
-import { JOINT_NAMES, N_JOINTS, PARENTS, forwardKinematicsReduced, motionFromBvhText, reduceBvh } from '../../web/skeleton';
-import { NOW, startDuet } from '../../web/rollout';
-import { MAX_RECORD_FRAMES, Recorder, formatDuration, timestamp } from '../../web/record';
-import { leaderMotionFromText } from '../../web/dropzone';
-import { DuetError } from '../../web/errors';
-import { mulberry32 } from '../../web/random';
+} from '../../web/ui/bvhwriter';
+import { JOINT_NAMES, N_JOINTS, PARENTS, forwardKinematicsReduced, motionFromBvhText, reduceBvh } from '../../web/mirror/skeleton';
+import { NOW, startDuet } from '../../web/mirror/rollout';
+import { MAX_RECORD_FRAMES, Recorder, formatDuration, timestamp } from '../../web/ui/record';
+import { leaderMotionFromText } from '../../web/ui/dropzone';
+import { DuetError } from '../../web/ui/errors';
+import { mulberry32 } from '../../web/engine/random';
 import { fixture } from './fixture';
 
 const data = fixture('rollout');

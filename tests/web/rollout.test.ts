@@ -1,10 +1,10 @@
-// web/rollout.ts against training/rollout.py: start pose, and four steps of the duet loop from the
+// web/mirror/rollout.ts against training/mirror/rollout.py: start pose, and four steps of the duet loop from the
 // procedural dancers (steering, both inputs, outputs applied, intention, and absurd outputs that
 // reset a dancer: NaN, a root jump, a joint too far).
 
 import { describe, expect, it } from 'vitest';
-import { INPUT_SIZE } from '../../web/features';
-import * as R from '../../web/rollout';
+import { INPUT_SIZE } from '../../web/mirror/features';
+import * as R from '../../web/mirror/rollout';
 import { type Json, expectClose, fixture, trackOf } from './fixture';
 
 const data = fixture('rollout');

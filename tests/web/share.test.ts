@@ -1,8 +1,8 @@
-// Settings from a share link (web/share.ts): every value is validated and clamped; anything
+// Settings from a share link (web/ui/share.ts): every value is validated and clamped; anything
 // unknown, non-numeric or carrying markup leaves the default in place.
 
 import { describe, expect, it } from 'vitest';
-import { LIMITS, type Settings, defaultSettings, readCamera, readSettings, writeSettings } from '../../web/share';
+import { LIMITS, type Settings, defaultSettings, readCamera, readSettings, writeSettings } from '../../web/ui/share';
 
 const defaults: Settings = { ...defaultSettings(0.5), seed: 42 };
 const read = (search: string) => readSettings(search, defaults);

@@ -1,14 +1,14 @@
-// The page's Simulation (createSimulation in web/simulation.ts) on fake policies: views in world
+// The page's Simulation (createSimulation in web/engine/simulation.ts) on fake policies: views in world
 // space, compare mode, ghosts that leave the real state alone, resets on absurd output, leader
 // playback from a recording, foot locking on the drawn pose only, step timing.
 
 import { describe, expect, it } from 'vitest';
-import { FOLLOWER_INPUT_LAYOUT, INPUT_SIZE, LEADER_INPUT_LAYOUT, OUTPUT_LAYOUT, OUTPUT_SIZE, Track, blockSlices } from '../../web/features';
-import { ANCHOR_RATE, NOW } from '../../web/rollout';
-import { type DuetSimulation, createSimulation } from '../../web/simulation';
-import type { Motion } from '../../web/skeleton';
-import type { Manifest, StepPolicy } from '../../web/types';
-import { ANKLE_FLOOR } from '../../web/footik';
+import { FOLLOWER_INPUT_LAYOUT, INPUT_SIZE, LEADER_INPUT_LAYOUT, OUTPUT_LAYOUT, OUTPUT_SIZE, Track, blockSlices } from '../../web/mirror/features';
+import { ANCHOR_RATE, NOW } from '../../web/mirror/rollout';
+import { type DuetSimulation, createSimulation } from '../../web/engine/simulation';
+import type { Motion } from '../../web/mirror/skeleton';
+import type { Manifest, StepPolicy } from '../../web/engine/types';
+import { ANKLE_FLOOR } from '../../web/mirror/footik';
 import { fixture, trackOf } from './fixture';
 
 const data = fixture('rollout');

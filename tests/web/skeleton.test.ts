@@ -1,12 +1,12 @@
-// web/skeleton.ts against training/skeleton.py: constants, reduction of a generated BVH to the 17
+// web/mirror/skeleton.ts against training/mirror/skeleton.py: constants, reduction of a generated BVH to the 17
 // joints (folding the collars and buttocks away), resampling, smoothing, root, mirroring, FK.
 
 import { describe, expect, it } from 'vitest';
-import { BvhError, parseBvh } from '../../web/bvh';
+import { BvhError, parseBvh } from '../../web/mirror/bvh';
 import {
   FEET, JOINT_NAMES, KEY_JOINTS, MIRROR, PARENTS, SCALE, FPS, facingDirection, forwardKinematicsReduced,
   gaussianSmooth, mirrorMotion, motionFromBvhText, reduceBvh, resample, rootFromMotion,
-} from '../../web/skeleton';
+} from '../../web/mirror/skeleton';
 import { expectClose, fixture } from './fixture';
 
 const data = fixture('bvh');

@@ -1,0 +1,212 @@
+"""python -m training.evaluation.soak: long free-running duets with random steering, checked for failure.
+
+    python -m training.evaluation.soak                          # 100 rollouts x 10 minutes (the full run)
+    python -m training.evaluation.soak --rollouts 2 --minutes 1 # what CI runs
+
+Runs the exported ONNX models through training/mirror/rollout.py (the loop the page mirrors) with a
+steering script that changes every 0.5-3 s: random directions, sharp reversals, long holds and
+idle spells. Per rollout it reports non-finite numbers, the largest leader-follower distance,
+bone-length error, the lowest foot, the share of frozen frames and guard resets; it exits 1 when
+any rollout breaks a limit. The summary adds how the duet reads as a couple (metrics.interaction),
+for the networks alone and with the run-time contact layer (training/mirror/contact.py).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+from tqdm import tqdm
+
+from ..data.folders import add_folder
+from ..mirror.rollout import NOW, OnnxPolicy, start_duet, step
+from . import metrics as M
+from ..mirror.skeleton import FEET, FPS, PARENTS
+
+MAX_DISTANCE = 3.0        # m between the partners
+MAX_BONE_ERROR = 0.001    # m
+MIN_FOOT = -0.02          # m: the ankle joint may not sink below this
+FROZEN_SPEED = 0.1        # m/s mean joint speed over the last second counts as frozen
+MAX_FROZEN = 0.25         # share of frames a dancer may stand frozen
+
+
+def steering_script(rng: np.random.Generator, frames: int) -> np.ndarray:
+    """[frames, 2] stick positions: segments of 0.5-3 s, each idle, a hold, a new random
+    direction, or a sharp reversal of the previous one."""
+    out = np.zeros((frames, 2))
+    t, stick = 0, np.zeros(2)
+    while t < frames:
+        n = int(rng.uniform(0.5, 3.0) * FPS)
+        kind = rng.choice(["idle", "hold", "turn", "reverse"], p=[0.25, 0.2, 0.35, 0.2])
+        if kind == "idle":
+            stick = np.zeros(2)
+        elif kind == "turn" or not stick.any():
+            a = rng.uniform(-np.pi, np.pi)
+            stick = np.array([np.sin(a), np.cos(a)]) * rng.uniform(0.5, 1.0)
+        elif kind == "reverse":
+            stick = -stick
+        if kind == "hold":
+            n *= 3   # long holds: up to 9 s in one direction
+        out[t:t + n] = stick
+        t += n
+    return out
+
+
+def bone_error(positions: np.ndarray, offsets: np.ndarray) -> float:
+    lengths = np.linalg.norm(positions[1:] - positions[PARENTS[1:]], axis=-1)
+    return float(np.abs(lengths - np.linalg.norm(offsets[1:], axis=-1)).max())
+
+
+def soak_one(manifest, leader, follower, seed: int, frames: int, temperature: float,
+             record: dict | None = None) -> dict:
+    """One steered duet. With `record` (a dict), every frame's world positions and foot contacts
+    of both dancers are stored there: `leader`, `follower` [frames, 17, 3] as the networks left
+    them, `leader_shown`, `follower_shown` after the contact layer, `leader_contacts`, `follower_contacts` [frames, 2]."""
+    rng = np.random.default_rng(seed)
+    sticks = steering_script(rng, frames)
+    duet = start_duet(manifest)
+    worst = {"nonfinite": 0, "max_distance": 0.0, "bone_error": 0.0, "min_foot": np.inf}
+    speeds = np.zeros((frames, 2))
+    if record is not None:
+        for k in ("leader", "follower"):
+            record[k] = np.zeros((frames, 17, 3))
+            record[f"{k}_shown"] = np.zeros((frames, 17, 3))
+            record[f"{k}_contacts"] = np.zeros((frames, 2))
+    for f in range(frames):
+        step(duet, leader, follower, sticks[f], temperature, rng)
+        if record is not None:
+            for i, (k, d) in enumerate((("leader", duet.leader), ("follower", duet.follower))):
+                record[k][f] = d.track.positions[NOW]
+                record[f"{k}_shown"][f] = duet.shown[i]
+                record[f"{k}_contacts"][f] = d.contacts
+        for i, d in enumerate((duet.leader, duet.follower)):
+            p = d.track.positions
+            if not np.all(np.isfinite(p[NOW])):
+                worst["nonfinite"] += 1
+                continue
+            worst["bone_error"] = max(worst["bone_error"], bone_error(p[NOW], d.offsets))
+            worst["min_foot"] = min(worst["min_foot"], float(p[NOW][FEET, 1].min()))
+            speeds[f, i] = np.linalg.norm(p[NOW] - p[NOW - FPS], axis=-1).mean()  # m over the last 1 s
+        worst["max_distance"] = max(worst["max_distance"],
+                                    float(np.linalg.norm(duet.leader.root - duet.follower.root)))
+    frozen = (speeds[FPS:] < FROZEN_SPEED).mean(0)
+    return {"seed": seed, **worst, "frozen_leader": float(frozen[0]), "frozen_follower": float(frozen[1]),
+            "resets": duet.leader.resets + duet.follower.resets}
+
+
+TURN_HOLD_SECONDS = 4.0    # each steering trial: hold one direction, then the one 90 degrees off
+
+
+def steering_trial(manifest, leader, follower, angle: float, turn: float, temperature: float,
+                   seed: int) -> dict:
+    """Hold the stick fully at `angle` (radians, world) for TURN_HOLD_SECONDS, then turn it by
+    `turn` and hold again: metrics.steering_response of the leader's root after the turn."""
+    rng = np.random.default_rng(seed)
+    duet = start_duet(manifest)
+    hold = int(TURN_HOLD_SECONDS * FPS)
+    first = np.array([np.sin(angle), np.cos(angle)])
+    second = np.array([np.sin(angle + turn), np.cos(angle + turn)])
+    root = np.zeros((2 * hold, 2))
+    for f in range(2 * hold):
+        step(duet, leader, follower, first if f < hold else second, temperature, rng)
+        root[f] = duet.leader.root
+    return M.steering_response(root, hold, second)
+
+
+def steering_trials(manifest, leader, follower, temperature: float, trials: int = 8) -> dict:
+    """`trials` turns of 90 degrees (alternately left and right, from evenly spread headings):
+    mean seconds until the leader moves within 30 degrees of the new direction (and how many
+    never did within TURN_HOLD_SECONDS), and the mean speed reached."""
+    res = [steering_trial(manifest, leader, follower, 2 * np.pi * i / trials, (-1) ** i * np.pi / 2,
+                          temperature, seed=i) for i in range(trials)]
+    reached = [r["seconds"] for r in res if r["seconds"] is not None]
+    return {"trials": trials, "turn_seconds": float(np.mean(reached)) if reached else None,
+            "turn_missed": trials - len(reached), "speed": float(np.mean([r["speed"] for r in res]))}
+
+
+def failures(r: dict) -> list[str]:
+    out = []
+    if r["nonfinite"]:
+        out.append("non-finite")
+    if r["max_distance"] >= MAX_DISTANCE:
+        out.append(f"distance {r['max_distance']:.2f} m")
+    if r["bone_error"] >= MAX_BONE_ERROR:
+        out.append(f"bone error {r['bone_error'] * 1000:.2f} mm")
+    if r["min_foot"] <= MIN_FOOT:
+        out.append(f"foot {r['min_foot'] * 100:.1f} cm")
+    if max(r["frozen_leader"], r["frozen_follower"]) > MAX_FROZEN:
+        out.append("frozen")
+    if r["resets"]:
+        out.append(f"{r['resets']} resets")
+    return out
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m training.evaluation.soak", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    add_folder(ap, "models", "the leader and follower that dance")
+    ap.add_argument("--follower", default="follower", help="follower model name in the manifest")
+    ap.add_argument("--rollouts", type=int, default=100)
+    ap.add_argument("--minutes", type=float, default=10.0)
+    ap.add_argument("--temperature", type=float, default=None, help="default: the manifest's")
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--out", default=None, help="write the table as JSON here")
+    args = ap.parse_args(argv)
+    manifest_path = Path(args.models) / "manifest.json"
+    if not manifest_path.exists():
+        print(f"error: {manifest_path} not found (python -m training.learning.export writes it)", file=sys.stderr)
+        return 2
+    manifest = json.loads(manifest_path.read_text())
+    if args.follower not in manifest["models"]:
+        print(f"error: no model {args.follower!r} in {manifest_path}", file=sys.stderr)
+        return 2
+    temperature = manifest["defaultTemperature"] if args.temperature is None else args.temperature
+    leader = OnnxPolicy(Path(args.models) / manifest["models"]["leader"]["file"])
+    follower = OnnxPolicy(Path(args.models) / manifest["models"][args.follower]["file"])
+    frames = int(args.minutes * 60 * FPS)
+    t0 = time.time()
+    results = []
+    print(f"{args.rollouts} rollouts x {frames} frames ({args.minutes:g} min at {FPS} Hz), "
+          f"follower {args.follower}, temperature {temperature}")
+    print(" seed  nonfinite  max dist m  bone err mm  min foot cm  frozen L  frozen F  resets  result")
+    for i in tqdm(range(args.rollouts), desc="soak", unit="rollout", leave=False):
+        rec = {}
+        r = soak_one(manifest, leader, follower, args.seed + i, frames, temperature, rec)
+        r["interaction"] = M.interaction(rec["leader"], rec["follower"], rec["leader_contacts"], rec["follower_contacts"])
+        r["interaction_layer"] = M.interaction(rec["leader_shown"], rec["follower_shown"], rec["leader_contacts"],
+                                               rec["follower_contacts"])
+        r["failures"] = failures(r)
+        results.append(r)
+        tqdm.write(f"{r['seed']:>5} {r['nonfinite']:>10} {r['max_distance']:>11.2f} "
+                   f"{r['bone_error'] * 1000:>12.4f} {r['min_foot'] * 100:>12.1f} {r['frozen_leader']:>9.3f} "
+                   f"{r['frozen_follower']:>9.3f} {r['resets']:>7}  {'; '.join(r['failures']) or 'ok'}")
+    bad = [r for r in results if r["failures"]]
+    summary = {"rollouts": len(results), "frames": frames, "failed": len(bad),
+               "nonfinite": sum(r["nonfinite"] for r in results),
+               "max_distance": max(r["max_distance"] for r in results),
+               "bone_error_mm": max(r["bone_error"] for r in results) * 1000,
+               "min_foot_cm": min(r["min_foot"] for r in results) * 100,
+               "frozen_max": max(max(r["frozen_leader"], r["frozen_follower"]) for r in results),
+               "resets": sum(r["resets"] for r in results), "seconds": time.time() - t0}
+    for key in ("interaction", "interaction_layer"):
+        summary[key] = {k: float(np.mean([r[key][k] for r in results])) for k in results[0][key]}
+    print(f"summary: {len(bad)} of {len(results)} rollouts failed; max distance {summary['max_distance']:.2f} m; "
+          f"bone error {summary['bone_error_mm']:.4f} mm; lowest foot {summary['min_foot_cm']:.1f} cm; "
+          f"most frozen {summary['frozen_max']:.3f}; resets {summary['resets']}; {summary['seconds']:.0f} s")
+    for key, title in (("interaction", "networks alone"), ("interaction_layer", "with the contact layer")):
+        m = summary[key]
+        print(f"interaction, {title}: torsos through each other {m['interpenetration']:.1%} of frames, "
+              f"hands within 20 cm {m['hand_hold']:.1%}, closest hands {m['closest_hand_m']:.2f} m, "
+              f"foot skate leader / follower {m['contact_skate_leader_cm']:.2f} / "
+              f"{m['contact_skate_follower_cm']:.2f} cm per contact frame "
+              f"({m['skate_leader_cm']:.2f} / {m['skate_follower_cm']:.2f} while low)")
+    if args.out:
+        Path(args.out).write_text(json.dumps({"summary": summary, "rollouts": results}, indent=1))
+    return 1 if bad else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

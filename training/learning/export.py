@@ -1,0 +1,164 @@
+"""python -m training.learning.export: trained runs -> dynamic-int8 ONNX step models + manifest.
+
+    python -m training.learning.export                    # runs/models/{follower,follower_ccm,leader} -> public/models
+    python -m training.learning.export --runs R --models M --model follower
+
+One ONNX file per model holds the whole step (normalization, intention, input encoder, Gumbel-max
+sampling with temperature and noise as inputs, gather decoder, de-normalization), so the page
+only builds features and reads results. Dynamic int8 (per channel) because static QDQ int8 runs
+6-8x slower in the browser's WASM backend.
+
+Each follower also gets MODELS/eval/NAME.output_encoder.onnx (fp32, evaluation only; for the
+page's public/models it goes to models/eval/, outside what the site publishes: stamp.eval_folder):
+what training.evaluation.evaluate needs for the codebook error. Every file carries the
+run's fingerprint (training/learning/stamp.py), repeated in manifest.json.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from ..mirror import features as feat
+from ..data.dataset import DataError, discover_takes, load_pair
+from ..data.folders import add_folder
+from .models import OutputEncoderStep, StepModel
+from ..data.prepared import TrainError
+from .runs import fingerprint, load_run
+from .stamp import eval_file, write_stamp
+from ..mirror.skeleton import FPS, JOINT_NAMES, KEY_JOINTS, PARENTS
+from .train import SHIPPED
+
+MANIFEST_VERSION = 1
+OPSET = 18
+DEFAULT_TEMPERATURE = 0.5
+CREDIT = ("The data used in this project was obtained from mocap.cs.cmu.edu. "
+          "The database was created with funding from NSF EIA-0196217.")
+
+
+def export_onnx(model: StepModel, path: Path) -> None:
+    cfg = model.cfg
+    x = torch.zeros(2, cfg.input_size)
+    t = torch.ones(1)
+    u = torch.full((2, cfg.latent), 0.5)
+    names = ["output", "intention", "code"] if cfg.intention else ["output", "code"]
+    torch.onnx.export(model, (x, t, u), str(path), opset_version=OPSET, dynamo=False,
+                      input_names=["input", "temperature", "noise"], output_names=names,
+                      dynamic_axes={"input": {0: "batch"}, "noise": {0: "batch"},
+                                    **{n: {0: "batch"} for n in names}})
+
+
+def export_output_encoder(model: StepModel, path: Path) -> None:
+    """fp32 ONNX of OutputEncoderStep: (input [B, 660], output [B, 323]) -> target_logits [B, C*D].
+    fp32, not int8: it is the reference every follower's codes are scored against."""
+    cfg = model.cfg
+    path.parent.mkdir(parents=True, exist_ok=True)
+    torch.onnx.export(OutputEncoderStep(model).eval(), (torch.zeros(2, cfg.input_size), torch.zeros(2, cfg.output_size)),
+                      str(path), opset_version=OPSET, dynamo=False, input_names=["input", "output"],
+                      output_names=["target_logits"],
+                      dynamic_axes={"input": {0: "batch"}, "output": {0: "batch"}, "target_logits": {0: "batch"}})
+
+
+def stamp_of(name: str, model: StepModel) -> dict:
+    return {"fingerprint": fingerprint(model), "name": name, "role": model.cfg.role,
+            "channels": model.cfg.channels, "classes": model.cfg.classes}
+
+
+def quantize(src: Path, dst: Path) -> None:
+    from onnxruntime.quantization import QuantType, quantize_dynamic
+    quantize_dynamic(str(src), str(dst), per_channel=True, weight_type=QuantType.QInt8)
+
+
+def skeleton_offsets(data: str) -> dict:
+    """Bone offsets (metres) of each role, from the first take: the page draws and exports BVH
+    with them. Offsets are constant per dancer, so this is not frame-by-frame data."""
+    take = discover_takes(data)[0]
+    lead, follow = load_pair(take)
+    return {"leader": np.round(lead.offsets, 5).tolist(), "follower": np.round(follow.offsets, 5).tolist()}
+
+
+def start_pose(stats_mean: np.ndarray) -> dict:
+    """A neutral standing pose per role from the mean output pose (an average over all frames):
+    the page starts both dancers from it."""
+    pose = stats_mean[feat.block_slices(feat.OUTPUT_LAYOUT)["pose"]].reshape(feat.N_JOINTS, 12)
+    return {"hip": np.round(pose[0, :3], 4).tolist(),
+            "forward": np.round(pose[:, 6:9], 4).tolist(), "up": np.round(pose[:, 9:12], 4).tolist()}
+
+
+def write_manifest(out: Path, models: dict[str, StepModel], data: str, prepared: str) -> dict:
+    stats = np.load(Path(prepared) / "stats.npz")
+    manifest = {
+        "version": MANIFEST_VERSION,
+        "fps": FPS,
+        "skeleton": {"names": JOINT_NAMES, "parents": PARENTS, "offsets": skeleton_offsets(data)},
+        "keyJoints": KEY_JOINTS,
+        "layout": {"input": feat.INPUT_SIZE, "output": feat.OUTPUT_SIZE, "intention": feat.INTENTION_SIZE,
+                   "followerInput": feat.FOLLOWER_INPUT_LAYOUT, "leaderInput": feat.LEADER_INPUT_LAYOUT,
+                   "outputBlocks": feat.OUTPUT_LAYOUT},
+        "startPose": {role: start_pose(stats[f"{role}_output_mean"]) for role in ("leader", "follower")},
+        "models": {},
+        "defaultTemperature": DEFAULT_TEMPERATURE,
+        "credit": CREDIT,
+    }
+    for name, m in models.items():
+        f = out / f"{name}.onnx"
+        entry = manifest["models"][name] = {
+            "file": f.name, "bytes": f.stat().st_size, "role": m.cfg.role, "channels": m.cfg.channels,
+            "classes": m.cfg.classes, "intention": m.cfg.intention, "hidden": m.cfg.hidden,
+            "fingerprint": fingerprint(m)}
+        e = eval_file(out, name)
+        if m.cfg.role == "follower" and e.exists():
+            entry["eval"] = {"outputEncoder": os.path.relpath(e, out), "bytes": e.stat().st_size}
+    (out / "manifest.json").write_text(json.dumps(manifest, indent=1))
+    return manifest
+
+
+def export_all(names: list[str], runs: str, out: str, data: str, prepared: str, keep_fp32: str | None):
+    out_dir = Path(out)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    fp32_dir = Path(keep_fp32) if keep_fp32 else Path(runs) / "fp32"
+    fp32_dir.mkdir(parents=True, exist_ok=True)
+    models = {}
+    for name in names:
+        model = load_run(Path(runs) / name, prepared).model
+        fp32 = fp32_dir / f"{name}.onnx"
+        export_onnx(model, fp32)
+        quantize(fp32, out_dir / f"{name}.onnx")
+        stamp = stamp_of(name, model)
+        write_stamp(out_dir / f"{name}.onnx", stamp)
+        if model.cfg.role == "follower":
+            export_output_encoder(model, eval_file(out_dir, name))
+            write_stamp(eval_file(out_dir, name), stamp)
+        models[name] = model
+        print(f"{name}: fp32 {fp32.stat().st_size / 1e6:.2f} MB -> int8 "
+              f"{(out_dir / f'{name}.onnx').stat().st_size / 1e6:.2f} MB")
+    return write_manifest(out_dir, models, data, prepared)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m training.learning.export", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--model", action="append", help=f"default: {', '.join(SHIPPED)}")
+    add_folder(ap, "runs", "read")
+    add_folder(ap, "prepared", "read for the normalization")
+    add_folder(ap, "data", "read for the skeleton offsets")
+    add_folder(ap, "models", "written", old=("--out",))
+    ap.add_argument("--fp32", default=None, help="where to keep the fp32 ONNX (default RUNS/fp32)")
+    args = ap.parse_args(argv)
+    try:
+        m = export_all(args.model or SHIPPED, args.runs, args.models, args.data, args.prepared, args.fp32)
+    except (TrainError, DataError) as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+    total = sum(v["bytes"] for v in m["models"].values())
+    print(f"wrote {args.models}/manifest.json; models total {total / 1e6:.2f} MB")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,540 @@
+"""python -m training.learning.train: intention predictor, then adversarial codebook matching.
+
+    python -m training.learning.train --all              # every shipped model (follower, follower_ccm, leader)
+    python -m training.learning.train --model follower   # one model (names in MODELS below)
+    python -m training.learning.train --all --smoke      # tiny run for CI (< 2 min)
+    torchrun --nproc_per_node 2 -m training.learning.train --model follower   # data parallel (DDP)
+
+Reads the prepared arrays (--prepared, default runs/data); each model lives in --runs (default
+runs/models) as NAME/: checkpoint.pt (resume with --resume), losses.png, history.json. Bad input
+(no prepared data, feature sizes that do not match, a corrupt checkpoint) stops with a one-line
+error instead of quietly starting over.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+import time
+from dataclasses import asdict, dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+import torch
+import torch.nn.functional as F
+from tqdm import tqdm
+
+from ..mirror import features as feat
+from .distributed import average_gradients, broadcast_parameters, pick_device, setup_distributed, stop_distributed
+from ..data.folders import add_folder
+from ..evaluation.loss_plot import plot_history
+from .models import CodebookMatching, Discriminator, IntentionPredictor, ModelConfig, code_logits, sample_codes
+from ..data.prepared import (TrainError, load_mirror_flags, load_offsets, load_split, load_stats, normalize,
+                       pose_error_cm)
+from .runs import load_checkpoint, save_checkpoint
+from .partner_losses import (INTERACTION_JOINTS, block_positions, decoded_positions, input_slices,
+                             partner_terms, penetration_loss)
+from ..mirror.skeleton import HANDS
+
+
+@dataclass
+class TrainConfig:
+    model: ModelConfig = field(default_factory=ModelConfig)
+    intention_epochs: int = 20
+    # Regularizing the predictor alone (docs/results.md, "Learning more from the same frames"):
+    # its dropout and weight decay (None: the model's dropout, the shared weight decay), and
+    # whether to keep the epoch with the lowest validation MSE instead of the last one.
+    intention_dropout: float | None = None
+    intention_weight_decay: float | None = None
+    intention_best: bool = False
+    epochs: int = 40
+    batch_size: int = 256
+    lr: float = 1e-3
+    weight_decay: float = 1e-4
+    lambda_reconstruction: float = 1.0
+    lambda_codebook: float = 10.0         # 12-epoch trials, val MSE (normalized): λC 1 -> 1.15 (codes unmatched), 10 -> 0.40, 100 -> 0.71 (decoder starved)
+    lambda_generator: float = 0.01        # 0 switches the adversarial term off ("w/o GAN")
+    intention_noise: float = 0.0          # std of noise on the frozen predictor's output (normalized)
+    end_to_end: bool = False              # train the intention predictor jointly ...
+    scheduled_sampling: bool = True       # ... feeding its prediction with probability epoch/E
+    control_noise: float = 0.05           # leader: metres of noise on the 1 s control key
+    control_rotation: float = 15.0        # leader: degrees of random turn of the control path
+    # Terms on the decoded body (training/learning/partner_losses.py), in m^2 against normalized MSE.
+    # Sizes: a 5 cm slide of a planted foot costs 30 * 0.0025 = 0.075, about half the final
+    # reconstruction loss; penetration is rare in the recording, so its weight is larger.
+    lambda_penetration: float = 0.0
+    lambda_foot_contact: float = 0.0
+    lambda_interaction: float = 0.0
+    recorded_contacts: bool = False       # weight the foot-contact term by the recorded contacts
+    interaction_hands_only: bool = False  # the interaction term keeps hand distances only
+    # Follower: this share of samples has the partner's whole window moved closer (a leader
+    # steered into the follower, which the recording never shows), penalized by penetration
+    # with its own weight; the interaction term skips them (their recorded distances are moot).
+    proximity_share: float = 0.0
+    lambda_proximity: float = 0.0
+    # Train on the tempo copies too (prepare's train_tempo.npz): more varied samples, same steps.
+    tempo_copies: bool = False
+    seed: int = 1
+
+
+# The follower's network. 24 code channels: at 8 the decoder's reconstruction from even the
+# target code is the bulk of the error (5.7 of 5.8 cm validation MPJPE for ours and CCM alike),
+# so better matching has nothing to win; at 24 the reconstruction drops to 4.6 cm and the wrong
+# channels cost 0.3-0.5 cm, the part the intention can reduce (it does on the validation take
+# for three seeds; on the test takes ours and CCM tie: docs/results.md, "Latent size").
+FOLLOWER = ModelConfig(channels=24)
+# Weights of the terms on the decoded body (partner_losses.py); the ablation rows below switch
+# one off or change it (docs/results.md, "Partner terms", measured on steered duets):
+# - penetration 3000: at 100 the follower came closer than before the terms (the interaction term
+#   draws it in) and its torso passed through the leader's in 10.5 % of steered frames;
+# - foot contact 100, weighted by the recorded contacts: weighted by the decoded contacts, 30 made
+#   the feet stick and the motion stiff (free-running FID 193 against 97 before the terms), 10
+#   kept FID (111) but hardly reduced foot skate; the recorded contacts are what the decoded ones
+#   learn anyway, and at 100 they cut the follower's steered slide by a third (skate in contact
+#   3.45 against 4.94 cm without the term) while FID stays 101.
+PARTNER = dict(lambda_penetration=3000.0, lambda_foot_contact=100.0, lambda_interaction=10.0,
+               recorded_contacts=True)
+# Proximity augmentation (TrainConfig.proximity_share): the recording never shows a leader
+# walking into the follower, so the penetration term alone never taught the follower to make
+# room for a steered leader (its torso passed through the leader's in 10.3 % of steered frames,
+# 5.3 % with a quarter of the samples moved closer at weight 100; docs/results.md).
+PROXIMITY = dict(proximity_share=0.25, lambda_proximity=100.0)
+# The leader was trained with the first weights tried (penetration 100, foot contact 30 on its
+# decoded contacts); a leader with penetration 3000 did not change the steered duet's numbers.
+LEADER_PARTNER = dict(lambda_penetration=100.0, lambda_foot_contact=30.0, lambda_interaction=10.0)
+
+
+# The follower pair with the partner terms and without proximity (shipped until proximity came;
+# training.evaluation.crossval compares them), and the shipped pair.
+OURS_NO_PROXIMITY = TrainConfig(model=FOLLOWER, intention_noise=0.3, **PARTNER)
+CCM_NO_PROXIMITY = TrainConfig(model=replace(FOLLOWER, intention=False), **PARTNER)
+OURS = replace(OURS_NO_PROXIMITY, **PROXIMITY)
+CCM = replace(CCM_NO_PROXIMITY, **PROXIMITY)
+
+
+def partner_variant(**changes) -> TrainConfig:
+    """The follower's partner-term recipe (before proximity) with some settings changed (ablation rows)."""
+    return replace(OURS_NO_PROXIMITY, **changes)
+
+
+# The models `--all` trains (shipped), and the ones evaluation adds (ablations, larger CCM).
+MODELS = {
+    # The predictor fits training frames better than new ones (MSE 0.14 vs 0.23): noise of the
+    # size of that gap keeps the encoders from trusting its training-set accuracy, which buys
+    # FID and Diversity on the test takes (docs/results.md, w/o intention noise).
+    "follower": OURS,
+    "follower_ccm": CCM,
+    # The leader's partner is the follower: it gets the same terms (its own weights, above).
+    "leader": TrainConfig(model=ModelConfig(role="leader"), **LEADER_PARTNER),
+    "follower_small": TrainConfig(model=replace(FOLLOWER, hidden=256, intention_hidden=128), intention_noise=0.3),
+    "follower_ccm_large": TrainConfig(model=replace(FOLLOWER, intention=False, channels=3 * FOLLOWER.channels)),
+    "follower_no_gan": TrainConfig(model=FOLLOWER, lambda_generator=0.0, intention_noise=0.3),
+    "follower_no_intention_noise": TrainConfig(model=FOLLOWER),
+    "follower_end_to_end": TrainConfig(model=FOLLOWER, end_to_end=True),
+    "follower_end_to_end_no_ss": TrainConfig(model=FOLLOWER, end_to_end=True, scheduled_sampling=False),
+    # The shipped pair trained on the tempo copies too: measured, not kept (docs/results.md,
+    # "Learning more from the same frames": FID 89.7 against 107.6, but the follower's feet slide
+    # more in the steered duet, and cross-validated no metric moves outside its interval).
+    "follower_tempo": replace(OURS, tempo_copies=True),
+    "follower_ccm_tempo": replace(CCM, tempo_copies=True),
+    # The shipped pair before proximity augmentation (the recipes training.evaluation.crossval compares).
+    "follower_no_proximity": OURS_NO_PROXIMITY,
+    "follower_ccm_no_proximity": CCM_NO_PROXIMITY,
+    # Partner terms (scripts/partner_terms.sh): one switched off, or another weight or weighting.
+    "follower_no_partner_terms": TrainConfig(model=FOLLOWER, intention_noise=0.3),
+    "follower_no_penetration": partner_variant(lambda_penetration=0.0),
+    "follower_no_foot_contact": partner_variant(lambda_foot_contact=0.0),
+    "follower_no_interaction": partner_variant(lambda_interaction=0.0),
+    "follower_recorded_contact_30": partner_variant(lambda_foot_contact=30.0),
+    "follower_interaction_hands_only": partner_variant(interaction_hands_only=True),
+    "follower_decoded_contact_5": partner_variant(lambda_foot_contact=5.0, recorded_contacts=False),
+    "follower_decoded_contact_10": partner_variant(lambda_foot_contact=10.0, recorded_contacts=False),
+    "follower_decoded_contact_30": partner_variant(lambda_foot_contact=30.0, recorded_contacts=False),
+    "follower_decoded_contact_30_penetration_100": partner_variant(lambda_foot_contact=30.0, recorded_contacts=False,
+                                                                   lambda_penetration=100.0),
+}
+SHIPPED = ["follower", "follower_ccm", "leader"]
+
+
+# ---------------------------------------------------------------- data
+
+def augment_control(x: torch.Tensor, cfg: TrainConfig, gen: torch.Generator) -> torch.Tensor:
+    """Leader only: turn and jitter the control path (raw features) so that a steered path that
+    the recording never took still reads as a plausible intention."""
+    sl = feat.block_slices(feat.LEADER_INPUT_LAYOUT)["control"]
+    keys = x[:, sl].reshape(-1, feat.KEYS, 4).clone()
+    b = keys.shape[0]
+    a = (torch.rand(b, 1, generator=gen) * 2 - 1) * math.radians(cfg.control_rotation)
+    c, s = torch.cos(a), torch.sin(a)
+    for i in (0, 2):   # (x, z) position and (x, z) forward both turn about the root
+        px, pz = keys[..., i].clone(), keys[..., i + 1].clone()
+        keys[..., i], keys[..., i + 1] = c * px + s * pz, -s * px + c * pz
+    ramp = torch.arange(1, feat.KEYS + 1) / feat.KEYS
+    keys[..., :2] += torch.randn(b, feat.KEYS, 2, generator=gen) * cfg.control_noise * ramp[None, :, None]
+    x = x.clone()
+    x[:, sl] = keys.reshape(b, -1)
+    return x
+
+
+PROXIMITY_HIP_DISTANCE = (0.15, 0.45)   # m: where a moved partner's hip ends up from the own hip
+
+
+def move_partner_closer(x: torch.Tensor, share: float, gen: torch.Generator) -> tuple[torch.Tensor, torch.Tensor]:
+    """Follower inputs (raw) -> a copy where `share` of the samples have every partner position
+    (trajectory keys, key joints, pose) shifted horizontally toward the own hip, so the hips end
+    up PROXIMITY_HIP_DISTANCE apart; directions and velocities stay. Returns (x, moved mask)."""
+    sl = feat.block_slices(feat.FOLLOWER_INPUT_LAYOUT)
+    b = len(x)
+    partner_hip = x[:, sl["partner_pose"]].reshape(b, feat.N_JOINTS, 12)[:, 0, [0, 2]]
+    own_hip = x[:, sl["self_pose"]].reshape(b, feat.N_JOINTS, 12)[:, 0, [0, 2]]
+    v = own_hip - partner_hip
+    dist = v.norm(dim=-1).clamp_min(1e-6)
+    lo, hi = PROXIMITY_HIP_DISTANCE
+    target = lo + (hi - lo) * torch.rand(b, generator=gen)
+    moved = (torch.rand(b, generator=gen) < share) & (dist > target)
+    shift = torch.where(moved[:, None], v / dist[:, None] * (dist - target)[:, None], torch.zeros_like(v))
+    x = x.clone()
+    for block, width, xz in (("partner_trajectory_past", 4, (0, 1)), ("partner_trajectory_future", 4, (0, 1)),
+                             ("partner_key_joints_past", 3, (0, 2)), ("partner_pose", 12, (0, 2))):
+        part = x[:, sl[block]].reshape(b, -1, width)
+        part[..., xz[0]] += shift[:, None, 0]
+        part[..., xz[1]] += shift[:, None, 1]
+        x[:, sl[block]] = part.reshape(b, -1)
+    return x, moved
+
+
+# ---------------------------------------------------------------- training
+
+def cosine(step: int, total: int, lr: float) -> float:
+    return lr * 0.5 * (1 + math.cos(math.pi * min(step, total) / max(total, 1)))
+
+
+def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = "cpu",
+                resume: bool = False, quiet: bool = False, rank: int = 0, world: int = 1) -> dict:
+    torch.manual_seed(cfg.seed)
+    np.random.seed(cfg.seed)
+    role = cfg.model.role
+    train = load_split(data, "train", role, cfg.tempo_copies)
+    val = load_split(data, "validation", role)
+    stats = load_stats(data, role)
+    run = Path(out) / name
+    run.mkdir(parents=True, exist_ok=True)
+    ckpt_path = run / "checkpoint.pt"
+
+    xr = torch.from_numpy(train["input"]).float()          # raw, for leader augmentation
+    partner_weights = {"penetration": cfg.lambda_penetration, "foot_contact": cfg.lambda_foot_contact,
+                       "interaction": cfg.lambda_interaction}
+    if any(partner_weights.values()):
+        offsets = load_offsets(data, role, device)
+        mirrored = torch.from_numpy(load_mirror_flags(data, cfg.tempo_copies)).long()
+    y, j = normalize(train["output"], stats, "output"), normalize(train["intention"], stats, "intention")
+    xv, yv, jv = (normalize(val[k], stats, k) for k in ("input", "output", "intention"))
+    mcfg = cfg.model
+    predictor = IntentionPredictor(mcfg if cfg.intention_dropout is None
+                                   else replace(mcfg, dropout=cfg.intention_dropout)).to(device)
+    matching = CodebookMatching(mcfg).to(device)
+    disc = Discriminator(mcfg).to(device)
+    opt_p = torch.optim.AdamW(predictor.parameters(), lr=cfg.lr, weight_decay=cfg.weight_decay
+                              if cfg.intention_weight_decay is None else cfg.intention_weight_decay)
+    gen_params = list(matching.parameters()) + (list(predictor.parameters()) if cfg.end_to_end else [])
+    opt_g = torch.optim.AdamW(gen_params, lr=cfg.lr, weight_decay=cfg.weight_decay)
+    opt_d = torch.optim.AdamW(disc.parameters(), lr=cfg.lr, weight_decay=cfg.weight_decay)
+    history = {"intention_train": [], "intention_val": [], "reconstruction": [], "codebook": [],
+               "generator": [], "discriminator": [], "val_mse": [], "val_codebook": [],
+               "val_mpjpe_cm": [], **{k: [] for k, w in partner_weights.items() if w},
+               **({"proximity": []} if cfg.lambda_proximity else {})}
+    stage, epoch, seconds = "intention", 0, 0.0
+    if resume and ckpt_path.exists():
+        ck = load_checkpoint(ckpt_path)
+        if ck.get("config") != asdict(cfg):
+            raise TrainError(f"{ckpt_path}: saved with another configuration; use a new --out or delete it")
+        predictor.load_state_dict(ck["predictor"]); matching.load_state_dict(ck["matching"])
+        disc.load_state_dict(ck["disc"]); opt_p.load_state_dict(ck["opt_p"])
+        opt_g.load_state_dict(ck["opt_g"]); opt_d.load_state_dict(ck["opt_d"])
+        history, stage, epoch, seconds = ck["history"], ck["stage"], ck["epoch"], ck["seconds"]
+        if rank == 0 and not quiet:
+            print(f"{name}: resumed at {stage} epoch {epoch}")
+    elif ckpt_path.exists() and not resume and rank == 0 and not quiet:
+        print(f"{name}: {ckpt_path} exists; training from scratch over it (use --resume to continue)")
+    broadcast_parameters([predictor, matching, disc], world)
+
+    gen = torch.Generator().manual_seed(cfg.seed + 1000 * rank)
+    n = len(xr)
+    # An epoch is as many steps as one pass over the samples at the recorded tempo: with tempo
+    # copies each epoch draws that many from the larger pool, so a recipe with them costs the
+    # same time and is compared at the same number of steps.
+    recorded = len(load_mirror_flags(data))
+    steps_per_epoch = max(1, recorded // (cfg.batch_size * world))
+
+    def batches(epoch_seed):
+        perm = torch.randperm(n, generator=torch.Generator().manual_seed(cfg.seed * 7919 + epoch_seed))
+        perm = perm[rank::world]   # each process its own shard of one shared shuffle
+        for s in range(steps_per_epoch):
+            idx = perm[s * cfg.batch_size:(s + 1) * cfg.batch_size]
+            if len(idx):
+                yield idx
+
+    def inputs(idx, proximity: bool = False):
+        """Normalized inputs of a batch, and which samples had their partner moved closer."""
+        x, moved = xr[idx], None
+        if role == "leader" and cfg.control_noise + cfg.control_rotation > 0:
+            x = augment_control(x, cfg, gen)
+        if proximity and role == "follower" and cfg.proximity_share > 0:
+            x, moved = move_partner_closer(x, cfg.proximity_share, gen)
+        return ((x - stats["input_mean"]) / stats["input_std"]).to(device), moved
+
+    def save(stage_, epoch_):
+        if rank == 0:
+            save_checkpoint(ckpt_path, {
+                "config": asdict(cfg), "name": name, "stage": stage_, "epoch": epoch_,
+                "seconds": seconds, "history": history, "predictor": predictor.state_dict(),
+                "matching": matching.state_dict(), "disc": disc.state_dict(),
+                "opt_p": opt_p.state_dict(), "opt_g": opt_g.state_dict(), "opt_d": opt_d.state_dict()})
+
+    # Stage 1: the intention predictor alone (MSE), then frozen. End-to-end variants skip it.
+    if mcfg.intention and not cfg.end_to_end and stage == "intention":
+        total = cfg.intention_epochs * steps_per_epoch
+        best = (math.inf, None)   # validation MSE and weights of the best epoch (intention_best)
+        while epoch < cfg.intention_epochs:
+            t0 = time.time()
+            predictor.train()
+            bar = tqdm(batches(epoch), total=steps_per_epoch, disable=quiet or rank > 0,
+                       desc=f"{name} intention {epoch + 1}/{cfg.intention_epochs}", leave=False)
+            losses = []
+            for i, idx in enumerate(bar):
+                for g in opt_p.param_groups:
+                    g["lr"] = cosine(epoch * steps_per_epoch + i, total, cfg.lr)
+                loss = F.mse_loss(predictor(inputs(idx)[0]), j[idx].to(device))
+                opt_p.zero_grad(); loss.backward(); average_gradients([predictor], world); opt_p.step()
+                losses.append(loss.item())
+                bar.set_postfix(mse=f"{np.mean(losses[-50:]):.4f}")
+            predictor.eval()
+            with torch.no_grad():
+                v = F.mse_loss(predictor(xv.to(device)), jv.to(device)).item()
+            history["intention_train"].append(float(np.mean(losses)))
+            history["intention_val"].append(v)
+            if v < best[0]:
+                best = (v, {k: t.clone() for k, t in predictor.state_dict().items()})
+            epoch += 1
+            seconds += time.time() - t0
+            if rank == 0 and not quiet:
+                print(f"{name} intention {epoch}/{cfg.intention_epochs}  train {np.mean(losses):.4f}  val {v:.4f}")
+            save("intention", epoch)
+        if cfg.intention_best and best[1] is not None:
+            predictor.load_state_dict(best[1])
+        stage, epoch = "matching", 0
+        save(stage, epoch)
+    elif stage == "intention":
+        stage, epoch = "matching", 0
+
+    # Stage 2: codebook matching (+ adversarial term), intention predictor frozen.
+    if mcfg.intention and not cfg.end_to_end:
+        predictor.eval()
+        for p in predictor.parameters():
+            p.requires_grad_(False)
+    total = cfg.epochs * steps_per_epoch
+    bce = F.binary_cross_entropy_with_logits
+    # Raw features back from normalized ones, for the terms on the decoded body (set up once).
+    scale = {k: (stats[f"{k}_std"].to(device).float(), stats[f"{k}_mean"].to(device).float()) for k in ("input", "output")}
+    raw = lambda t, k: t * scale[k][0] + scale[k][1]
+    while epoch < cfg.epochs:
+        t0 = time.time()
+        matching.train(); disc.train()
+        if cfg.end_to_end:
+            predictor.train()
+        bar = tqdm(batches(10_000 + epoch), total=steps_per_epoch, disable=quiet or rank > 0,
+                   desc=f"{name} matching {epoch + 1}/{cfg.epochs}", leave=False)
+        sums = {"reconstruction": [], "codebook": [], "generator": [], "discriminator": [],
+                **{k: [] for k, w in partner_weights.items() if w}, **({"proximity": []} if cfg.lambda_proximity else {})}
+        p_pred = epoch / cfg.epochs   # scheduled sampling: share of predicted intentions
+        for i, idx in enumerate(bar):
+            lr = cosine(epoch * steps_per_epoch + i, total, cfg.lr)
+            for o in (opt_g, opt_d):
+                for g in o.param_groups:
+                    g["lr"] = lr
+            (x, moved), yb = inputs(idx, proximity=True), y[idx].to(device)
+            intention, extra = None, 0.0
+            if mcfg.intention:
+                if cfg.end_to_end:
+                    pred = predictor(x)
+                    extra = F.mse_loss(pred, j[idx].to(device))
+                    if cfg.scheduled_sampling:
+                        use = (torch.rand(len(idx), 1, generator=gen) < p_pred).to(device)
+                        intention = torch.where(use, pred, j[idx].to(device))
+                    else:
+                        intention = pred
+                else:
+                    with torch.no_grad():
+                        intention = predictor(x)
+                        if cfg.intention_noise > 0:
+                            intention = intention + cfg.intention_noise * torch.randn(
+                                intention.shape, generator=gen).to(device)
+            recon, s, s_hat, code, code_hat = matching(x, yb, intention)
+            l_r = F.mse_loss(recon, yb)
+            l_c = F.mse_loss(code, code_hat)
+            loss = cfg.lambda_reconstruction * l_r + cfg.lambda_codebook * l_c + extra
+            if any(partner_weights.values()):
+                keep = slice(None) if moved is None else ~moved.to(device)   # recorded relations only
+                off = offsets[mirrored[idx]]
+                terms = partner_terms(raw(recon[keep], "output"), raw(yb[keep], "output"), raw(x[keep], "input"),
+                                      off[keep], role, cfg.recorded_contacts,
+                                      HANDS if cfg.interaction_hands_only else INTERACTION_JOINTS)
+                for k, w in partner_weights.items():
+                    if w:
+                        loss = loss + w * terms[k]
+                        sums[k].append(terms[k].item())
+                if moved is not None and cfg.lambda_proximity > 0 and moved.any():
+                    m = moved.to(device)
+                    me = decoded_positions(raw(recon[m], "output"), off[m])
+                    l_p = penetration_loss(me, block_positions(raw(x[m], "input"), input_slices(role)["partner_pose"]))
+                    loss = loss + cfg.lambda_proximity * l_p
+                    sums["proximity"].append(l_p.item())
+            l_g = torch.zeros(())
+            if cfg.lambda_generator > 0:
+                # Discriminator step on detached logits, then the generator term for the encoders.
+                d_real, d_fake = disc(s.detach()), disc(s_hat.detach())
+                l_d = bce(d_real, torch.ones_like(d_real)) + bce(d_fake, torch.zeros_like(d_fake))
+                opt_d.zero_grad(); l_d.backward(); average_gradients([disc], world); opt_d.step()
+                d_gen = disc(s_hat)
+                l_g = bce(d_gen, torch.ones_like(d_gen))
+                loss = loss + cfg.lambda_generator * l_g
+                sums["discriminator"].append(l_d.item())
+            opt_g.zero_grad(); loss.backward()
+            average_gradients([matching, predictor] if cfg.end_to_end else [matching], world)
+            opt_g.step()
+            sums["reconstruction"].append(l_r.item()); sums["codebook"].append(l_c.item())
+            sums["generator"].append(l_g.item())
+            bar.set_postfix(rec=f"{np.mean(sums['reconstruction'][-50:]):.4f}",
+                            cb=f"{np.mean(sums['codebook'][-50:]):.4f}")
+        val_mse, val_cb, val_mpjpe = validate(predictor, matching, mcfg, xv, yv, device, stats)
+        for k, v in sums.items():
+            history[k].append(float(np.mean(v)) if v else 0.0)
+        history["val_mse"].append(val_mse)
+        history["val_codebook"].append(val_cb)
+        history.setdefault("val_mpjpe_cm", []).append(val_mpjpe)
+        epoch += 1
+        seconds += time.time() - t0
+        if rank == 0 and not quiet:
+            print(f"{name} matching {epoch}/{cfg.epochs}  rec {history['reconstruction'][-1]:.4f}  "
+                  f"cb {history['codebook'][-1]:.4f}  G {history['generator'][-1]:.3f}  "
+                  f"val mse {val_mse:.4f}  val cb {val_cb:.4f}  val mpjpe {val_mpjpe:.2f} cm  "
+                  + "".join(f"{k} {history[k][-1]:.2e}  " for k, w in partner_weights.items() if w) +
+                  f"({time.time() - t0:.1f} s)")
+        save("matching", epoch)
+    stage = "done"
+    save(stage, epoch)
+    if rank == 0:
+        plot_history(history, run / "losses.png", name)
+        kept = {"intention_kept_epoch": int(np.argmin(history["intention_val"])) + 1} \
+            if cfg.intention_best and history["intention_val"] else {}
+        (run / "history.json").write_text(json.dumps({"seconds": seconds, **kept, **history}, indent=1))
+    return {"name": name, "seconds": seconds, "val_mse": history["val_mse"][-1] if history["val_mse"] else None}
+
+
+@torch.no_grad()
+def validate(predictor, matching, mcfg, xv, yv, device, stats, batch=4096):
+    """Teacher-forced validation: argmax code from the input encoder. Returns the MSE on
+    normalized output, the codebook matching error (MSE between target and estimated one-hot
+    codes) and the pose MPJPE in cm (joint positions in the dancer's root space, the number
+    evaluation reports on the test takes)."""
+    predictor.eval(); matching.eval()
+    se, cb, pe, n = 0.0, 0.0, 0.0, 0
+    for s in range(0, len(xv), batch):
+        x, yb = xv[s:s + batch].to(device), yv[s:s + batch].to(device)
+        s_hat, s_target, _ = code_logits(predictor, matching, x, yb)
+        code_hat, code = (sample_codes(l, mcfg.channels, 0.0) for l in (s_hat, s_target))
+        y_hat = matching.decoder(code_hat)
+        se += F.mse_loss(y_hat, yb, reduction="sum").item() / yb.shape[1]
+        cb += F.mse_loss(code, code_hat, reduction="sum").item() / code.shape[1]
+        pe += pose_error_cm(y_hat, yb, stats).sum().item()
+        n += len(x)
+    return se / n, cb / n, pe / n
+
+
+def smoke(cfg: TrainConfig) -> TrainConfig:
+    """A configuration that exercises every code path in seconds (CI)."""
+    return replace(cfg, intention_epochs=1, epochs=2,
+                   model=replace(cfg.model, hidden=32, intention_hidden=32, channels=2, classes=4))
+
+
+# Flags that change a recipe: argparse name -> how its value changes the TrainConfig.
+OVERRIDES = {
+    "epochs": lambda c, v: replace(c, epochs=v),
+    "intention_epochs": lambda c, v: replace(c, intention_epochs=v),
+    "seed": lambda c, v: replace(c, seed=v),
+    "channels": lambda c, v: replace(c, model=replace(c.model, channels=v)),
+    "lambda_generator": lambda c, v: replace(c, lambda_generator=v),
+    "intention_dropout": lambda c, v: replace(c, intention_dropout=v),
+    "intention_weight_decay": lambda c, v: replace(c, intention_weight_decay=v),
+    "intention_hidden": lambda c, v: replace(c, model=replace(c.model, intention_hidden=v)),
+    "intention_best": lambda c, v: replace(c, intention_best=True),
+}
+
+
+def apply_overrides(cfg: TrainConfig, args) -> TrainConfig:
+    """The recipe with every flag given on the command line applied (unset flags change nothing)."""
+    for key, change in OVERRIDES.items():
+        value = getattr(args, key)
+        if value is not None and value is not False:
+            cfg = change(cfg, value)
+    return cfg
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m training.learning.train", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--model", action="append", choices=sorted(MODELS), help="model(s) to train")
+    ap.add_argument("--all", action="store_true", help=f"train the shipped models: {', '.join(SHIPPED)}")
+    ap.add_argument("--ablations", action="store_true", help="train the evaluation-only models too")
+    add_folder(ap, "prepared", "read", old=("--data",))
+    add_folder(ap, "runs", "written, one folder per model", old=("--out",))
+    ap.add_argument("--epochs", type=int, help="override matching epochs")
+    ap.add_argument("--intention-epochs", type=int)
+    ap.add_argument("--lambda-generator", type=float, help="override λG (λC stays as configured)")
+    ap.add_argument("--seed", type=int, help="override the seed (seed-to-seed spread)")
+    ap.add_argument("--channels", type=int, help="override the number of code channels C")
+    ap.add_argument("--intention-dropout", type=float, help="override the intention predictor's dropout")
+    ap.add_argument("--intention-weight-decay", type=float, help="override the predictor's weight decay")
+    ap.add_argument("--intention-hidden", type=int, help="override the predictor's width")
+    ap.add_argument("--intention-best", action="store_true",
+                    help="keep the predictor's epoch with the lowest validation MSE (early stopping)")
+    ap.add_argument("--smoke", action="store_true", help="tiny sizes and 2 epochs (CI)")
+    ap.add_argument("--resume", action="store_true", help="continue from RUNS/NAME/checkpoint.pt")
+    ap.add_argument("--device", default="cpu", help="cpu, cuda, cuda:N or auto")
+    ap.add_argument("--threads", type=int, default=0, help="torch CPU threads (0 = torch default)")
+    args = ap.parse_args(argv)
+    names = list(args.model or [])
+    if args.all:
+        names += [n for n in SHIPPED if n not in names]
+    if args.ablations:
+        names += [n for n in MODELS if n not in names]
+    if not names:
+        ap.error("name a --model, or use --all")
+    if args.threads:
+        torch.set_num_threads(args.threads)
+    device = pick_device(args.device)
+    rank, world = setup_distributed(device)
+    t0 = time.time()
+    try:
+        for name in names:
+            cfg = MODELS[name]
+            if args.smoke:
+                cfg = smoke(cfg)
+            cfg = apply_overrides(cfg, args)
+            r = train_model(name, cfg, args.prepared, args.runs, device, args.resume, rank=rank, world=world)
+            if rank == 0:
+                mse = "" if r["val_mse"] is None else f", val mse {r['val_mse']:.4f}"
+                print(f"{name}: done in {r['seconds']:.0f} s{mse}")
+    except TrainError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+    finally:
+        stop_distributed(world)
+    if rank == 0:
+        print(f"total wall time {time.time() - t0:.0f} s on {device} x{world}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,118 @@
+"""The run-time contact layer: what is shown of the duet (web/mirror/contact.ts mirrors it name for name).
+
+The networks place each dancer on its own; three things they do not guarantee are fixed here, on
+copies of the current poses, never on the Track the features read (so the networks' own motion
+stays what they made, and every metric can be read with and without this layer):
+
+1. bodies do not pass through each other: where the two spines come closer than 2 x TORSO_RADIUS
+   (metrics.interaction's test), both bodies are moved apart horizontally, half the shortfall each;
+2. hands meet when the model brings them within reach: the closest pair of hands of the two
+   dancers, once closer than HAND_REACH, is drawn toward a grip around its midpoint by two-bone IK
+   of both arms, fully at HAND_FULL and closer, with a weight that rises and falls smoothly;
+3. planted feet stay planted: footik.FootLock on both dancers, last, so that a body moved by 1.
+   keeps its feet where they were.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .footik import FootLock, two_bone_ik
+from ..evaluation.metrics import TORSO_RADIUS, closest_on_segments
+from .skeleton import HANDS, PARENTS, SPINE
+
+SEPARATION = 2 * TORSO_RADIUS + 0.01   # m between the spines after the push (1 cm to spare)
+HAND_REACH = 0.45      # m: a hand pair closer than this starts to meet (a forearm's length)
+HAND_FULL = 0.25       # m: at or below this the hands meet fully
+GRIP = 0.06            # m between the two hands' joints when they meet (palm to palm)
+HOLD_RATE = 0.3        # share of the way the hold weight moves to its target every step
+ELBOW_POLE = (0.0, -1.0, 0.0)   # a straight arm bends its elbow downward
+
+
+def spine_gap(a: np.ndarray, b: np.ndarray) -> tuple[float, np.ndarray]:
+    """Closest distance between the two spines (positions [17, 3]) and the horizontal unit
+    direction from b's closest point to a's (the way to push a; b goes the other way)."""
+    pa0, pa1 = a[SPINE[:-1]][:, None], a[SPINE[1:]][:, None]          # [3, 1, 3]: a's segments
+    pb0, pb1 = b[SPINE[:-1]][None], b[SPINE[1:]][None]                # [1, 3, 3]: b's
+    s, t = closest_on_segments(pa0, pa1, pb0, pb1)                    # [3, 3] pairs
+    diff = (pa0 + (pa1 - pa0) * s[..., None]) - (pb0 + (pb1 - pb0) * t[..., None])
+    dist = np.linalg.norm(diff, axis=-1)
+    i, j = np.unravel_index(np.argmin(dist), dist.shape)   # the first of equal pairs, as web/mirror/contact.ts
+    best, away = float(dist[i, j]), diff[i, j]
+    away = np.array([away[0], 0.0, away[2]])
+    n = float(np.linalg.norm(away))
+    if n < 1e-6:   # one spine right above the other: push along the line between the hips
+        away = np.array([a[0, 0] - b[0, 0], 0.0, a[0, 2] - b[0, 2]])
+        n = float(np.linalg.norm(away))
+        if n < 1e-6:
+            away, n = np.array([1.0, 0.0, 0.0]), 1.0
+    return best, away / n
+
+
+def separate(a: np.ndarray, b: np.ndarray) -> float:
+    """Move both bodies apart (in place) until their spines are SEPARATION apart; returns the
+    distance each moved (0 when they were apart already)."""
+    gap, away = spine_gap(a, b)
+    if gap >= SEPARATION:
+        return 0.0
+    push = (SEPARATION - gap) / 2
+    a += away * push
+    b -= away * push
+    return push
+
+
+def closest_hands(a: np.ndarray, b: np.ndarray) -> tuple[int, int, float]:
+    """Indices into HANDS of the closest hand pair of the two dancers, and its distance."""
+    best = (0, 0, np.inf)
+    for i in range(len(HANDS)):
+        for j in range(len(HANDS)):
+            d = float(np.linalg.norm(a[HANDS[i]] - b[HANDS[j]]))
+            if d < best[2]:
+                best = (i, j, d)
+    return best
+
+
+def reach_weight(distance: float) -> float:
+    """1 at HAND_FULL and closer, 0 at HAND_REACH and beyond, linear between."""
+    return min(max((HAND_REACH - distance) / (HAND_REACH - HAND_FULL), 0.0), 1.0)
+
+
+def move_hand(positions: np.ndarray, hand: int, target: np.ndarray) -> None:
+    """Two-bone IK of the arm (shoulder - forearm - hand) that ends at `hand`."""
+    elbow = PARENTS[hand]
+    two_bone_ik(positions, PARENTS[elbow], elbow, hand, target, ELBOW_POLE)
+
+
+class ContactLayer:
+    """State kept between steps: both dancers' foot locks and the hand hold."""
+
+    def __init__(self):
+        self.leader_feet = FootLock()
+        self.follower_feet = FootLock()
+        self.hold = 0.0                 # 0..1: how far the closest hands are drawn together
+        self.hands = (0, 0)             # the pair held (indices into HANDS: leader's, follower's)
+        self.pushed = 0.0               # m each body was moved apart this step
+
+    def clear(self) -> None:
+        """Forget every lock and the hold (after a reset or a jump of either dancer)."""
+        self.leader_feet.clear()
+        self.follower_feet.clear()
+        self.hold = 0.0
+
+    def apply(self, leader: np.ndarray, follower: np.ndarray, leader_contacts, follower_contacts,
+              leader_heading: float, follower_heading: float) -> None:
+        """Make the shown poses leader, follower [17, 3] (world, copies: changed in place) read
+        as partner dancing."""
+        self.pushed = separate(leader, follower)
+        i, j, d = closest_hands(leader, follower)
+        self.hold += (reach_weight(d) - self.hold) * HOLD_RATE
+        self.hands = (i, j)
+        if self.hold > 1e-3 and d > 1e-6:
+            hl, hf = leader[HANDS[i]].copy(), follower[HANDS[j]].copy()
+            mid, u = (hl + hf) / 2, (hl - hf) / d
+            move_hand(leader, HANDS[i], hl + (mid + u * GRIP / 2 - hl) * self.hold)
+            # The follower's hand goes to where the leader's hand got (an arm too short to reach the
+            # midpoint leaves the rest of the way to the partner's arm).
+            reached = leader[HANDS[i]]
+            move_hand(follower, HANDS[j], hf + (reached - u * GRIP - hf) * self.hold)
+        self.leader_feet.apply(leader, leader_contacts, leader_heading)
+        self.follower_feet.apply(follower, follower_contacts, follower_heading)

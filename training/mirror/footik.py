@@ -1,0 +1,99 @@
+"""Foot locking for what is shown (web/mirror/footik.ts mirrors it name for name).
+
+While the model says a foot is planted (contact > 0.5), the foot stays where the contact began,
+with a two-bone IK on thigh - shin - foot, and never below the floor. This touches only the SHOWN
+positions (contact.py's layer); the Track the features read stays what the model produced, so
+the page's features remain identical to Python's and the networks' own metrics stay measurable.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .skeleton import FEET, PARENTS
+
+# Lowest height of the ankle joint: a flat foot's ankle sits 7-11 cm up in the data, so 6 cm
+# keeps the sole above the floor without ever lifting a real flat foot.
+ANKLE_FLOOR = 0.06
+# A lock further than this from the model's foot is stale (a reset, a glitch, a step the model
+# took without lifting the foot): let it go. The re-lock of a stale foot is a jump, and those jumps
+# are nearly all of the shown foot skate. Steered duet of the shipped models, 4 x 60 s, skate in
+# contact of the leader / follower: 0.25 m gave 1.49 / 0.87 cm per frame (first partner-trained
+# models), 0.4 m 1.01 / 1.03, 0.5 m 0.87 / 0.77 (recording 0.67 / 0.72). Half a metre is a long
+# stride: the leg reaches it stretched.
+MAX_LOCK_DISTANCE = 0.5
+# After a contact ends, the lock's pull decays by this factor per step (no pop on release).
+RELEASE_DECAY = 0.5
+
+
+def two_bone_ik(positions: np.ndarray, a: int, b: int, c: int, target, pole) -> None:
+    """In place on positions [17, 3]: joints a -> b -> c keep their bone lengths, c goes to the
+    target (or as near as the chain reaches), and the middle joint stays on the side it bends to
+    now (the pole direction when the chain is straight)."""
+    pa, pb, pc = positions[a].copy(), positions[b], positions[c]
+    upper = float(np.linalg.norm(pb - pa))
+    lower = float(np.linalg.norm(pc - pb))
+    n = np.asarray(target, float) - pa
+    reach = float(np.linalg.norm(n))
+    if reach < 1e-9 or upper < 1e-9 or lower < 1e-9:
+        return
+    n /= reach
+    d = min(max(reach, abs(upper - lower) + 1e-6), upper + lower - 1e-6)
+    # Bend direction: the middle joint's side of the a-c line as posed now (a knee bent forward
+    # stays forward), made perpendicular to the new line; the pole for a straight chain.
+    u = pc - pa
+    m = np.asarray(pole, float).copy()
+    un = float(np.linalg.norm(u))
+    if un > 1e-9:
+        u = u / un
+        ab = pb - pa
+        side = ab - float(ab @ u) * u
+        if np.linalg.norm(side) > 1e-6:
+            m = side
+    m = m - float(m @ n) * n
+    mn = float(np.linalg.norm(m))
+    if mn < 1e-9:
+        return
+    m /= mn
+    # Triangle with sides upper, lower, d: the middle joint sits x along the line and h off it.
+    x = (upper * upper - lower * lower + d * d) / (2 * d)
+    h = np.sqrt(max(0.0, upper * upper - x * x))
+    positions[b] = pa + x * n + h * m
+    positions[c] = pa + d * n
+
+
+class FootLock:
+    """The lock state of one dancer's two feet, kept between steps."""
+
+    def __init__(self):
+        self.locked = [False, False]
+        self.target = np.zeros((2, 3))
+        self.weight = np.zeros(2)
+
+    def clear(self) -> None:
+        """Forget every lock (after a reset or a jump of the dancer)."""
+        self.locked = [False, False]
+        self.weight[:] = 0
+
+    def apply(self, positions: np.ndarray, contacts, heading: float) -> None:
+        """Lock or release each foot from contacts (left, right) and bend the legs of positions
+        [17, 3] (world, in place). heading gives the knee's bend direction for a straight leg."""
+        for i, foot in enumerate(FEET):
+            knee = PARENTS[foot]
+            thigh = PARENTS[knee]
+            f = positions[foot].copy()
+            t = self.target[i]
+            if contacts[i] > 0.5:
+                stale = self.locked[i] and np.linalg.norm(t - f) > MAX_LOCK_DISTANCE
+                if not self.locked[i] or stale:
+                    t[:] = (f[0], max(f[1], ANKLE_FLOOR), f[2])
+                    self.locked[i] = True
+                self.weight[i] = 1.0
+            else:
+                self.locked[i] = False
+                w = self.weight[i] * RELEASE_DECAY
+                self.weight[i] = 0.0 if w < 0.01 else w
+            w = self.weight[i]
+            goal = f + (t - f) * w
+            goal[1] = max(goal[1], ANKLE_FLOOR)
+            if w > 0 or f[1] < ANKLE_FLOOR:
+                two_bone_ik(positions, thigh, knee, foot, goal, (np.sin(heading), 0.0, np.cos(heading)))

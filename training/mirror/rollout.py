@@ -1,0 +1,296 @@
+"""The duet at run time, in Python: the same loop the page runs (web/mirror/rollout.ts mirrors it).
+
+Each dancer is a `Track` of 61 frames: 30 past, the current frame at index NOW = 30, and 30 slots
+of planned future of which only the key frames (NOW+5, ..., NOW+30) are filled. The features are
+then the very functions training used, read at frame NOW, so training and run time cannot differ.
+
+One step: the leader's plan is its last predicted future bent toward the user's steering; both
+models read the current state (the follower sees that plan as the leader's future); both outputs
+move their dancer one frame on. Absurd output (non-finite, a joint > 3 m from the root, a root
+jump > 1 m) resets that dancer beside its partner and is counted, never drawn.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import features as feat
+from .contact import ContactLayer
+from .features import (FUTURE_OFFSETS, HISTORY, KEYS, Track, follower_input, from_root_space_directions,
+                       from_root_space_points, leader_input)
+from .skeleton import FEET, FPS, KEY_JOINTS, forward_kinematics_reduced
+
+NOW = HISTORY
+TRACK_FRAMES = 2 * HISTORY + 1
+OUT = feat.block_slices(feat.OUTPUT_LAYOUT)
+
+MAX_SPEED = 0.8            # m/s of the steered path at full stick (the recorded leaders cover
+                           # 0.49 m in a second at the median and 0.96 m at the 90th percentile)
+STEER_HALFLIFE = 0.25      # s for the steered velocity to get halfway to the stick's
+MAX_JOINT_DISTANCE = 3.0   # m from the root: beyond this the output is absurd
+MAX_ROOT_JUMP = 1.0        # m in one step
+MIN_ANKLE_HEIGHT = 0.04    # m: the lowest ankle height in the recordings
+ANCHOR_RATE = 0.3          # share of the leader's distance to its anchor closed every frame
+                           # in which neither foot is planted (scaled down by the contacts)
+LEASH_DISTANCE = 2.0       # m: beyond this a follower is drawn toward its leader ...
+LEASH_RATE = 0.1           # ... closing this share of the excess every frame
+START_DISTANCE = 0.8       # m between the partners at the start and after a reset
+
+
+def rotations_from_vectors(forward: np.ndarray, up: np.ndarray) -> np.ndarray:
+    """[..., 3] forward (R ez) and up (R ey) -> orthonormal [..., 3, 3] (Gram-Schmidt on forward)."""
+    z = forward / np.maximum(np.linalg.norm(forward, axis=-1, keepdims=True), 1e-9)
+    x = np.cross(up, z)
+    x /= np.maximum(np.linalg.norm(x, axis=-1, keepdims=True), 1e-9)
+    y = np.cross(z, x)
+    return np.stack([x, y, z], -1)
+
+
+@dataclass
+class Dancer:
+    offsets: np.ndarray                       # [17, 3]
+    track: Track
+    contacts: np.ndarray = field(default_factory=lambda: np.zeros(2))
+    intention: np.ndarray | None = None       # [6, 5, 3] world: what this dancer expects of its partner
+    resets: int = 0
+    leashed: int = 0                          # frames the leash moved this dancer
+
+    @property
+    def root(self):
+        return self.track.root[NOW]
+
+    @property
+    def heading(self):
+        return float(self.track.heading[NOW])
+
+    @property
+    def positions(self):
+        return self.track.positions[NOW]
+
+
+def start_dancer(offsets, start_pose: dict, root, heading) -> Dancer:
+    """A dancer standing still in the start pose, with a still history and a still plan."""
+    h = np.float64(heading)
+    rot_local = rotations_from_vectors(np.asarray(start_pose["forward"]), np.asarray(start_pose["up"]))
+    rotations = np.einsum("ij,njk->nik", rotation_y(h), rot_local)
+    hip = from_root_space_points(np.asarray(start_pose["hip"], float), np.asarray(root, float), h)
+    positions = forward_kinematics_reduced(np.asarray(offsets), hip, rotations)
+    track = Track(positions=np.repeat(positions[None], TRACK_FRAMES, 0),
+                  rotations=np.repeat(rotations[None], TRACK_FRAMES, 0),
+                  root=np.repeat(np.asarray(root, float)[None], TRACK_FRAMES, 0),
+                  heading=np.full(TRACK_FRAMES, h))
+    return Dancer(np.asarray(offsets, float), track)
+
+
+def rotation_y(heading: float) -> np.ndarray:
+    c, s = np.cos(heading), np.sin(heading)
+    return np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]])
+
+
+def output_is_absurd(output: np.ndarray) -> bool:
+    if not np.all(np.isfinite(output)):
+        return True
+    pose = output[OUT["pose"]].reshape(feat.N_JOINTS, 12)
+    jump = np.linalg.norm(output[OUT["root_update"]][:2])
+    return bool(np.linalg.norm(pose[:, :3], axis=-1).max() > MAX_JOINT_DISTANCE
+                or jump > MAX_ROOT_JUMP)
+
+
+def apply_output(d: Dancer, output: np.ndarray) -> None:
+    """Move the dancer one frame on with a model output O (raw, 323)."""
+    t = d.track
+    dx, dz, dtheta = output[OUT["root_update"]]
+    root = from_root_space_points(np.array([dx, 0.0, dz]), t.root[NOW], t.heading[NOW])[[0, 2]]
+    heading = t.heading[NOW] + dtheta
+    heading = float(np.angle(np.exp(1j * heading)))
+    # Shift the past one frame back; the current slot gets the new frame.
+    for a in (t.positions, t.rotations, t.root, t.heading):
+        a[:NOW] = a[1:NOW + 1]
+    t.root[NOW], t.heading[NOW] = root, heading
+    pose = output[OUT["pose"]].reshape(feat.N_JOINTS, 12)
+    forward = from_root_space_directions(pose[:, 6:9], heading)
+    up = from_root_space_directions(pose[:, 9:12], heading)
+    t.rotations[NOW] = rotations_from_vectors(forward, up)
+    hip = from_root_space_points(pose[0, :3], root, heading)
+    t.positions[NOW] = forward_kinematics_reduced(d.offsets, hip, t.rotations[NOW])
+    # The predicted hip height can sag a few cm below what the legs need; lifting the whole body
+    # keeps the ankles on or above the floor without bending a bone.
+    lift = MIN_ANKLE_HEIGHT - t.positions[NOW][FEET, 1].min()
+    if lift > 0:
+        t.positions[NOW][:, 1] += lift
+    # The predicted future root path becomes the plan (the leader's is bent by steering later).
+    future = output[OUT["trajectory_future"]].reshape(KEYS, 4)
+    keys = NOW + FUTURE_OFFSETS
+    world = from_root_space_points(np.stack([future[:, 0], np.zeros(KEYS), future[:, 1]], -1), root, heading)
+    t.root[keys] = world[:, [0, 2]]
+    fwd = from_root_space_directions(np.stack([future[:, 2], np.zeros(KEYS), future[:, 3]], -1), heading)
+    t.heading[keys] = np.arctan2(fwd[:, 0], fwd[:, 2])
+    d.contacts = np.clip(output[OUT["contacts"]], 0, 1)
+
+
+def reset_beside(d: Dancer, partner: Dancer, start_pose: dict) -> None:
+    """Recover a dancer that produced absurd output: stand it in front of its partner, facing it."""
+    p_heading = partner.heading
+    root = partner.root + START_DISTANCE * np.array([np.sin(p_heading), np.cos(p_heading)])
+    fresh = start_dancer(d.offsets, start_pose, root, p_heading + np.pi)
+    d.track, d.contacts, d.resets = fresh.track, np.zeros(2), d.resets + 1
+
+
+@dataclass
+class Steering:
+    """The user's stick (world x, z; length <= 1) turned into a smooth velocity, and the anchor
+    that velocity carries: the spot the leader dances around. It moves only while steered."""
+    velocity: np.ndarray = field(default_factory=lambda: np.zeros(2))
+    anchor: np.ndarray = field(default_factory=lambda: np.zeros(2))
+
+    def update(self, stick: np.ndarray, dt: float = 1 / FPS) -> None:
+        target = np.asarray(stick, float) * MAX_SPEED
+        self.velocity = target + (self.velocity - target) * 0.5 ** (dt / STEER_HALFLIFE)
+        self.anchor = self.anchor + self.velocity * dt
+
+
+def steer_plan(leader: Dancer, steering: Steering, stick: np.ndarray) -> None:
+    """Bend the leader's planned future root path toward the stick.
+
+    With no stick, the plan is the leader's own last prediction (it dances on its own). With the
+    stick held, each key moves toward where the smoothed steering velocity carries the anchor,
+    in proportion to how far the stick is pushed.
+    """
+    steering.update(stick)
+    weight = min(1.0, float(np.linalg.norm(stick)))
+    if weight <= 0:
+        return
+    t = leader.track
+    for k, off in enumerate(FUTURE_OFFSETS):
+        target = steering.anchor + steering.velocity * off / FPS
+        t.root[NOW + off] += weight * (target - t.root[NOW + off])
+
+
+def shift_dancer(d: Dancer, shift: np.ndarray) -> None:
+    """Slide a dancer on the floor: current root, current pose and planned path together."""
+    t = d.track
+    t.root[NOW] += shift
+    t.root[NOW + FUTURE_OFFSETS] += shift
+    t.positions[NOW][:, [0, 2]] += shift
+
+
+def follow_anchor(leader: Dancer, steering: Steering) -> None:
+    """Draw the leader a little toward its anchor in the frames where its feet are free.
+
+    The leader model reads the steered plan as an intention, not an order: fed its own predicted
+    path it wanders (about 1.7 m in 3 s here), and steered it answers only in part. Pulling the
+    root toward the anchor lets it dance freely around the spot the user left it at and travel
+    where the user steers. The pull moves the whole body, so it acts only as far as no foot is
+    planted (1 - the larger contact): a planted foot is never slid by it. Measured with the
+    shipped models (training.evaluation.soak.steering_trials: 8 turns of 90 degrees), seconds until the
+    leader moves within 30 degrees of the new direction: gated rate 0.15 0.77 s, 0.3 0.58 s,
+    0.5 0.53 s (the ungated 0.05 spring before it, with the models of then: 0.46 s).
+    """
+    free = 1.0 - float(np.clip(leader.contacts, 0.0, 1.0).max())
+    shift_dancer(leader, (steering.anchor - leader.root) * ANCHOR_RATE * free)
+
+
+def keep_close(follower: Dancer, leader: Dancer) -> bool:
+    """Draw a follower that fell behind toward its leader.
+
+    A steered leader can travel faster and straighter than any recorded one; the follower model
+    then lags. The leash only acts beyond LEASH_DISTANCE, where the recordings hardly go (99 % of
+    recorded frames are within 2.74 m), and moves at most a tenth of the excess per frame.
+    """
+    d = leader.root - follower.root
+    dist = float(np.linalg.norm(d))
+    if dist <= LEASH_DISTANCE:
+        return False
+    shift_dancer(follower, d / dist * (dist - LEASH_DISTANCE) * LEASH_RATE)
+    return True
+
+
+@dataclass
+class Duet:
+    leader: Dancer
+    follower: Dancer
+    start_pose: dict
+    steering: Steering = field(default_factory=Steering)
+    frame: int = 0
+    layer: ContactLayer = field(default_factory=ContactLayer)
+    # What is shown after the contact layer: [leader, follower] world positions [17, 3].
+    shown: np.ndarray = field(default_factory=lambda: np.zeros((2, feat.N_JOINTS, 3)))
+    resets_seen: int = 0
+
+
+def show(duet: Duet) -> None:
+    """The contact layer on copies of both current poses (the tracks stay the networks')."""
+    resets = duet.leader.resets + duet.follower.resets
+    if resets != duet.resets_seen:   # a dancer placed anew must not drag its old locks along
+        duet.layer.clear()
+        duet.resets_seen = resets
+    duet.shown[0] = duet.leader.positions
+    duet.shown[1] = duet.follower.positions
+    duet.layer.apply(duet.shown[0], duet.shown[1], duet.leader.contacts, duet.follower.contacts,
+                     duet.leader.heading, duet.follower.heading)
+
+
+def start_duet(manifest: dict) -> Duet:
+    sk, sp = manifest["skeleton"], manifest["startPose"]
+    leader = start_dancer(sk["offsets"]["leader"], sp["leader"], [0.0, 0.0], 0.0)
+    follower = start_dancer(sk["offsets"]["follower"], sp["follower"], [0.0, START_DISTANCE], np.pi)
+    return Duet(leader, follower, sp, Steering(anchor=leader.root.copy()))
+
+
+def step_inputs(duet: Duet) -> tuple[np.ndarray, np.ndarray]:
+    now = np.array([NOW])
+    return (leader_input(duet.follower.track, duet.leader.track, now)[0],
+            follower_input(duet.leader.track, duet.follower.track, now)[0])
+
+
+def finish_step(duet: Duet, leader_output: np.ndarray, follower_output: np.ndarray,
+                follower_intention: np.ndarray | None = None) -> None:
+    for d, partner, out, role in ((duet.leader, duet.follower, leader_output, "leader"),
+                                  (duet.follower, duet.leader, follower_output, "follower")):
+        if output_is_absurd(out):
+            reset_beside(d, partner, duet.start_pose[role])
+            if d is duet.leader:
+                duet.steering.anchor = duet.leader.root.copy()
+        else:
+            apply_output(d, out)
+            if d is duet.leader:
+                follow_anchor(d, duet.steering)
+    if keep_close(duet.follower, duet.leader):
+        duet.follower.leashed += 1
+    if follower_intention is not None:
+        f = duet.follower
+        keys = follower_intention.reshape(KEYS, len(KEY_JOINTS), 3)
+        f.intention = from_root_space_points(keys, f.root, f.heading)
+    show(duet)
+    duet.frame += 1
+
+
+class OnnxPolicy:
+    """One exported step model in onnxruntime (what the page runs, minus the browser)."""
+
+    def __init__(self, path, threads: int = 1):
+        import onnxruntime as ort
+        so = ort.SessionOptions()
+        so.intra_op_num_threads = threads
+        so.inter_op_num_threads = 1
+        self.session = ort.InferenceSession(str(path), so, providers=["CPUExecutionProvider"])
+        self.outputs = [o.name for o in self.session.get_outputs()]
+        self.latent = self.session.get_inputs()[2].shape[1]
+
+    def __call__(self, x: np.ndarray, temperature: float, rng: np.random.Generator):
+        x = np.atleast_2d(x).astype(np.float32)
+        noise = rng.random((x.shape[0], self.latent), dtype=np.float32)
+        res = self.session.run(None, {"input": x, "temperature": np.array([temperature], np.float32),
+                                      "noise": noise})
+        return dict(zip(self.outputs, res))
+
+
+def step(duet: Duet, leader_policy, follower_policy, stick, temperature: float,
+         rng: np.random.Generator) -> None:
+    steer_plan(duet.leader, duet.steering, np.asarray(stick, float))
+    xl, xf = step_inputs(duet)
+    ol = leader_policy(xl, temperature, rng)
+    of = follower_policy(xf, temperature, rng)
+    finish_step(duet, ol["output"][0], of["output"][0],
+                of["intention"][0] if "intention" in of else None)

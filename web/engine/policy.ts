@@ -1,0 +1,153 @@
+// The neural policies: one ONNX InferenceSession per model, stepped once per frame.
+//
+// I/O contract (docs/features.md): inputs `input` [B, 660], `temperature` [1], `noise` [B, C·D]
+// uniform in (0, 1); outputs `output` [B, 323], `intention` [B, 90] (only models with an intention
+// predictor), `code` [B, C]. Everything here is allocated once: callers write into `input`, call
+// run(), and read `result`, so stepping at 30 Hz creates no garbage of ours.
+
+import { ort } from './ort';
+import type { Manifest, ModelEntry, PolicyResult, StepPolicy } from './types';
+import { DuetError } from '../ui/errors';
+import { createUniform, fillUniform } from './random';
+import { INPUT_SIZE, INTENTION_SIZE, OUTPUT_SIZE } from '../mirror/features';
+
+type Session = Awaited<ReturnType<typeof ort.InferenceSession.create>>;
+type Tensor = InstanceType<typeof ort.Tensor>;
+
+/** Buffers and tensors for one batch size, created on first use and kept. */
+interface Batch {
+  size: number;
+  input: Float32Array;
+  noise: Float32Array;
+  feeds: Record<string, Tensor>;
+  result: PolicyResult;
+}
+
+export class Policy implements StepPolicy {
+  /** Write the [660] input features here before run(). */
+  readonly input: Float32Array;
+  /** Filled by run(); the same object and arrays every call. */
+  readonly result: PolicyResult;
+
+  private readonly temperature = new Float32Array(1);
+  private readonly temperatureTensor: Tensor;
+  private readonly batches = new Map<number, Batch>();
+  private readonly fetches: string[];
+  private readonly uniform: () => number;
+  private readonly single: Batch;
+
+  constructor(
+    /** Manifest key: 'follower', 'follower_ccm', 'leader'. */
+    readonly name: string,
+    readonly entry: ModelEntry,
+    private readonly session: Session,
+    seed: number,
+  ) {
+    this.uniform = createUniform(seed);
+    this.temperatureTensor = new ort.Tensor('float32', this.temperature, [1]);
+    // Fetch only what we read; `code` is for evaluation.
+    this.fetches = entry.intention ? ['output', 'intention'] : ['output'];
+    this.single = this.batch(1);
+    this.input = this.single.input;
+    this.result = this.single.result;
+  }
+
+  get hasIntention(): boolean {
+    return this.entry.intention;
+  }
+
+  /** One step for one character: reads `input`, fills `result`. */
+  run(temperature: number): Promise<PolicyResult> {
+    return this.runBatch(1, temperature);
+  }
+
+  /** The [k × 660] input block for a batched run (e.g. k ghost samples); write rows here. */
+  batchInput(k: number): Float32Array {
+    return this.batch(k).input;
+  }
+
+  /** k samples at once, each with its own noise: reads batchInput(k), returns [k × ...] results. */
+  async runBatch(k: number, temperature: number): Promise<PolicyResult> {
+    const batch = this.batch(k);
+    this.temperature[0] = temperature;
+    fillUniform(batch.noise, this.uniform);
+    const outputs = await this.session.run(batch.feeds, this.fetches);
+    copyOut(outputs.output, batch.result.output);
+    if (batch.result.intention) copyOut(outputs.intention, batch.result.intention);
+    return batch.result;
+  }
+
+  private batch(k: number): Batch {
+    let batch = this.batches.get(k);
+    if (!batch) {
+      const noiseSize = this.entry.channels * this.entry.classes;
+      const input = new Float32Array(k * INPUT_SIZE);
+      const noise = new Float32Array(k * noiseSize);
+      batch = {
+        size: k,
+        input,
+        noise,
+        feeds: {
+          input: new ort.Tensor('float32', input, [k, INPUT_SIZE]),
+          temperature: this.temperatureTensor,
+          noise: new ort.Tensor('float32', noise, [k, noiseSize]),
+        },
+        result: {
+          output: new Float32Array(k * OUTPUT_SIZE),
+          intention: this.entry.intention ? new Float32Array(k * INTENTION_SIZE) : null,
+        },
+      };
+      this.batches.set(k, batch);
+    }
+    return batch;
+  }
+}
+
+function copyOut(tensor: Tensor | undefined, into: Float32Array): void {
+  if (!tensor || tensor.data.length !== into.length) {
+    throw new DuetError('Model output has the wrong size', `expected ${into.length} numbers, got ${tensor?.data.length}`);
+  }
+  into.set(tensor.data as Float32Array);
+  // CPU tensors are plain arrays, but dispose() is the API's way to free a tensor, whatever its location.
+  tensor.dispose();
+}
+
+/** Create the session for one model from its bytes (see fetchModelBytes in manifest.ts). */
+export async function createPolicy(manifest: Manifest, name: string, bytes: Uint8Array, seed: number): Promise<Policy> {
+  const entry = manifest.models[name];
+  if (!entry) throw new DuetError('Model not found', `"${name}" is not in manifest.json`);
+  let session: Session;
+  try {
+    session = await ort.InferenceSession.create(bytes, {
+      executionProviders: ['wasm'],
+      graphOptimizationLevel: 'all',
+    });
+  } catch (error) {
+    // onnxruntime's own message can be empty ("ERROR_MESSAGE: "): say what it means in any case.
+    const detail = String((error as Error)?.message ?? error).trim();
+    throw new DuetError(
+      'A model file is corrupt',
+      `models/${entry.file} is not a readable ONNX model (damaged or half downloaded; a reload fetches it again)` +
+        (detail ? `. onnxruntime: ${detail}` : ''),
+    );
+  }
+  checkSession(name, entry, session);
+  return new Policy(name, entry, session, seed);
+}
+
+/** The ONNX graph must have the inputs and outputs of the contract, with matching widths. */
+function checkSession(name: string, entry: ModelEntry, session: Session): void {
+  const bad = (detail: string) => new DuetError('A model does not match this page', `${name}: ${detail}`);
+  const widths: Record<string, number> = { input: INPUT_SIZE, noise: entry.channels * entry.classes };
+  for (const input of ['input', 'temperature', 'noise']) {
+    if (!session.inputNames.includes(input)) throw bad(`no input named "${input}"`);
+  }
+  for (const meta of session.inputMetadata) {
+    const width = widths[meta.name];
+    if (width === undefined || !meta.isTensor) continue;
+    const last = meta.shape[meta.shape.length - 1];
+    if (typeof last === 'number' && last !== width) throw bad(`input "${meta.name}" is ${last} wide, expected ${width}`);
+  }
+  if (!session.outputNames.includes('output')) throw bad('no output named "output"');
+  if (entry.intention && !session.outputNames.includes('intention')) throw bad('manifest says intention, the model has no "intention" output');
+}

@@ -1,0 +1,229 @@
+// The page's Simulation: policies in, DancerViews out. One step runs the duet loop of rollout.ts
+// (the mirror of training/mirror/rollout.py) with the page's policies, then refreshes what the page draws
+// (the contact layer's poses: web/mirror/contact.ts; planned paths, intentions). Also here: sampled ghosts and leader playback
+// from a recording. Nothing in this file changes a number the models see.
+
+import { FUTURE_OFFSETS, INPUT_SIZE, INTENTION_SIZE, KEYS, OUTPUT_SIZE, followerInput } from '../mirror/features';
+import { KEY_JOINTS, type Motion, POSITIONS_SIZE, ROTATIONS_SIZE } from '../mirror/skeleton';
+import { ContactLayer } from '../mirror/contact';
+import { FootLock } from '../mirror/footik';
+import { LeaderPlayback } from './playback';
+import { StepTimer } from './timing';
+import {
+  Dancer, type Duet, NOW, applyOutput, finishStep, outputIsAbsurd, startDuet, steerPlan, stepInputs,
+} from '../mirror/rollout';
+import type { DancerView, Simulation, SimulationOptions, StepPolicy, Steer } from './types';
+
+/** Per dancer: what the page draws, kept up to date from the dancer after every step. */
+class View implements DancerView {
+  root: [number, number] = [0, 0];
+  heading = 0;
+  readonly positions = new Float32Array(POSITIONS_SIZE);
+  readonly future = new Float32Array(KEYS * 2);
+  intention?: Float32Array;
+  readonly rotations = new Float32Array(ROTATIONS_SIZE);
+  readonly contacts = new Float32Array(2);
+  /** Per hand (left, right): how far the contact layer draws it to the partner's, 0..1. */
+  readonly hands = new Float32Array(2);
+  /** Foot locks of a follower beyond the first (compare mode): the contact layer has the others. */
+  readonly feet = new FootLock();
+  resets = -1;
+
+  constructor(withIntention: boolean) {
+    if (withIntention) this.intention = new Float32Array(INTENTION_SIZE);
+  }
+
+  update(d: Dancer): void {
+    this.root[0] = d.rootX;
+    this.root[1] = d.rootZ;
+    this.heading = d.heading;
+    const t = d.track;
+    for (let i = 0; i < POSITIONS_SIZE; i++) this.positions[i] = t.positions[NOW * POSITIONS_SIZE + i];
+    for (let i = 0; i < ROTATIONS_SIZE; i++) this.rotations[i] = t.rotations[NOW * ROTATIONS_SIZE + i];
+    this.contacts[0] = d.contacts[0];
+    this.contacts[1] = d.contacts[1];
+    this.hands.fill(0);
+    for (let k = 0; k < KEYS; k++) {
+      this.future[2 * k] = t.root[2 * (NOW + FUTURE_OFFSETS[k])];
+      this.future[2 * k + 1] = t.root[2 * (NOW + FUTURE_OFFSETS[k]) + 1];
+    }
+    if (this.intention && d.intention) this.intention.set(d.intention);
+  }
+}
+
+export class DuetSimulation implements Simulation {
+  readonly leader: DancerView;
+  readonly followers: DancerView[];
+  duet: Duet;
+  private readonly leaderView: View;
+  private readonly followerViews: View[];
+  private readonly leaderPolicy: StepPolicy;
+  private readonly followerPolicies: StepPolicy[];
+  private readonly followerInputs: Float32Array[];
+  // Own copies of each model's result: two roles may never share a policy's result arrays.
+  private readonly leaderOutput = new Float32Array(OUTPUT_SIZE);
+  private readonly guardCounts = { resets: 0, leashed: 0 };
+  private readonly followerOutputs: Float32Array[];
+  private readonly followerIntentions: (Float32Array | null)[];
+  private readonly timer = new StepTimer(300);
+  private readonly layer = new ContactLayer();
+  private playback: LeaderPlayback | null = null;
+  private temperature: number;
+  private readonly ghost: Dancer;
+  private readonly ghostPoses: Float32Array[] = [];
+
+  constructor(private readonly options: SimulationOptions) {
+    const { manifest, leader, followers } = options;
+    if (followers.length < 1) throw new RangeError('a duet needs at least one follower');
+    this.leaderPolicy = leader;
+    this.followerPolicies = followers;
+    this.followerInputs = followers.map((p) => p.input);
+    this.temperature = manifest.defaultTemperature ?? 0.5;
+    this.duet = startDuet(manifest, followers.length);
+    this.leaderView = new View(false);
+    this.followerViews = followers.map((p) => new View(p.hasIntention));
+    this.leader = this.leaderView;
+    this.followers = this.followerViews;
+    this.followerOutputs = followers.map(() => new Float32Array(OUTPUT_SIZE));
+    this.followerIntentions = followers.map((p) => (p.hasIntention ? new Float32Array(INTENTION_SIZE) : null));
+    this.ghost = new Dancer(this.duet.followers[0].offsets);
+    this.updateViews(true);
+  }
+
+  reset(): void {
+    this.duet = startDuet(this.options.manifest, this.followerPolicies.length);
+    this.playback?.start(this.duet.leader.track);
+    this.timer.clear();
+    this.updateViews(true);
+  }
+
+  async step(steer: Steer, temperature: number): Promise<void> {
+    const started = performance.now();
+    this.temperature = temperature;
+    const duet = this.duet;
+    const playing = this.playback !== null;
+    if (!playing) {
+      const sx = steer.active ? steer.x : 0;
+      const sz = steer.active ? steer.z : 0;
+      steerPlan(duet.leader, duet.steering, sx, sz);
+    }
+    stepInputs(duet, playing ? null : this.leaderPolicy.input, this.followerInputs);
+    if (!playing) {
+      const result = await this.leaderPolicy.run(temperature);
+      this.leaderOutput.set(result.output);
+    }
+    for (let i = 0; i < this.followerPolicies.length; i++) {
+      const result = await this.followerPolicies[i].run(temperature);
+      this.followerOutputs[i].set(result.output);
+      if (result.intention) this.followerIntentions[i]?.set(result.intention);
+    }
+    if (this.playback) this.playback.advance(duet.leader.track, duet.leader.contacts);
+    finishStep(duet, playing ? null : this.leaderOutput, this.followerOutputs, this.followerIntentions);
+    this.updateViews(false);
+    this.timer.add(performance.now() - started);
+  }
+
+  /**
+   * k alternative next poses of the first follower: its model run once on k copies of its current
+   * input (each sample draws its own noise), each output applied to a scratch copy of the dancer.
+   */
+  async ghosts(k: number): Promise<Float32Array[]> {
+    if (k <= 0) return [];
+    const policy = this.followerPolicies[0];
+    const follower = this.duet.followers[0];
+    const input = policy.batchInput(k);
+    followerInput(this.duet.leader.track, follower.track, NOW, input, 0);
+    for (let i = 1; i < k; i++) input.copyWithin(i * INPUT_SIZE, 0, INPUT_SIZE);
+    const { output } = await policy.runBatch(k, this.temperature);
+    while (this.ghostPoses.length < k) this.ghostPoses.push(new Float32Array(POSITIONS_SIZE));
+    for (let i = 0; i < k; i++) {
+      this.ghost.copyFrom(follower);
+      if (!outputIsAbsurd(output, i * OUTPUT_SIZE)) applyOutput(this.ghost, output, i * OUTPUT_SIZE);
+      const p = this.ghost.track.positions;
+      for (let n = 0; n < POSITIONS_SIZE; n++) this.ghostPoses[i][n] = p[NOW * POSITIONS_SIZE + n];
+    }
+    return this.ghostPoses.slice(0, k);
+  }
+
+  /** Called every animation frame by the HUD: sums into one reused object, allocates nothing. */
+  guards(): { resets: number; leashed: number } {
+    const g = this.guardCounts;
+    g.resets = this.duet.leader.resets;
+    g.leashed = this.duet.leader.leashed;
+    for (const f of this.duet.followers) {
+      g.resets += f.resets;
+      g.leashed += f.leashed;
+    }
+    return g;
+  }
+
+  stepMs(): { median: number; p95: number } {
+    return this.timer.summary();
+  }
+
+  /**
+   * Drive the leader from a recorded motion (30 fps, e.g. motionFromBvhText) instead of the leader
+   * model, or go back to the model with null. The recording starts where the leader stands now,
+   * facing where it faces, and loops.
+   */
+  setLeaderPlayback(motion: Motion | null): void {
+    if (!motion) {
+      this.playback = null;
+      return;
+    }
+    const playback = new LeaderPlayback(motion);
+    playback.takeOver(this.duet.leader.track);
+    this.playback = playback;
+  }
+
+  /** Whether the leader follows a recording; the recording's current frame and length. */
+  get leaderPlayback(): { frame: number; frames: number } | null {
+    return this.playback ? { frame: this.playback.frame, frames: this.playback.frames } : null;
+  }
+
+  private updateViews(jumped: boolean): void {
+    const leader = this.duet.leader;
+    this.leaderView.update(leader);
+    this.duet.followers.forEach((f, i) => {
+      const view = this.followerViews[i];
+      view.update(f);
+      // Before the first prediction: the leader's key joints where they are now, at every key.
+      if (view.intention && !f.intention) {
+        for (let k = 0; k < KEYS; k++) {
+          KEY_JOINTS.forEach((j, n) => {
+            for (let a = 0; a < 3; a++) view.intention![(k * KEY_JOINTS.length + n) * 3 + a] = leader.track.positions[NOW * POSITIONS_SIZE + 3 * j + a];
+          });
+        }
+      }
+    });
+    this.showContacts(jumped);
+  }
+
+  /**
+   * The contact layer (web/mirror/contact.ts) on the views: between the leader and the first follower
+   * (the duet on screen); a compare-mode follower keeps only its own foot locks.
+   */
+  private showContacts(jumped: boolean): void {
+    const leader = this.duet.leader, first = this.duet.followers[0];
+    const lv = this.leaderView, fv = this.followerViews[0];
+    // A dancer that was just placed anew must not drag its old locks or hold along.
+    if (jumped || leader.resets !== lv.resets || first.resets !== fv.resets) this.layer.clear();
+    lv.resets = leader.resets;
+    fv.resets = first.resets;
+    const layer = this.layer;
+    layer.apply(lv.positions, fv.positions, leader.contacts, first.contacts, leader.heading, first.heading);
+    lv.hands[layer.hands[0]] = layer.hold;
+    fv.hands[layer.hands[1]] = layer.hold;
+    for (let i = 1; i < this.followerViews.length; i++) {
+      const view = this.followerViews[i], f = this.duet.followers[i];
+      if (jumped || f.resets !== view.resets) view.feet.clear();
+      view.resets = f.resets;
+      view.feet.apply(view.positions, f.contacts, f.heading);
+    }
+  }
+}
+
+/** The page's factory (see CreateSimulation in types.ts). */
+export function createSimulation(options: SimulationOptions): DuetSimulation {
+  return new DuetSimulation(options);
+}

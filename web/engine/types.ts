@@ -1,0 +1,165 @@
+// Shared types between the page shell (main, scene, hud, ...) and the simulation (simulation.ts).
+// The shell only ever talks to a `Simulation`; what happens inside one step (features, both
+// models, pose) is the simulation's business.
+
+import type { Motion } from '../mirror/skeleton';
+import type { RecordableDuet } from '../ui/record';
+
+/** A 2D steering request on the floor, in world x/z; |(x, z)| is in 0..1. */
+export interface Steer {
+  x: number;
+  z: number;
+  /** true while the user is pressing a key or holding the joystick. */
+  active: boolean;
+}
+
+/** What the shell needs to draw one dancer. All arrays are world space and owned by the
+ *  simulation; the shell copies them after each step and never writes to them. */
+export interface DancerView {
+  /** Root on the floor: [x, z] metres. */
+  root: [number, number];
+  /** Facing angle in radians; forward = (sin θ, 0, cos θ). */
+  heading: number;
+  /** 17 joints × (x, y, z). */
+  positions: Float32Array;
+  /** Future root trajectory: 6 keys × (x, z). */
+  future: Float32Array;
+  /** Predicted partner key joints (intention): 6 keys × 5 key joints × (x, y, z). */
+  intention?: Float32Array;
+  /** Optional, for drawing hands, feet and the face: 17 joints × world rotation (row-major 3×3)
+   *  of the same frame as `positions`. */
+  rotations?: Float32Array;
+  /** Optional, for the floor marks under planted feet: foot contact [left, right] in 0..1. */
+  contacts?: Float32Array;
+  /** Optional, for the hand glow: per hand [left, right], how far the contact layer draws it to
+   *  the partner's hand, 0..1. */
+  hands?: Float32Array;
+}
+
+export interface Simulation {
+  /** Back to the start pose; keeps the models. */
+  reset(): void;
+  /** Advance one 1/30 s step. */
+  step(steer: Steer, temperature: number): Promise<void>;
+  leader: DancerView;
+  /** One follower, or two in compare mode (ours first). */
+  followers: DancerView[];
+  /** k alternative next follower poses sampled from the model, each 17 × (x, y, z) world. */
+  ghosts(k: number): Promise<Float32Array[]>;
+  /** Wall time of step() over the last 300 steps, milliseconds. */
+  stepMs(): { median: number; p95: number };
+  /** Guard counts since the start: dancers reset after absurd model output, and frames the
+   *  leash drew a follower toward the leader (see rollout.ts). */
+  guards(): { resets: number; leashed: number };
+  /**
+   * Drive the leader from a recorded motion (30 fps) instead of the leader model, or go back to
+   * the model with null. Throws, changing nothing, on a motion it cannot play.
+   */
+  setLeaderPlayback(motion: Motion | null): void;
+  /** The dancers as they are now, for the recorder (a new object after reset). */
+  readonly duet: RecordableDuet;
+}
+
+/** What one model returns; the arrays are the policy's own and overwritten by its next run. */
+export interface PolicyResult {
+  /** [B × 323] raw model output (root update, trajectory, key joints, pose, contacts). */
+  output: Float32Array;
+  /** [B × 90] predicted partner key joints, or null for models without an intention predictor. */
+  intention: Float32Array | null;
+}
+
+/** What the simulation needs of one model (policy.ts Policy; fakes in the tests). */
+export interface StepPolicy {
+  /** Write the [660] input features here before run(). */
+  readonly input: Float32Array;
+  /** Whether run() returns an intention. */
+  readonly hasIntention: boolean;
+  /** One step for one character: reads `input`. */
+  run(temperature: number): Promise<PolicyResult>;
+  /** The [k × 660] input block for a batched run (e.g. k ghost samples); write rows here. */
+  batchInput(k: number): Float32Array;
+  /** k samples at once, each with its own noise: reads batchInput(k), returns [k × ...] results. */
+  runBatch(k: number, temperature: number): Promise<PolicyResult>;
+}
+
+/** What the shell hands to the simulation factory. */
+export interface SimulationOptions {
+  manifest: Manifest;
+  leader: StepPolicy;
+  /** [ours] or [ccm], or [ours, ccm] in compare mode. */
+  followers: StepPolicy[];
+  /** Seed for anything random the simulation does itself (the policies carry their own PRNG). */
+  seed: number;
+}
+
+/** simulation.ts exports a function of this type named `createSimulation`. */
+export type CreateSimulation = (options: SimulationOptions) => Simulation;
+
+export interface ModelEntry {
+  file: string;
+  bytes: number;
+  /** Codebook channels C and classes D; the noise input is [B, C·D]. */
+  channels: number;
+  classes: number;
+  /** Whether the model has an `intention` output. */
+  intention: boolean;
+}
+
+/** public/models/manifest.json, written by training/learning/export.py. */
+export interface Manifest {
+  version: number;
+  fps: number;
+  skeleton: {
+    names: string[];
+    parents: number[];
+    offsets: { leader: number[][]; follower: number[][] };
+  };
+  keyJoints: number[];
+  layout: {
+    input: number;
+    output: number;
+    intention: number;
+    /** (block name, size) in order, as training/mirror/features.py lays them out (web/mirror/features.ts too). */
+    followerInput: [string, number][];
+    leaderInput: [string, number][];
+    outputBlocks: [string, number][];
+  };
+  /** Opaque to the shell; read by rollout.ts (startDuet). */
+  startPose: unknown;
+  models: Record<string, ModelEntry>;
+  defaultTemperature: number;
+  credit: string;
+}
+
+/** Follower model choices in the panel and the URL. */
+export type FollowerChoice = 'ours' | 'ccm' | 'compare';
+
+/** The test hook on window.duet: the end-to-end tests (tests/e2e) read only this. */
+export interface DuetHook {
+  ready: boolean;
+  error: string | null;
+  /** Simulation steps taken since the page loaded (not reset by R). */
+  frame: number;
+  leader: { root: [number, number]; heading: number };
+  follower: { root: [number, number]; heading: number };
+  /** step() wall time over the last 300 steps: features + both models + pose. */
+  stepMs: { median: number; p95: number };
+  /** Follower model in use: 'ours', 'ccm' or 'compare'. */
+  model: string;
+  /** The contact layer's hand hold between the leader and the (first) follower, 0..1
+   *  (web/mirror/contact.ts): 1 when the closest hands meet. */
+  hold: number;
+  // Extras for the bench and for debugging (not part of the contract).
+  paused: boolean;
+  threads: number;
+  /** Bytes of the ONNX files loaded so far. */
+  modelBytes: number;
+  /** performance.now() when the first step finished (cold load to a reacting page). */
+  firstFrameMs: number | null;
+}
+
+declare global {
+  interface Window {
+    duet?: DuetHook;
+  }
+}

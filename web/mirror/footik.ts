@@ -1,0 +1,119 @@
+// Mirror of training/mirror/footik.py. Foot locking for drawing: while the model says a foot is planted
+// (contact > 0.5), keep it where the contact began, with a two-bone IK on thigh - shin - foot, and never below the floor.
+//
+// This touches only the DRAWN positions (DancerView.positions). The Track the features read stays
+// exactly what the model produced, so the page's features remain identical to Python's.
+
+import { FEET, PARENTS } from './skeleton';
+
+/** Lowest height of the ankle joint: a flat foot's ankle sits 7-11 cm up in the data, so 6 cm
+ *  keeps the sole above the floor without ever lifting a real flat foot. */
+export const ANKLE_FLOOR = 0.06;
+/** A lock further than this from the model's foot is stale (a reset, a glitch, a step the model
+ *  took without lifting the foot): let it go. A long stride (training/mirror/footik.py: measured). */
+export const MAX_LOCK_DISTANCE = 0.5;
+/** After a contact ends, the lock's pull decays by this factor per step (no pop on release). */
+export const RELEASE_DECAY = 0.5;
+
+/**
+ * Two-bone IK in place on `positions` (17 × 3): joints a (thigh) -> b (knee) -> c (foot) keep
+ * their bone lengths, c goes to the target (or as near as the leg reaches), and the knee stays
+ * on the side it bends to now (the pole direction when the leg is straight).
+ */
+export function twoBoneIk(
+  positions: Float32Array | Float64Array, a: number, b: number, c: number,
+  tx: number, ty: number, tz: number, poleX: number, poleY: number, poleZ: number,
+): void {
+  const ax = positions[3 * a], ay = positions[3 * a + 1], az = positions[3 * a + 2];
+  const abx = positions[3 * b] - ax, aby = positions[3 * b + 1] - ay, abz = positions[3 * b + 2] - az;
+  const upper = Math.hypot(abx, aby, abz);
+  const lower = Math.hypot(positions[3 * c] - positions[3 * b], positions[3 * c + 1] - positions[3 * b + 1], positions[3 * c + 2] - positions[3 * b + 2]);
+  let nx = tx - ax, ny = ty - ay, nz = tz - az;
+  const reach = Math.hypot(nx, ny, nz);
+  if (reach < 1e-9 || upper < 1e-9 || lower < 1e-9) return;
+  nx /= reach;
+  ny /= reach;
+  nz /= reach;
+  const d = Math.min(Math.max(reach, Math.abs(upper - lower) + 1e-6), upper + lower - 1e-6);
+  // Bend direction: the knee's side of the thigh-foot line as posed now (so a knee bent forward
+  // stays forward), made perpendicular to the new line; the pole for a straight leg.
+  let ux = positions[3 * c] - ax, uy = positions[3 * c + 1] - ay, uz = positions[3 * c + 2] - az;
+  const u = Math.hypot(ux, uy, uz);
+  let mx = poleX, my = poleY, mz = poleZ;
+  if (u > 1e-9) {
+    ux /= u;
+    uy /= u;
+    uz /= u;
+    const along = abx * ux + aby * uy + abz * uz;
+    const bx = abx - along * ux, by = aby - along * uy, bz = abz - along * uz;
+    if (Math.hypot(bx, by, bz) > 1e-6) {
+      mx = bx;
+      my = by;
+      mz = bz;
+    }
+  }
+  const along = mx * nx + my * ny + mz * nz;
+  mx -= along * nx;
+  my -= along * ny;
+  mz -= along * nz;
+  const m = Math.hypot(mx, my, mz);
+  if (m < 1e-9) return;
+  mx /= m;
+  my /= m;
+  mz /= m;
+  // Triangle with sides upper, lower, d: the knee sits x along the line and h off it.
+  const x = (upper * upper - lower * lower + d * d) / (2 * d);
+  const h = Math.sqrt(Math.max(0, upper * upper - x * x));
+  positions[3 * b] = ax + x * nx + h * mx;
+  positions[3 * b + 1] = ay + x * ny + h * my;
+  positions[3 * b + 2] = az + x * nz + h * mz;
+  positions[3 * c] = ax + d * nx;
+  positions[3 * c + 1] = ay + d * ny;
+  positions[3 * c + 2] = az + d * nz;
+}
+
+/** The lock state of one dancer's two feet, kept between steps. */
+export class FootLock {
+  private readonly locked = [false, false];
+  private readonly target = new Float64Array(6);
+  private readonly weight = new Float64Array(2);
+
+  /** Forget every lock (after a reset or a jump of the dancer). */
+  clear(): void {
+    this.locked[0] = this.locked[1] = false;
+    this.weight.fill(0);
+  }
+
+  /**
+   * Lock or release each foot from `contacts` (left, right) and bend the legs of `positions`
+   * (17 × 3 world, modified in place). `heading` gives the knee's bend direction for a straight leg.
+   */
+  apply(positions: Float32Array | Float64Array, contacts: ArrayLike<number>, heading: number): void {
+    for (let i = 0; i < FEET.length; i++) {
+      const foot = FEET[i];
+      const knee = PARENTS[foot];
+      const thigh = PARENTS[knee];
+      const fx = positions[3 * foot], fy = positions[3 * foot + 1], fz = positions[3 * foot + 2];
+      const t = this.target;
+      const o = 3 * i;
+      if (contacts[i] > 0.5) {
+        const stale = this.locked[i] && Math.hypot(t[o] - fx, t[o + 1] - fy, t[o + 2] - fz) > MAX_LOCK_DISTANCE;
+        if (!this.locked[i] || stale) {
+          t[o] = fx;
+          t[o + 1] = Math.max(fy, ANKLE_FLOOR);
+          t[o + 2] = fz;
+          this.locked[i] = true;
+        }
+        this.weight[i] = 1;
+      } else {
+        this.locked[i] = false;
+        this.weight[i] = this.weight[i] * RELEASE_DECAY < 0.01 ? 0 : this.weight[i] * RELEASE_DECAY;
+      }
+      const w = this.weight[i];
+      const tx = fx + (t[o] - fx) * w;
+      const ty = Math.max(fy + (t[o + 1] - fy) * w, ANKLE_FLOOR);
+      const tz = fz + (t[o + 2] - fz) * w;
+      if (w > 0 || fy < ANKLE_FLOOR) twoBoneIk(positions, thigh, knee, foot, tx, ty, tz, Math.sin(heading), 0, Math.cos(heading));
+    }
+  }
+}

@@ -1,0 +1,161 @@
+// Steering input: arrow keys / WASD and a touch joystick, both relative to where the camera looks,
+// turned into one 2D vector on the floor (world x, z) of length 0..1. Space pauses, R resets.
+
+import type { Steer } from '../engine/types';
+
+/** Joystick travel in CSS pixels for full speed, and the dead zone around the thumb. */
+const JOYSTICK_RADIUS = 60;
+const DEAD_ZONE = 6;
+
+const KEY_DIRECTIONS: Record<string, [number, number]> = {
+  // [forward, right]
+  ArrowUp: [1, 0],
+  KeyW: [1, 0],
+  ArrowDown: [-1, 0],
+  KeyS: [-1, 0],
+  ArrowLeft: [0, -1],
+  KeyA: [0, -1],
+  ArrowRight: [0, 1],
+  KeyD: [0, 1],
+};
+
+export interface ControlsOptions {
+  /** Where pointers are read (the WebGL canvas). */
+  surface: HTMLElement;
+  /** Writes the camera's floor-projected, normalized view direction into `out`. */
+  viewForward(out: { x: number; z: number }): void;
+  onPause(): void;
+  onReset(): void;
+}
+
+export class Controls {
+  private readonly pressed = new Set<string>();
+  private readonly steer: Steer = { x: 0, z: 0, active: false };
+  private readonly forward = { x: 0, z: 1 };
+  private readonly joystick = { pointerId: -1, originX: 0, originY: 0, forward: 0, right: 0 };
+  private readonly base: HTMLElement;
+  private readonly knob: HTMLElement;
+  private readonly touches = new Set<number>();
+
+  constructor(private readonly options: ControlsOptions) {
+    // Keys are read by physical position (event.code), so WASD works on AZERTY keyboards too.
+    window.addEventListener('keydown', (event) => this.onKeyDown(event));
+    window.addEventListener('keyup', (event) => this.pressed.delete(event.code));
+    // A key released while the window had no focus would otherwise steer forever.
+    window.addEventListener('blur', () => this.pressed.clear());
+
+    this.base = document.createElement('div');
+    this.base.className = 'joystick';
+    this.knob = document.createElement('div');
+    this.knob.className = 'joystick-knob';
+    this.base.appendChild(this.knob);
+    document.body.appendChild(this.base);
+
+    const surface = options.surface;
+    // touch-action: none (style.css) stops the browser from scrolling or zooming while steering.
+    surface.addEventListener('pointerdown', (event) => this.onPointerDown(event));
+    window.addEventListener('pointermove', (event) => this.onPointerMove(event));
+    window.addEventListener('pointerup', (event) => this.onPointerUp(event));
+    window.addEventListener('pointercancel', (event) => this.onPointerUp(event));
+    // iOS Safari pinch-zooms the page through its own gesture events.
+    document.addEventListener('gesturestart', (event) => event.preventDefault());
+  }
+
+  /** The current steering vector in world x/z (the same object every call). */
+  getSteer(): Steer {
+    let forward = 0;
+    let right = 0;
+    for (const code of this.pressed) {
+      const direction = KEY_DIRECTIONS[code];
+      if (!direction) continue;
+      forward += direction[0];
+      right += direction[1];
+    }
+    if (this.joystick.pointerId !== -1) {
+      forward += this.joystick.forward;
+      right += this.joystick.right;
+    }
+    // Diagonals (two keys) are as fast as straight lines.
+    const length = Math.hypot(forward, right);
+    if (length > 1) {
+      forward /= length;
+      right /= length;
+    }
+    // Forward is the camera's view on the floor; right is forward turned 90° clockwise seen from above.
+    const f = this.forward;
+    this.options.viewForward(f);
+    this.steer.x = forward * f.x - right * f.z;
+    this.steer.z = forward * f.z + right * f.x;
+    this.steer.active = length > 0;
+    return this.steer;
+  }
+
+  private onKeyDown(event: KeyboardEvent): void {
+    // Typing a number into the settings panel must not steer or reset.
+    const target = event.target as HTMLElement | null;
+    if (target && (target.tagName === 'INPUT' || target.tagName === 'SELECT' || target.tagName === 'TEXTAREA')) return;
+    if (event.ctrlKey || event.metaKey || event.altKey) return; // Ctrl+R still reloads
+    if (event.code in KEY_DIRECTIONS) {
+      this.pressed.add(event.code);
+      event.preventDefault(); // arrows would scroll the page
+    } else if (event.code === 'Space') {
+      event.preventDefault();
+      if (!event.repeat) this.options.onPause();
+    } else if (event.code === 'KeyR' && !event.repeat) {
+      this.options.onReset();
+    }
+  }
+
+  // Touch joystick: the first finger on the canvas steers from wherever it lands; a second finger
+  // hands the gesture to the camera (OrbitControls: two fingers orbit and zoom).
+
+  private onPointerDown(event: PointerEvent): void {
+    if (event.pointerType === 'mouse') return; // the mouse orbits; the keyboard steers
+    this.touches.add(event.pointerId);
+    if (this.touches.size > 1) {
+      this.release();
+      return;
+    }
+    const j = this.joystick;
+    j.pointerId = event.pointerId;
+    j.originX = event.clientX;
+    j.originY = event.clientY;
+    j.forward = 0;
+    j.right = 0;
+    this.base.style.left = `${event.clientX}px`;
+    this.base.style.top = `${event.clientY}px`;
+    this.knob.style.transform = 'translate(-50%, -50%)';
+    this.base.classList.add('visible');
+    event.preventDefault();
+  }
+
+  private onPointerMove(event: PointerEvent): void {
+    const j = this.joystick;
+    if (event.pointerId !== j.pointerId) return;
+    let dx = event.clientX - j.originX;
+    let dy = event.clientY - j.originY;
+    const distance = Math.hypot(dx, dy);
+    if (distance > JOYSTICK_RADIUS) {
+      dx *= JOYSTICK_RADIUS / distance;
+      dy *= JOYSTICK_RADIUS / distance;
+    }
+    this.knob.style.transform = `translate(calc(-50% + ${dx}px), calc(-50% + ${dy}px))`;
+    const strength = distance < DEAD_ZONE ? 0 : Math.min(1, (distance - DEAD_ZONE) / (JOYSTICK_RADIUS - DEAD_ZONE));
+    const scale = distance > 0 ? strength / Math.min(distance, JOYSTICK_RADIUS) : 0;
+    // Screen up is "away from the camera".
+    j.forward = -dy * scale;
+    j.right = dx * scale;
+  }
+
+  private onPointerUp(event: PointerEvent): void {
+    this.touches.delete(event.pointerId);
+    if (event.pointerId === this.joystick.pointerId) this.release();
+  }
+
+  private release(): void {
+    this.joystick.pointerId = -1;
+    this.joystick.forward = 0;
+    this.joystick.right = 0;
+    this.base.classList.remove('visible');
+  }
+}

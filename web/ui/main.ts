@@ -1,0 +1,431 @@
+// duet: the page. One scene, one loop (three.js examples style).
+//
+// The simulation advances in fixed 1/30 s steps, decoupled from the display rate: an accumulator
+// collects real time (times the speed setting), each step runs the models once, and drawing
+// interpolates between the last two steps, so 60 or 120 Hz screens look smooth and a slow frame
+// never changes the dance.
+
+import './style.css';
+import type { CreateSimulation, DancerView, DuetHook, FollowerChoice, Manifest, Simulation } from '../engine/types';
+import type { Policy } from '../engine/policy';
+import { checkBrowserSupport, installGlobalErrorHandlers, showError } from './errors';
+import { fetchModelBytes, loadManifest } from '../engine/manifest';
+import { Stage } from '../draw/scene';
+import { Controls } from './controls';
+import { Hud } from './hud';
+import { Panel } from './panel';
+import { LIMITS, type Settings, copyLink, defaultSettings, readSettings, writeSettings } from './share';
+import { FPS, type Motion } from '../mirror/skeleton';
+import { KEYS, N_KEY_JOINTS } from '../mirror/features';
+import { DancerTrack } from '../draw/interpolation';
+import { MAX_RECORD_FRAMES, Recorder, formatDuration } from './record';
+import { RecordPanel } from './recordpanel';
+import { LeaderFileInput } from './dropzone';
+import { showToast } from './toast';
+
+const DT = 1 / FPS;
+const NO_GUARDS = { resets: 0, leashed: 0 };
+/** A long stall counts as at most this much time, so the dance never jumps ahead. */
+const MAX_FRAME_SECONDS = 0.5;
+/** Simulation time the loop may fall behind before it gives up on catching up (slow motion). */
+const MAX_BACKLOG_SECONDS = 0.5;
+/** Wall time spent stepping before we draw anyway: at least this, or as long as the last frame
+ *  took to draw, so that slow drawing (software WebGL) cannot starve the simulation either. */
+const MIN_STEP_BUDGET_MS = 50;
+const MAX_GHOSTS = LIMITS.ghosts[1];
+const PAUSED_STATUS = 'paused — Space to resume';
+const FOLLOWER_MODELS: Record<FollowerChoice, string[]> = {
+  ours: ['follower'],
+  ccm: ['follower_ccm'],
+  compare: ['follower', 'follower_ccm'],
+};
+/** Each model gets its own noise stream, all derived from the one seed in the URL. */
+const MODEL_NAMES = ['leader', 'follower', 'follower_ccm'];
+
+const hook: DuetHook = {
+  ready: false,
+  error: null,
+  frame: 0,
+  leader: { root: [0, 0], heading: 0 },
+  follower: { root: [0, 0], heading: 0 },
+  stepMs: { median: 0, p95: 0 },
+  model: 'ours',
+  paused: false,
+  threads: 1,
+  modelBytes: 0,
+  firstFrameMs: null,
+  hold: 0,
+};
+window.duet = hook;
+installGlobalErrorHandlers();
+
+function publish(target: DuetHook['leader'], view: DancerView): void {
+  target.root[0] = view.root[0];
+  target.root[1] = view.root[1];
+  target.heading = view.heading;
+}
+
+/**
+ * onnxruntime, the policies and the duet loop (features, both models, pose): loaded with the
+ * models, not with the page (ORT alone is 3.7 MB gzipped).
+ */
+function loadRuntime() {
+  const runtime = Promise.all([import('../engine/ort'), import('../engine/policy'), import('../engine/simulation')]);
+  runtime.catch(() => undefined); // reported where it is awaited
+  return runtime;
+}
+
+type Runtime = Awaited<ReturnType<typeof loadRuntime>>;
+
+/** Each model file fetched once, from the first time it is asked for. */
+function modelDownloads(manifest: Manifest): (name: string) => Promise<Uint8Array> {
+  const downloads = new Map<string, Promise<Uint8Array>>();
+  return (name) => {
+    if (!downloads.has(name)) {
+      const bytes = fetchModelBytes(manifest, name);
+      bytes.catch(() => undefined); // reported where it is awaited
+      downloads.set(name, bytes);
+    }
+    return downloads.get(name)!;
+  };
+}
+
+/** The page once the manifest is in: floor, controls, panel, recording, and the animation loop. */
+class Page {
+  private readonly defaults: Settings;
+  private readonly settings: Settings;
+  private readonly hasCcm: boolean;
+  private readonly download: (name: string) => Promise<Uint8Array>;
+  private readonly stage: Stage;
+  private readonly hud: Hud;
+  private readonly controls: Controls;
+  private readonly recorder: Recorder;
+  private readonly leaderFileInput: LeaderFileInput;
+  private readonly recordPanel: RecordPanel;
+
+  private simulation: Simulation | null = null;
+  private paused = false;
+  private accumulator = 0;
+  private stepping = false;
+  private drawMs = 0; // smoothed wall time per animation frame not spent stepping
+  private steppedMs = 0; // wall time spent stepping since the last animation frame
+  private ghostPoses: Float32Array[] = [];
+  private readonly leader = new DancerTrack();
+  private readonly followers = [new DancerTrack(), new DancerTrack()];
+  /** Steps, resets and model switches must not overlap: they all go through this queue. */
+  private queue: Promise<void> = Promise.resolve();
+  private leaderFile: { motion: Motion; name: string } | null = null;
+
+  // Set once the runtime has loaded.
+  private createSimulation: CreateSimulation | null = null;
+  private createPolicy: Runtime[1]['createPolicy'] | null = null;
+  private readonly policies = new Map<string, Promise<Policy>>();
+
+  // The display rate, for the HUD.
+  private frames = 0;
+  private fps = 0;
+  private fpsSince = 0;
+  private last = 0;
+  private lastIdleDraw = -Infinity;
+
+  constructor(private readonly manifest: Manifest) {
+    this.defaults = defaultSettings(manifest.defaultTemperature);
+    this.settings = readSettings(location.search, this.defaults);
+    this.hasCcm = 'follower_ccm' in manifest.models;
+    if (!this.hasCcm) this.settings.model = 'ours';
+    this.download = modelDownloads(manifest);
+    for (const name of ['leader', ...FOLLOWER_MODELS[this.settings.model]]) this.download(name);
+
+    // The floor is up while the models download: something to look at, never a blank canvas.
+    this.stage = new Stage(document.getElementById('app')!, manifest.skeleton.parents, MAX_GHOSTS);
+    if (this.settings.camera) this.stage.setOrbit(this.settings.camera);
+    this.hud = new Hud(document.getElementById('overlay')!);
+    this.hud.setStatus('loading models…');
+    const credit = document.getElementById('credit');
+    if (credit) credit.textContent = manifest.credit ?? '';
+
+    this.controls = new Controls({
+      surface: this.stage.canvas,
+      viewForward: (out) => this.stage.viewForward(out),
+      onPause: () => this.togglePause(),
+      onReset: () => this.reset(),
+    });
+    const panel = this.createPanel();
+    this.recorder = new Recorder(MAX_RECORD_FRAMES, () =>
+      showToast('Recording stopped', `It reached the ${formatDuration(MAX_RECORD_FRAMES / FPS)} limit. Download the take (“download BVH”).`, 'error', 15_000));
+    this.leaderFileInput = new LeaderFileInput({
+      notify: showToast,
+      onMotion: (motion, name) => this.playLeaderFile(motion, name),
+    });
+    this.recordPanel = new RecordPanel({
+      gui: panel.gui,
+      overlay: document.getElementById('overlay')!,
+      recorder: this.recorder,
+      duet: () => this.simulation?.duet ?? null,
+      between: (task) => this.exclusive(task),
+      notify: showToast,
+      onOpenLeaderFile: () => this.leaderFileInput.open(),
+      onLeaderModel: () => this.leaderBackToModel(),
+    });
+  }
+
+  private createPanel(): Panel {
+    return new Panel({
+      settings: this.settings,
+      models: this.hasCcm ? ['ours', 'ccm', 'compare'] : ['ours'],
+      onModel: (choice) => this.useModel(choice).catch(this.fail),
+      onGhosts: () => this.exclusive(() => this.refreshGhosts()).catch(this.fail),
+      onReset: () => this.reset(),
+      onShare: () => this.share(),
+    });
+  }
+
+  /** Run a task after every task queued before it. */
+  private exclusive(task: () => Promise<void> | void): Promise<void> {
+    const run = this.queue.then(task);
+    this.queue = run.catch(() => undefined);
+    return run;
+  }
+
+  private readonly fail = (error: unknown): void => {
+    this.simulation = null; // stop stepping; the overlay explains
+    showError(error);
+  };
+
+  private status(): string {
+    return this.paused ? PAUSED_STATUS : '';
+  }
+
+  /** Copy the simulation's views for drawing (snap: no interpolation from the last state). */
+  private capture(snap: boolean): void {
+    const simulation = this.simulation;
+    if (!simulation) return;
+    this.leader.capture(simulation.leader, snap);
+    for (let i = 0; i < simulation.followers.length; i++) this.followers[i].capture(simulation.followers[i], snap);
+    publish(hook.leader, simulation.leader);
+    publish(hook.follower, simulation.followers[0]);
+    const hands = simulation.leader.hands;
+    hook.hold = hands ? Math.max(hands[0], hands[1]) : 0;
+    const stats = simulation.stepMs();
+    hook.stepMs.median = stats.median;
+    hook.stepMs.p95 = stats.p95;
+  }
+
+  /** Put the camera between the partners at once. */
+  private snapCamera(): void {
+    const { leader, followers } = this;
+    this.stage.follow(0.5 * (leader.root[2] + followers[0].root[2]), 0.5 * (leader.root[3] + followers[0].root[3]), 0, true);
+  }
+
+  private reset(): Promise<void> {
+    return this.exclusive(() => {
+      if (!this.simulation) return;
+      this.simulation.reset();
+      this.accumulator = 0;
+      this.capture(true);
+      this.snapCamera();
+    });
+  }
+
+  private togglePause(): void {
+    this.paused = !this.paused;
+    hook.paused = this.paused;
+    this.hud.setStatus(this.status());
+  }
+
+  /** One model's policy, created once. */
+  private policy(name: string): Promise<Policy> {
+    let loading = this.policies.get(name);
+    if (!loading) {
+      const seed = (this.settings.seed + MODEL_NAMES.indexOf(name) * 0x9e3779b9) >>> 0;
+      loading = this.download(name).then((bytes) => this.createPolicy!(this.manifest, name, bytes, seed)).then((p) => {
+        hook.modelBytes += p.entry.bytes;
+        return p;
+      });
+      this.policies.set(name, loading);
+    }
+    return loading;
+  }
+
+  /** (Re)build the simulation for a follower choice; a new simulation starts from the start pose. */
+  private useModel(choice: FollowerChoice): Promise<void> {
+    return this.exclusive(async () => {
+      this.hud.setStatus('loading models…');
+      const [leaderPolicy, ...followerPolicies] = await Promise.all([this.policy('leader'), ...FOLLOWER_MODELS[choice].map((n) => this.policy(n))]);
+      this.simulation = this.createSimulation!({ manifest: this.manifest, leader: leaderPolicy, followers: followerPolicies, seed: this.settings.seed });
+      this.applyLeaderFile(); // a new simulation keeps the leader's file
+      hook.model = choice;
+      this.accumulator = 0;
+      this.capture(true);
+      this.snapCamera();
+      this.hud.setStatus(this.status());
+    });
+  }
+
+  private async refreshGhosts(): Promise<void> {
+    const { simulation, settings } = this;
+    this.ghostPoses = simulation && settings.ghosts > 0 ? await simulation.ghosts(settings.ghosts) : [];
+  }
+
+  /** Write the settings into the URL and copy it. */
+  private async share(): Promise<void> {
+    const query = writeSettings(this.settings, this.stage.getOrbit(), this.defaults.temperature);
+    const url = `${location.origin}${location.pathname}?${query}`;
+    history.replaceState(null, '', url);
+    if (await copyLink(url)) {
+      this.hud.setStatus('link copied');
+      setTimeout(() => this.hud.setStatus(this.status()), 2000);
+    } else {
+      window.prompt('Copy this link:', url);
+    }
+  }
+
+  private applyLeaderFile(): void {
+    this.simulation?.setLeaderPlayback(this.leaderFile?.motion ?? null);
+  }
+
+  private playLeaderFile(motion: Motion, name: string): Promise<void> {
+    return this.exclusive(() => {
+      if (!this.simulation) throw new Error('The dancers are still loading; try again in a moment.');
+      this.simulation.setLeaderPlayback(motion); // throws (nothing changed) on a motion it cannot play
+      this.leaderFile = { motion, name };
+      this.recordPanel.setLeaderFile(name);
+    });
+  }
+
+  private leaderBackToModel(): void {
+    this.exclusive(() => {
+      this.leaderFile = null;
+      this.applyLeaderFile();
+      this.recordPanel.setLeaderFile(null);
+    }).catch(this.fail);
+  }
+
+  /** Run the steps that real time asks for; called from the animation loop, one call at a time. */
+  private async advance(): Promise<void> {
+    const began = performance.now();
+    let steps = 0;
+    while (this.simulation && this.accumulator >= DT) {
+      await this.simulation.step(this.controls.getSteer(), this.settings.temperature);
+      this.accumulator -= DT;
+      steps++;
+      this.capture(false);
+      const duet = this.simulation?.duet;
+      if (this.recorder.recording && duet) this.recorder.capture(duet);
+      hook.frame++;
+      if (hook.firstFrameMs === null) hook.firstFrameMs = performance.now();
+      hook.ready = true;
+      // Draw between steps when stepping is slow (software rendering, big models, high speed).
+      if (performance.now() - began > Math.max(MIN_STEP_BUDGET_MS, this.drawMs)) break;
+    }
+    if (steps > 0 && this.settings.ghosts > 0) await this.refreshGhosts();
+    if (steps > 0) this.recordPanel.update();
+    this.steppedMs += performance.now() - began;
+  }
+
+  /** Start the animation loop. */
+  startLoop(): void {
+    this.fpsSince = performance.now();
+    this.last = performance.now();
+    requestAnimationFrame(this.frame);
+    // Browsers stop animation frames in hidden tabs: start timing afresh when the tab comes back.
+    document.addEventListener('visibilitychange', () => {
+      this.last = performance.now();
+    });
+  }
+
+  private readonly frame = (now: number): void => {
+    requestAnimationFrame(this.frame);
+    const elapsed = Math.min(Math.max(0, now - this.last) / 1000, MAX_FRAME_SECONDS);
+    this.drawMs += 0.2 * (Math.max(0, elapsed * 1000 - this.steppedMs) - this.drawMs);
+    this.steppedMs = 0;
+    this.last = now;
+    this.countFrame(now);
+
+    // A device that cannot keep up runs the dance in slow motion rather than piling up work.
+    const { settings } = this;
+    if (this.simulation && !this.paused) this.accumulator = Math.min(this.accumulator + elapsed * settings.speed, MAX_BACKLOG_SECONDS * settings.speed);
+    if (this.simulation && !this.stepping && this.accumulator >= DT) {
+      this.stepping = true;
+      this.exclusive(() => this.advance())
+        .catch(this.fail)
+        .finally(() => (this.stepping = false));
+    }
+
+    // While models load (or after an error) there is nothing moving: redraw rarely and leave the
+    // CPU to downloading and compiling.
+    if (this.simulation || now - this.lastIdleDraw > 250) {
+      this.lastIdleDraw = now;
+      this.draw(Math.min(1, this.accumulator / DT), elapsed);
+    }
+    const guards = this.simulation ? this.simulation.guards() : NO_GUARDS;
+    this.hud.update(now, { stepMs: hook.stepMs, fps: this.fps, threads: hook.threads, modelBytes: hook.modelBytes, guards });
+  };
+
+  private countFrame(now: number): void {
+    this.frames++;
+    if (now - this.fpsSince >= 500) {
+      this.fps = (this.frames * 1000) / (now - this.fpsSince);
+      this.frames = 0;
+      this.fpsSince = now;
+    }
+  }
+
+  private draw(alpha: number, elapsed: number): void {
+    const { stage, simulation, leader, followers } = this;
+    const count = simulation ? simulation.followers.length : 0;
+    stage.leader.setCount(simulation ? 1 : 0);
+    if (simulation) stage.leader.setPose(0, leader.interpolate(alpha), leader.interpolateRotations(alpha), leader.contacts);
+    // Hand glows: dancer 0 is the leader, 1 and 2 the followers (Stage.setHandContact).
+    for (let h = 0; h < 2; h++) {
+      stage.setHandContact(0, h, simulation ? leader.hands[h] : 0);
+      for (let i = 0; i < stage.followers.length; i++) stage.setHandContact(i + 1, h, i < count ? followers[i].hands[h] : 0);
+    }
+    for (let i = 0; i < stage.followers.length; i++) {
+      stage.followers[i].setCount(i < count ? 1 : 0);
+      if (i < count) stage.followers[i].setPose(0, followers[i].interpolate(alpha), followers[i].interpolateRotations(alpha), followers[i].contacts);
+    }
+    this.drawOverlays(alpha, count);
+    if (simulation) stage.follow(0.5 * (leader.rootX(alpha) + followers[0].rootX(alpha)), 0.5 * (leader.rootZ(alpha) + followers[0].rootZ(alpha)), elapsed);
+    stage.render();
+  }
+
+  /** The leader's and each follower's future root path; the followers' intentions; the ghosts. */
+  private drawOverlays(alpha: number, count: number): void {
+    const { stage, settings, leader, followers } = this;
+    for (let i = 0; i < stage.trajectories.length; i++) {
+      const overlay = stage.trajectories[i];
+      const track = i === 0 ? leader : followers[i - 1];
+      overlay.group.visible = settings.trajectories && this.simulation !== null && i <= count;
+      if (overlay.group.visible) overlay.setFloorPath(track.rootX(alpha), track.rootZ(alpha), track.future);
+    }
+    for (let i = 0; i < stage.intentions.length; i++) {
+      const overlay = stage.intentions[i];
+      overlay.group.visible = settings.intentions && i < count && followers[i].hasIntention;
+      if (overlay.group.visible) overlay.setKeyMajorPoints(followers[i].intention, KEYS, N_KEY_JOINTS);
+    }
+    const ghosts = settings.ghosts > 0 ? Math.min(this.ghostPoses.length, settings.ghosts) : 0;
+    stage.ghosts.setCount(ghosts);
+    for (let i = 0; i < ghosts; i++) stage.ghosts.setPose(i, this.ghostPoses[i]);
+  }
+
+  /** The runtime is in: make the policies and the simulation, and start dancing. */
+  async attach([ortModule, policyModule, simulationModule]: Runtime): Promise<void> {
+    hook.threads = ortModule.configureThreads(this.settings.threads);
+    this.createPolicy = policyModule.createPolicy;
+    this.createSimulation = simulationModule.createSimulation;
+    await this.useModel(this.settings.model);
+  }
+}
+
+async function start(): Promise<void> {
+  checkBrowserSupport();
+  // Start every download at once: onnxruntime and the simulation code now, the models as soon as
+  // the manifest names them; the floor is drawn meanwhile.
+  const runtime = loadRuntime();
+  const page = new Page(await loadManifest());
+  page.startLoop();
+  await page.attach(await runtime);
+}
+
+start().catch(showError);
