@@ -6,6 +6,7 @@
 //
 //   npm run bench                 # threads 1 and 2
 //   node scripts/bench.mjs --seconds 20 --json
+//   npm run bench -- --phone      # a phone on a mobile network: see scripts/bench_phone.mjs
 //
 // Timings on a 2-core machine with software WebGL vary by ±20 % between runs.
 
@@ -83,6 +84,12 @@ async function run(url, threads) {
   } finally {
     await browser.close();
   }
+}
+
+if (args.includes('--phone')) {
+  const { benchPhone } = await import('./bench_phone.mjs');
+  await benchPhone({ json, seconds });
+  process.exit(0);
 }
 
 await build('dist');

@@ -4,6 +4,7 @@
 
 import type { Manifest } from './types';
 import { DuetError } from '../ui/errors';
+import { VERSION_HEADER, readBody } from './download';
 import {
   FOLLOWER_INPUT_LAYOUT, INPUT_SIZE, INTENTION_SIZE, LEADER_INPUT_LAYOUT, type Layout, N_JOINTS, OUTPUT_LAYOUT, OUTPUT_SIZE,
 } from '../mirror/features';
@@ -77,16 +78,22 @@ export function firstDifference(blocks: unknown, expected: Layout): string | nul
 }
 
 /** Download one model's bytes and check them against the manifest. Independent of ORT, so the
- *  downloads run while onnxruntime itself is still loading. */
-export async function fetchModelBytes(manifest: Manifest, name: string): Promise<Uint8Array> {
+ *  downloads run while onnxruntime itself is still loading. `onBytes` sees each chunk as it
+ *  arrives (the progress bar); `version` goes to the service worker (download.ts). */
+export async function fetchModelBytes(
+  manifest: Manifest,
+  name: string,
+  onBytes?: (bytes: number) => void,
+  version = '',
+): Promise<Uint8Array> {
   const entry = manifest.models[name];
   if (!entry) throw new DuetError('Model not found', `"${name}" is not in manifest.json`);
   const url = `models/${entry.file}`;
   let bytes: Uint8Array;
   try {
-    const response = await fetch(url);
+    const response = await fetch(url, version ? { headers: { [VERSION_HEADER]: version } } : undefined);
     if (!response.ok) throw new Error(`answered ${response.status}`);
-    bytes = new Uint8Array(await response.arrayBuffer());
+    bytes = await readBody(response, onBytes, entry.bytes);
   } catch (error) {
     throw new DuetError('A model file is missing', `${url}: ${(error as Error).message}`);
   }

@@ -15,7 +15,9 @@ export const ort = await import('onnxruntime-web/wasm');
  * Threads need SharedArrayBuffer, which browsers only give to cross-origin-isolated pages
  * (COOP + COEP headers); without isolation we run on one thread rather than fail.
  */
-export function configureThreads(requested: number | null): number {
+export function configureThreads(requested: number | null, wasmBinary?: Uint8Array): number {
+  // The page fetched the wasm itself (wasm.ts), with a progress bar: onnxruntime fetches nothing.
+  if (wasmBinary) ort.env.wasm.wasmBinary = wasmBinary;
   const most = globalThis.crossOriginIsolated ? 2 : 1;
   const threads = requested === null ? most : Math.max(1, Math.min(most, Math.round(requested)));
   ort.env.wasm.numThreads = threads;

@@ -156,6 +156,10 @@ export interface DuetHook {
   modelBytes: number;
   /** performance.now() when the first step finished (cold load to a reacting page). */
   firstFrameMs: number | null;
+  /** performance.now() when the floor and the standing pair were first drawn (loading scene). */
+  sceneMs?: number | null;
+  /** Bytes of the first dance's downloads (wasm + models), so far and in all. */
+  download?: { loaded: number; total: number };
 }
 
 declare global {

@@ -10,6 +10,11 @@ import type { CreateSimulation, DancerView, DuetHook, FollowerChoice, Manifest, 
 import type { Policy } from '../engine/policy';
 import { checkBrowserSupport, installGlobalErrorHandlers, showError } from './errors';
 import { fetchModelBytes, loadManifest } from '../engine/manifest';
+import { DownloadProgress } from '../engine/download';
+import { fetchWasm } from '../engine/wasm';
+import { standingViews } from '../engine/standing';
+import { assetVersion, keepForOffline, registerOffline } from '../engine/offline';
+import { LoadingBar } from './loading';
 import { Stage } from '../draw/scene';
 import { Controls } from './controls';
 import { Hud } from './hud';
@@ -77,12 +82,15 @@ function loadRuntime() {
 
 type Runtime = Awaited<ReturnType<typeof loadRuntime>>;
 
-/** Each model file fetched once, from the first time it is asked for. */
-function modelDownloads(manifest: Manifest): (name: string) => Promise<Uint8Array> {
+/** Each model file fetched once, from the first time it is asked for (the CCM follower only when
+ *  chosen), its bytes counted in `progress`. */
+function modelDownloads(manifest: Manifest, progress: DownloadProgress): (name: string) => Promise<Uint8Array> {
   const downloads = new Map<string, Promise<Uint8Array>>();
+  const version = assetVersion(manifest);
   return (name) => {
     if (!downloads.has(name)) {
-      const bytes = fetchModelBytes(manifest, name);
+      progress.expect(name, manifest.models[name]?.bytes ?? 0);
+      const bytes = fetchModelBytes(manifest, name, (n) => progress.add(name, n), version);
       bytes.catch(() => undefined); // reported where it is awaited
       downloads.set(name, bytes);
     }
@@ -128,17 +136,28 @@ class Page {
   private last = 0;
   private lastIdleDraw = -Infinity;
 
-  constructor(private readonly manifest: Manifest) {
+  /** Both dancers in their start pose, drawn until the simulation exists. */
+  private readonly still: { leader: DancerView; followers: DancerView[] };
+
+  constructor(
+    private readonly manifest: Manifest,
+    progress: DownloadProgress,
+    private readonly loading: LoadingBar,
+  ) {
     this.defaults = defaultSettings(manifest.defaultTemperature);
     this.settings = readSettings(location.search, this.defaults);
     this.hasCcm = 'follower_ccm' in manifest.models;
     if (!this.hasCcm) this.settings.model = 'ours';
-    this.download = modelDownloads(manifest);
+    this.download = modelDownloads(manifest, progress);
     for (const name of ['leader', ...FOLLOWER_MODELS[this.settings.model]]) this.download(name);
 
     // The floor is up while the models download: something to look at, never a blank canvas.
     this.stage = new Stage(document.getElementById('app')!, manifest.skeleton.parents, MAX_GHOSTS);
     if (this.settings.camera) this.stage.setOrbit(this.settings.camera);
+    this.still = standingViews(manifest);
+    this.leader.capture(this.still.leader, true);
+    this.followers[0].capture(this.still.followers[0], true);
+    this.snapCamera();
     this.hud = new Hud(document.getElementById('overlay')!);
     this.hud.setStatus('loading models…');
     const credit = document.getElementById('credit');
@@ -327,6 +346,11 @@ class Page {
   startLoop(): void {
     this.fpsSince = performance.now();
     this.last = performance.now();
+    // The standing pair at once, not a frame later: the loading scene's moment for the bench.
+    this.draw(0, 0);
+    this.lastIdleDraw = this.last;
+    hook.sceneMs = performance.now();
+    performance.mark('duet-scene');
     requestAnimationFrame(this.frame);
     // Browsers stop animation frames in hidden tabs: start timing afresh when the tab comes back.
     document.addEventListener('visibilitychange', () => {
@@ -373,9 +397,10 @@ class Page {
 
   private draw(alpha: number, elapsed: number): void {
     const { stage, simulation, leader, followers } = this;
-    const count = simulation ? simulation.followers.length : 0;
-    stage.leader.setCount(simulation ? 1 : 0);
-    if (simulation) stage.leader.setPose(0, leader.interpolate(alpha), leader.interpolateRotations(alpha), leader.contacts);
+    // Until the models are in, the pair stands still in the start pose (this.still).
+    const count = simulation ? simulation.followers.length : 1;
+    stage.leader.setCount(1);
+    stage.leader.setPose(0, leader.interpolate(alpha), leader.interpolateRotations(alpha), leader.contacts);
     // Hand glows: dancer 0 is the leader, 1 and 2 the followers (Stage.setHandContact).
     for (let h = 0; h < 2; h++) {
       stage.setHandContact(0, h, simulation ? leader.hands[h] : 0);
@@ -410,11 +435,14 @@ class Page {
   }
 
   /** The runtime is in: make the policies and the simulation, and start dancing. */
-  async attach([ortModule, policyModule, simulationModule]: Runtime): Promise<void> {
-    hook.threads = ortModule.configureThreads(this.settings.threads);
+  async attach([ortModule, policyModule, simulationModule]: Runtime, wasm: Uint8Array): Promise<void> {
+    this.loading.compiling();
+    hook.threads = ortModule.configureThreads(this.settings.threads, wasm);
     this.createPolicy = policyModule.createPolicy;
     this.createSimulation = simulationModule.createSimulation;
     await this.useModel(this.settings.model);
+    this.loading.hide();
+    keepForOffline();
   }
 }
 
@@ -423,9 +451,19 @@ async function start(): Promise<void> {
   // Start every download at once: onnxruntime and the simulation code now, the models as soon as
   // the manifest names them; the floor is drawn meanwhile.
   const runtime = loadRuntime();
-  const page = new Page(await loadManifest());
+  const loading = new LoadingBar();
+  const progress = new DownloadProgress((loaded, total) => {
+    hook.download = { loaded, total };
+    loading.update(loaded, total);
+  });
+  const wasm = fetchWasm(progress);
+  wasm.catch(() => undefined); // reported where it is awaited
+  const manifest = await loadManifest();
+  registerOffline(assetVersion(manifest));
+  const page = new Page(manifest, progress, loading);
   page.startLoop();
-  await page.attach(await runtime);
+  const [modules, wasmBytes] = await Promise.all([runtime, wasm]);
+  await page.attach(modules, wasmBytes);
 }
 
 start().catch(showError);

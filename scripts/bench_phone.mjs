@@ -1,0 +1,142 @@
+// `npm run bench -- --phone`: the built site as a phone on a mobile network sees it. Serves dist/
+// with scripts/serve.mjs (precompressed files, COOP/COEP) and drives headless Chromium with the
+// throttling web performance audits use for phones: 4× slower CPU (Emulation.setCPUThrottlingRate),
+// 9 Mbit/s down and 40 ms round trips (Network.emulateNetworkConditions), a 412 × 823 touch screen.
+//
+// Prints, for a cold first visit: first paint, the drawn loading scene (floor + standing pair +
+// loading bar: window.duet.sceneMs), the first dancing frame (window.duet.firstFrameMs); the same
+// for a repeat visit with the service worker warm; the model step median at 4× CPU; and frames per
+// second drawing both dancers as skinned bodies and as ?bodies=sticks (skipped when the page has
+// no window.duet.bodies).
+//
+// CPU throttling applies to the page's main thread; onnxruntime's second thread (a worker) and
+// Chromium's software WebGL run unthrottled, so the step and frame-rate numbers flatter a phone.
+
+import { build, launch, sleep } from '../tests/e2e/harness.mjs';
+import { serve } from './serve.mjs';
+
+const PHONE = { viewport: { width: 412, height: 823 }, deviceScaleFactor: 1.75, isMobile: true, hasTouch: true };
+const NETWORK = { offline: false, latency: 40, downloadThroughput: (9e6 / 8) | 0, uploadThroughput: (1.6e6 / 8) | 0 };
+const TARGETS = { sceneMs: 1500, firstFrameMs: 6000, repeatMs: 2000, stepMs: 6 };
+
+async function throttle(page) {
+  const cdp = await page.context().newCDPSession(page);
+  await cdp.send('Network.enable');
+  await cdp.send('Network.emulateNetworkConditions', NETWORK);
+  await cdp.send('Emulation.setCPUThrottlingRate', { rate: 4 });
+  return cdp;
+}
+
+/** Load `url` and wait for the first dancing frame; the page's own timings, ms from navigation. */
+async function visit(page, url, timeoutMs = 90_000) {
+  await page.goto(url, { waitUntil: 'commit' });
+  await page.waitForFunction(() => window.duet && (window.duet.firstFrameMs || window.duet.error), null, { timeout: timeoutMs, polling: 50 });
+  return page.evaluate(() => {
+    const paint = Object.fromEntries(performance.getEntriesByType('paint').map((e) => [e.name, e.startTime]));
+    const transferred = performance.getEntriesByType('resource').reduce((sum, e) => sum + e.transferSize, 0) +
+      (performance.getEntriesByType('navigation')[0]?.transferSize ?? 0);
+    return {
+      error: window.duet.error,
+      firstPaintMs: paint['first-paint'] ?? null,
+      firstContentfulPaintMs: paint['first-contentful-paint'] ?? null,
+      sceneMs: window.duet.sceneMs ?? null,
+      firstFrameMs: window.duet.firstFrameMs,
+      download: window.duet.download ?? null,
+      transferredBytes: transferred,
+      controlled: !!navigator.serviceWorker?.controller,
+      threads: window.duet.threads,
+    };
+  });
+}
+
+/** Entries the service worker has stored, once it holds the wasm and the models (or after 60 s). */
+async function waitOfflineCache(page) {
+  const deadline = Date.now() + 60_000;
+  for (;;) {
+    const urls = await page.evaluate(async () => {
+      const all = [];
+      for (const name of await caches.keys()) for (const r of await (await caches.open(name)).keys()) all.push(r.url);
+      return all;
+    });
+    const wasm = urls.some((u) => u.endsWith('.wasm'));
+    const models = urls.filter((u) => u.endsWith('.onnx')).length;
+    if ((wasm && models >= 2) || Date.now() > deadline) return urls;
+    await sleep(250);
+  }
+}
+
+async function framesPerSecond(page, url, ms = 4000) {
+  await page.goto(url);
+  await page.waitForFunction(() => window.duet && (window.duet.ready || window.duet.error), null, { timeout: 90_000, polling: 50 });
+  const bodies = await page.evaluate(() => window.duet.bodies ?? null);
+  await sleep(1000);
+  const fps = await page.evaluate(
+    (duration) =>
+      new Promise((resolve) => {
+        let frames = 0;
+        const start = performance.now();
+        const tick = () => (++frames, performance.now() - start < duration ? requestAnimationFrame(tick) : resolve((frames * 1000) / (performance.now() - start)));
+        requestAnimationFrame(tick);
+      }),
+    ms,
+  );
+  return { bodies, fps };
+}
+
+export async function benchPhone({ json = false, seconds = 14 } = {}) {
+  await build('dist');
+  const server = await serve({ dir: 'dist' });
+  const browser = await launch(PHONE);
+  const result = {};
+  try {
+    const { page } = browser;
+    await throttle(page);
+    const url = `${server.url}?seed=1`;
+    result.cold = await visit(page, url);
+    result.cached = (await waitOfflineCache(page)).length;
+    result.repeat = await visit(page, url);
+
+    // Step time at 4× CPU while steering, on the warm page.
+    await page.keyboard.down('ArrowUp');
+    await sleep((seconds * 1000) / 2);
+    await page.keyboard.up('ArrowUp');
+    await sleep((seconds * 1000) / 2);
+    result.stepMs = await page.evaluate(() => window.duet.stepMs);
+
+    result.fps = {
+      skinned: await framesPerSecond(page, url),
+      sticks: await framesPerSecond(page, `${url}&bodies=sticks`),
+    };
+    result.consoleErrors = browser.consoleErrors;
+  } finally {
+    await browser.close();
+    await server.stop();
+  }
+
+  if (json) {
+    console.log(JSON.stringify(result, null, 1));
+    return result;
+  }
+  const s = (ms) => (ms === null || ms === undefined ? '   —  ' : `${(ms / 1000).toFixed(2)} s`);
+  const mark = (value, target) => (value !== null && value !== undefined && value <= target ? 'ok' : 'MISSED');
+  const { cold, repeat } = result;
+  console.log('\nphone profile: CPU 4× slower, 9 Mbit/s down, 40 ms RTT, 412×823 @1.75, scripts/serve.mjs (br/gzip, COOP/COEP)');
+  console.log(`first visit (${(cold.transferredBytes / 1e6).toFixed(2)} MB over the wire, ${cold.threads} threads)`);
+  console.log(`  first paint              ${s(cold.firstPaintMs)}  (first contentful ${s(cold.firstContentfulPaintMs)})`);
+  console.log(`  loading scene drawn      ${s(cold.sceneMs)}  target ≤ ${s(TARGETS.sceneMs)}  ${mark(cold.sceneMs, TARGETS.sceneMs)}`);
+  console.log(`  first dancing frame      ${s(cold.firstFrameMs)}  target ≤ ${s(TARGETS.firstFrameMs)}  ${mark(cold.firstFrameMs, TARGETS.firstFrameMs)}`);
+  console.log(`repeat visit (service worker ${repeat.controlled ? 'in control' : 'NOT in control'}, ${result.cached} files cached, ${(repeat.transferredBytes / 1e6).toFixed(2)} MB over the wire)`);
+  console.log(`  first paint              ${s(repeat.firstPaintMs)}`);
+  console.log(`  loading scene drawn      ${s(repeat.sceneMs)}`);
+  console.log(`  first dancing frame      ${s(repeat.firstFrameMs)}  target ≤ ${s(TARGETS.repeatMs)}  ${mark(repeat.firstFrameMs, TARGETS.repeatMs)}`);
+  console.log(`model step at 4× CPU       median ${result.stepMs.median.toFixed(2)} ms, p95 ${result.stepMs.p95.toFixed(2)} ms  target ≤ ${TARGETS.stepMs} ms  ${mark(result.stepMs.median, TARGETS.stepMs)}`);
+  const { skinned, sticks } = result.fps;
+  if (!skinned.bodies) {
+    console.log('drawing both dancers       skipped: this page has no window.duet.bodies (no skinned bodies / ?bodies=sticks switch yet)');
+  } else {
+    console.log(`drawing both dancers       ${skinned.bodies}: ${skinned.fps.toFixed(1)} fps   ${sticks.bodies}: ${sticks.fps.toFixed(1)} fps  (4× CPU, software WebGL)`);
+  }
+  if (cold.error || repeat.error) console.log(`page error: ${cold.error ?? repeat.error}`);
+  if (result.consoleErrors.length) console.log(`console errors: ${result.consoleErrors.join(' | ')}`);
+  return result;
+}

@@ -1,0 +1,81 @@
+// The built site's loading: precompressed files beside the large ones in dist/, served by
+// scripts/serve.mjs with the right encoding and MIME type; and while the models are still on their
+// way the page already shows the floor, the standing pair and a loading bar (not an empty page).
+
+import { after, before, test } from 'node:test';
+import assert from 'node:assert/strict';
+import { existsSync, readdirSync, statSync } from 'node:fs';
+import { join } from 'node:path';
+import { ROOT, build, duet, launch, waitReady } from './harness.mjs';
+import { serve } from '../../scripts/serve.mjs';
+
+const DIST = join(ROOT, 'dist');
+let server;
+let browser;
+
+before(async () => {
+  await build('dist');
+  server = await serve({ dir: DIST, base: '/duet/' });
+  browser = await launch();
+});
+
+after(async () => {
+  await browser?.close();
+  await server?.stop();
+});
+
+test('dist/ holds .br and .gz beside the wasm, the models and the scripts', () => {
+  const wasm = readdirSync(join(DIST, 'assets')).filter((f) => f.endsWith('.wasm'));
+  assert.equal(wasm.length, 1, `one wasm in dist/assets: ${wasm}`);
+  const large = [join('assets', wasm[0]), 'models/leader.onnx', 'models/follower.onnx', 'models/follower_ccm.onnx', 'index.html'];
+  for (const f of readdirSync(join(DIST, 'assets')).filter((f) => f.endsWith('.js') && statSync(join(DIST, 'assets', f)).size > 100_000)) large.push(join('assets', f));
+  for (const file of large) {
+    for (const suffix of ['.br', '.gz']) {
+      const path = join(DIST, file + suffix);
+      assert.ok(existsSync(path), `${file}${suffix} exists`);
+      assert.ok(statSync(path).size < statSync(join(DIST, file)).size, `${file}${suffix} is smaller than ${file}`);
+    }
+  }
+});
+
+test('serve.mjs sends brotli wasm as application/wasm with COOP/COEP', async () => {
+  const wasm = readdirSync(join(DIST, 'assets')).find((f) => f.endsWith('.wasm'));
+  const response = await fetch(`${server.url}assets/${wasm}`, { headers: { 'accept-encoding': 'br, gzip' } });
+  assert.equal(response.status, 200);
+  assert.equal(response.headers.get('content-type'), 'application/wasm');
+  assert.equal(response.headers.get('content-encoding'), 'br');
+  assert.equal(response.headers.get('cross-origin-embedder-policy'), 'require-corp');
+  assert.equal(Number(response.headers.get('content-length')), statSync(join(DIST, 'assets', `${wasm}.br`)).size);
+  assert.equal((await response.arrayBuffer()).byteLength, statSync(join(DIST, 'assets', wasm)).size);
+});
+
+test('before the models arrive: floor, standing pair and a loading bar; then it dances', async () => {
+  const { page } = browser;
+  let release;
+  const held = new Promise((resolve) => (release = resolve));
+  await page.route('**/models/*.onnx', async (route) => {
+    await held;
+    await route.continue();
+  });
+  try {
+    await page.goto(`${server.url}?seed=1`);
+    await page.waitForFunction(() => window.duet?.sceneMs, null, { timeout: 30_000, polling: 50 });
+    const loading = await duet(page);
+    assert.equal(loading.ready, false, 'still loading');
+    assert.equal(loading.error, null);
+    assert.ok(loading.download && loading.download.total > 10e6, `download total ${loading.download?.total}`);
+    assert.ok(loading.download.loaded < loading.download.total, 'models not in yet');
+    assert.equal(await page.locator('#loading').isVisible(), true, 'loading bar visible');
+    assert.equal(await page.locator('#loading .loading-bar').isVisible(), true);
+    // Only the help line for this device (a desktop: keys, not touch).
+    assert.equal(await page.locator('.help-keys').isVisible(), true);
+    assert.equal(await page.locator('.help-touch').isVisible(), false);
+    release();
+    await waitReady(page, 60_000);
+    assert.equal(await page.locator('#loading').isVisible(), false, 'loading bar gone once dancing');
+    assert.deepEqual(browser.consoleErrors, []);
+  } finally {
+    release();
+    await page.unroute('**/models/*.onnx');
+  }
+});
