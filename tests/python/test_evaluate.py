@@ -12,6 +12,10 @@ import numpy as np
 import pytest
 
 from training.evaluation import evaluate as E
+from training.evaluation.evaluate_inputs import load_eval_takes, window
+from training.evaluation.evaluate_rollouts import bend_plan
+from training.mirror.features import FUTURE_OFFSETS, follower_input, output_features
+from training.mirror.rollout import NOW
 
 from conftest import SMALL_TAKES
 
@@ -89,9 +93,9 @@ def test_codebook_error_comes_from_the_exported_files(result, exported, data3):
     from training.mirror.rollout import OnnxPolicy
     from training.learning.runs import load_run
     _, r = result
-    take = E.load_eval_takes(str(data3), [SMALL_TAKES["test"]], FRAMES, None)[0]
-    x = E.follower_input(take.lead, take.follow, take.frames).astype(np.float32)
-    y = E.output_features(take.follow, take.frames).astype(np.float32)
+    take = load_eval_takes(str(data3), [SMALL_TAKES["test"]], FRAMES, None)[0]
+    x = follower_input(take.lead, take.follow, take.frames).astype(np.float32)
+    y = output_features(take.follow, take.frames).astype(np.float32)
     run = load_run(exported["runs"] / "follower", str(exported["prepared"]))
     with torch.no_grad():
         target = run.model.logits(torch.from_numpy(x), torch.from_numpy(y)).target.numpy()
@@ -167,15 +171,15 @@ def test_bad_input_is_one_line_and_exit_2(exported, data3, tmp_path, capsys, cha
 def test_bend_plan_turns_and_shifts_the_future_keys(take_tracks):
     lead, _ = take_tracks
     t = 100
-    w = E.window(lead, t)
-    turned = E.window(lead, t)
-    E.bend_plan(turned, ("rot", 90.0))
-    keys = E.NOW + E.FUTURE_OFFSETS
-    rel, rel_t = w.root[keys] - w.root[E.NOW], turned.root[keys] - turned.root[E.NOW]
+    w = window(lead, t)
+    turned = window(lead, t)
+    bend_plan(turned, ("rot", 90.0))
+    keys = NOW + FUTURE_OFFSETS
+    rel, rel_t = w.root[keys] - w.root[NOW], turned.root[keys] - turned.root[NOW]
     np.testing.assert_allclose(np.linalg.norm(rel, axis=-1), np.linalg.norm(rel_t, axis=-1))
     # Turning by +90 degrees maps a direction (sin h, cos h) to (cos h, -sin h).
     np.testing.assert_allclose(rel_t, np.stack([rel[:, 1], -rel[:, 0]], -1), atol=1e-12)
-    np.testing.assert_array_equal(turned.root[:E.NOW + 1], w.root[:E.NOW + 1])   # past untouched
-    shifted = E.window(lead, t)
-    E.bend_plan(shifted, ("side", 0.6))
+    np.testing.assert_array_equal(turned.root[:NOW + 1], w.root[:NOW + 1])   # past untouched
+    shifted = window(lead, t)
+    bend_plan(shifted, ("side", 0.6))
     np.testing.assert_allclose(np.linalg.norm(shifted.root[keys[-1]] - w.root[keys[-1]]), 0.6)

@@ -11,8 +11,12 @@ import torch
 from training.mirror import features as feat
 from training.evaluation import metrics as M
 from training.evaluation import plots as P
+from training.evaluation.plots.codebook import FOLLOWER_IN, rotate_partner_future
+from training.evaluation.plots.common import FILES, per_frame_codebook_error
+from training.evaluation.plots.sweep import log_positions
+from training.evaluation.plots.tsne import evenly, knn_mixing, log_softmax_channels
 
-SL = P.FOLLOWER_IN["partner_trajectory_future"]
+SL = FOLLOWER_IN["partner_trajectory_future"]
 
 
 def _inputs(rng, n=7):
@@ -21,14 +25,14 @@ def _inputs(rng, n=7):
 
 def test_rotation_zero_is_identity(rng):
     x = _inputs(rng)
-    np.testing.assert_array_equal(P.rotate_partner_future(x, 0.0), x)
-    np.testing.assert_allclose(P.rotate_partner_future(x, 360.0), x, atol=1e-12)
+    np.testing.assert_array_equal(rotate_partner_future(x, 0.0), x)
+    np.testing.assert_allclose(rotate_partner_future(x, 360.0), x, atol=1e-12)
 
 
 def test_rotation_preserves_lengths_and_touches_only_the_future_path(rng):
     x = _inputs(rng)
     for deg in (30.0, -60.0, 137.0):
-        r = P.rotate_partner_future(x, deg)
+        r = rotate_partner_future(x, deg)
         keys, rk = x[:, SL].reshape(-1, feat.KEYS, 4), r[:, SL].reshape(-1, feat.KEYS, 4)
         for i in (0, 2):   # positions and forward directions
             np.testing.assert_allclose(np.linalg.norm(rk[..., i:i + 2], axis=-1),
@@ -39,8 +43,8 @@ def test_rotation_preserves_lengths_and_touches_only_the_future_path(rng):
         outside = np.ones(feat.INPUT_SIZE, bool)
         outside[SL] = False
         np.testing.assert_array_equal(r[:, outside], x[:, outside])
-        np.testing.assert_allclose(P.rotate_partner_future(r, -deg), x, atol=1e-12)
-    assert not np.shares_memory(P.rotate_partner_future(x, 10.0), x)
+        np.testing.assert_allclose(rotate_partner_future(r, -deg), x, atol=1e-12)
+    assert not np.shares_memory(rotate_partner_future(x, 10.0), x)
 
 
 def test_rotation_sense_matches_heading_convention():
@@ -49,7 +53,7 @@ def test_rotation_sense_matches_heading_convention():
     keys = np.zeros((feat.KEYS, 4))
     keys[:, 1], keys[:, 3] = np.arange(1, feat.KEYS + 1), 1.0       # straight ahead, facing ahead
     x[0, SL] = keys.reshape(-1)
-    r = P.rotate_partner_future(x, 90.0)[0, SL].reshape(feat.KEYS, 4)
+    r = rotate_partner_future(x, 90.0)[0, SL].reshape(feat.KEYS, 4)
     np.testing.assert_allclose(r[:, 0], np.arange(1, feat.KEYS + 1), atol=1e-12)
     np.testing.assert_allclose(r[:, 1], 0, atol=1e-12)
     h = math.atan2(r[0, 2], r[0, 3])
@@ -62,34 +66,34 @@ def test_per_frame_codebook_error_is_the_one_hot_mse(rng):
     e = t.copy()
     flip = rng.random((50, c)) < 0.3
     e[flip] = (e[flip] + 1) % d
-    per = P.per_frame_codebook_error(t, e, d)
+    per = per_frame_codebook_error(t, e, d)
     assert per.shape == (50,)
     assert per.mean() == pytest.approx(M.codebook_error(M.one_hot(t, d), M.one_hot(e, d)))
     np.testing.assert_allclose(per, 2 * flip.sum(1) / (c * d))
-    assert np.all(P.per_frame_codebook_error(t, t, d) == 0)
+    assert np.all(per_frame_codebook_error(t, t, d) == 0)
 
 
 def test_knn_mixing(rng):
     a, b = rng.normal(size=(150, 5)), rng.normal(size=(150, 5))
-    assert P.knn_mixing(a, b) == pytest.approx(1.0, abs=0.15)
-    assert P.knn_mixing(a, b + 100.0) == 0.0
+    assert knn_mixing(a, b) == pytest.approx(1.0, abs=0.15)
+    assert knn_mixing(a, b + 100.0) == 0.0
 
 
 def test_log_positions_and_log_softmax():
-    pos, zero = P.log_positions([0.0, 0.001, 0.01, 0.1])
+    pos, zero = log_positions([0.0, 0.001, 0.01, 0.1])
     assert zero == pytest.approx(1e-4)
     np.testing.assert_allclose(pos, [1e-4, 0.001, 0.01, 0.1])
-    pos, zero = P.log_positions([0.0])
+    pos, zero = log_positions([0.0])
     assert pos[0] == zero > 0
     logits = np.random.default_rng(0).normal(size=(3, 4 * 5)) * 5
-    ls = P.log_softmax_channels(logits, 4).reshape(3, 4, 5)
+    ls = log_softmax_channels(logits, 4).reshape(3, 4, 5)
     np.testing.assert_allclose(np.exp(ls).sum(-1), 1.0)
-    np.testing.assert_allclose(P.log_softmax_channels(logits + 7.0, 4), ls.reshape(3, -1))   # offset-free
+    np.testing.assert_allclose(log_softmax_channels(logits + 7.0, 4), ls.reshape(3, -1))   # offset-free
 
 
 def test_evenly():
-    assert list(P.evenly(5, 10)) == [0, 1, 2, 3, 4]
-    idx = P.evenly(972, 500)
+    assert list(evenly(5, 10)) == [0, 1, 2, 3, 4]
+    idx = evenly(972, 500)
     assert len(idx) == 500 and idx[0] == 0 and idx[-1] == 971 and np.all(np.diff(idx) > 0)
 
 
@@ -105,7 +109,7 @@ def test_main_without_inputs_exits_with_a_message(tmp_path, capsys):
     assert rc == 2
     assert "error: no figure could be made" in err
     assert "not found" in err and "Traceback" not in err
-    for f in P.FILES.values():
+    for f in FILES.values():
         assert f"skipped {f}" in err
     assert not (tmp_path / "out").exists()
 
@@ -136,8 +140,8 @@ def test_curves_and_sweep_from_partial_runs(tmp_path, capsys):
     rc = P.main(["--only", "curves,sweep", "--runs", str(runs), "--sweep", str(sweep), "--out", str(out)])
     text = capsys.readouterr().out
     assert rc == 0
-    assert (out / P.FILES["curves"]).stat().st_size > 10_000
-    assert (out / P.FILES["sweep"]).stat().st_size > 10_000
+    assert (out / FILES["curves"]).stat().st_size > 10_000
+    assert (out / FILES["sweep"]).stat().st_size > 10_000
     assert "λG 0 / λC 10 = 0:" in text and "λG 1 / λC 10 = 0.1:" in text
     assert "lg0.1/follower: no checkpoint yet" in text
     assert "(still training)" in text and "follower_small" in text   # listed as not available

@@ -208,34 +208,43 @@ def test_files_in_other_units(tmp_path, capsys):
     assert_nothing_written(tmp_path / "out")
 
 
-def test_tempo_copies_are_a_file_of_their_own_and_change_nothing_else(data3, prepared3, tmp_path):
+def test_tempo_copies_are_written_only_when_asked_for(data3, prepared3, tmp_path):
+    """prepare alone writes no tempo copies; --tempos alone writes them at 0.9x and 1.1x, in a file
+    of their own, and changes nothing else."""
+    from training.data.prepare import TEMPOS
     from training.data.prepared import load_mirror_flags, load_split
-    none = tmp_path / "none"
-    assert main(["--data", str(data3), "--prepared", str(none), "--validation", "12", "--test", "06",
-                 "--tempos", ""]) == 0
-    assert not (none / "train_tempo.npz").exists() and (prepared3 / "train_tempo.npz").exists()
+    copies = tmp_path / "copies"
+    assert main(["--data", str(data3), "--prepared", str(copies), "--validation", "12", "--test", "06",
+                 "--tempos"]) == 0
+    assert not (prepared3 / "train_tempo.npz").exists() and (copies / "train_tempo.npz").exists()
     # The recorded tempo's arrays and statistics are the same with or without the copies.
     for f in ("train.npz", "validation.npz", "test.npz", "stats.npz"):
-        with np.load(none / f) as a, np.load(prepared3 / f) as b:
+        with np.load(prepared3 / f) as a, np.load(copies / f) as b:
             for k in a.files:
                 np.testing.assert_array_equal(a[k], b[k])
-    with np.load(prepared3 / "train_tempo.npz") as z:
+    with np.load(copies / "train_tempo.npz") as z:
         tempos = z["tempo"]
-    plain = load_split(str(prepared3), "train", "follower")["input"]
-    more = load_split(str(prepared3), "train", "follower", tempo_copies=True)["input"]
+    assert sorted(set(tempos.tolist())) == pytest.approx(TEMPOS)
+    plain = load_split(str(copies), "train", "follower")["input"]
+    more = load_split(str(copies), "train", "follower", tempo_copies=True)["input"]
     # 0.9x plays longer (more samples), 1.1x shorter; the copies follow the recorded samples.
     assert (tempos == np.float32(0.9)).sum() > len(plain) > (tempos == np.float32(1.1)).sum() > 0
     assert len(more) == len(plain) + len(tempos) and np.array_equal(more[:len(plain)], plain)
-    assert len(load_mirror_flags(str(prepared3), tempo_copies=True)) == len(more)
+    assert len(load_mirror_flags(str(copies), tempo_copies=True)) == len(more)
 
 
-def test_a_tempo_recipe_without_copies_is_a_one_line_error(data3, tmp_path):
-    from training.data.prepared import TrainError, load_split
-    none = tmp_path / "none"
-    assert main(["--data", str(data3), "--prepared", str(none), "--validation", "12", "--test", "06",
-                 "--tempos", ""]) == 0
-    with pytest.raises(TrainError, match="tempo"):
-        load_split(str(none), "train", "follower", tempo_copies=True)
+def test_a_tempo_recipe_without_copies_says_to_prepare_with_tempos(prepared3, tmp_path, capsys):
+    from training.data.prepared import TrainError, load_mirror_flags, load_split
+    from training.learning.train import main as train_main
+    for read in (lambda: load_split(str(prepared3), "train", "follower", tempo_copies=True),
+                 lambda: load_mirror_flags(str(prepared3), tempo_copies=True)):
+        with pytest.raises(TrainError, match=r"train_tempo\.npz not found.*training\.data\.prepare .*--tempos"):
+            read()
+    # Training such a recipe stops with that one line, before any epoch.
+    assert train_main(["--model", "follower_tempo", "--smoke", "--prepared", str(prepared3),
+                       "--runs", str(tmp_path / "runs")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert "--tempos" in err[-1] and "train_tempo.npz" in err[-1]
 
 
 @pytest.mark.parametrize("bad", ["fast", "0.1", "3"])

@@ -1,10 +1,11 @@
 """python -m training.data.prepare: paired BVH takes -> feature arrays for training (git-ignored).
 
 Reads the BVH couples in --data; writes PREPARED/{train,validation,test}.npz (both roles, all phase
-offsets, mirrored copies in train), PREPARED/train_tempo.npz (the training couples time-warped to
---tempos, read only by recipes with tempo copies) and PREPARED/stats.npz (normalization, from the
-recorded tempo: recipes with and without the copies normalize alike), then prints frames per
-split and feature sizes.
+offsets, mirrored copies in train) and PREPARED/stats.npz (normalization, from the recorded tempo:
+recipes with and without tempo copies normalize alike), then prints frames per split and feature
+sizes. With --tempos it also writes PREPARED/train_tempo.npz, the training couples time-warped to
+those tempos (0.9,1.1 when the flag comes alone); only recipes with tempo copies read it, and no
+shipped model does, so it is not written unless asked for.
 """
 from __future__ import annotations
 
@@ -115,8 +116,9 @@ def main(argv=None) -> int:
     ap.add_argument("--test", default=",".join(TEST_TAKES), help="comma-separated takes")
     ap.add_argument("--leader", default=None, help="subject that leads (default: first by name)")
     ap.add_argument("--one-phase", action="store_true", help="use only phase 0 of 120 fps takes")
-    ap.add_argument("--tempos", default=",".join(map(str, TEMPOS)), metavar="LIST",
-                    help="training copies at these tempos, for recipes with tempo copies ('' for none)")
+    ap.add_argument("--tempos", nargs="?", default="", const=",".join(map(str, TEMPOS)), metavar="LIST",
+                    help="also write train_tempo.npz, the training couples at these tempos, for recipes "
+                         f"with tempo copies (alone: {','.join(map(str, TEMPOS))}; default: none)")
     args = ap.parse_args(argv)
     try:
         tempos = [float(t) for t in args.tempos.split(",") if t]

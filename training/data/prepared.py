@@ -23,14 +23,21 @@ def _unreadable(path: Path, e: Exception) -> TrainError:
                       f"({e.__class__.__name__}); re-run training.data.prepare")
 
 
+def require_tempo_copies(prepared: str) -> None:
+    """Tempo copies are written only on request (prepare --tempos): a recipe that trains on them
+    says how to get them instead of failing on a missing file."""
+    path = Path(prepared) / "train_tempo.npz"
+    if not path.exists():
+        raise TrainError(f"{path} not found: this recipe trains on tempo copies, which prepare writes only "
+                         f"when asked: run `python -m training.data.prepare --prepared {prepared} --tempos` first")
+
+
 def load_split(prepared: str, split: str, role: str, tempo_copies: bool = False) -> dict[str, np.ndarray]:
     """{"input", "output", "intention"} raw float32 arrays of one split and role; with
     `tempo_copies` the training split is followed by its time-warped copies (train_tempo.npz)."""
     if tempo_copies:
         a = load_split(prepared, split, role)    # the recorded samples first (and their checks)
-        if not (Path(prepared) / "train_tempo.npz").exists():
-            raise TrainError(f"{Path(prepared) / 'train_tempo.npz'} not found: this recipe trains on tempo "
-                             f"copies; re-run training.data.prepare (with its default --tempos)")
+        require_tempo_copies(prepared)
         b = load_split(prepared, "train_tempo", role)
         return {k: np.concatenate([a[k], b[k]]) for k in a}
     path = Path(prepared) / f"{split}.npz"
@@ -92,6 +99,8 @@ def load_offsets(prepared: str, role: str, device) -> torch.Tensor:
 def load_mirror_flags(prepared: str, tempo_copies: bool = False) -> np.ndarray:
     """Per training sample (in load_split's order): True where it is a mirrored copy (its
     skeleton is mirrored too)."""
+    if tempo_copies:
+        require_tempo_copies(prepared)
     files = ["train.npz"] + (["train_tempo.npz"] if tempo_copies else [])
     flags = []
     for f in files:

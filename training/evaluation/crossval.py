@@ -130,8 +130,9 @@ def evaluate_job(data: str, where: str, fold: dict, runs: list[str], eval_seeds:
     takes (WHERE/eval_RUN/metrics.json); what exists is kept. Methods are evaluated one by one:
     a method's numbers do not depend on the others (same seeds, same reference)."""
     import torch
-    from . import evaluate
     from ..learning import export
+    from . import evaluate
+    from .evaluate_inputs import NAMES
     torch.set_num_threads(1)
     where = Path(where)
     for run in runs:
@@ -145,7 +146,7 @@ def evaluate_job(data: str, where: str, fold: dict, runs: list[str], eval_seeds:
             "--data", data, "--takes", ",".join(fold["test"]), "--models", str(models),
             "--train-takes", ",".join(fold["train"]), "--conditions", "", "--seeds", eval_seeds,
             "--temperatures", "0.5", "--encoder-cache", str(where.parent / "eval_encoder"),
-            "--out", str(where / f"eval_{run}"), "--quiet", "--methods", evaluate.NAMES.get(run, run)]
+            "--out", str(where / f"eval_{run}"), "--quiet", "--methods", NAMES.get(run, run)]
             + (["--encoder-epochs", "2"] if smoke else []))
         if code:
             raise CrossvalError(f"evaluation of {run} failed in {where} (see {where / 'evaluate.log'})")
@@ -211,7 +212,7 @@ def run_crossval(args) -> dict:
 
 
 def report(out: Path, plan: dict, seconds: float, name: str = "crossval") -> dict:
-    from .evaluate import NAMES
+    from .evaluate_inputs import NAMES
     methods, seeds = plan["methods"], plan["seeds"]
     values: dict[str, dict] = {m: {} for m in methods}
     for f in plan["folds"]:

@@ -34,8 +34,9 @@ from ..mirror import features as feat
 from . import metrics as M
 from ..mirror.contact import ContactLayer
 from ..data.dataset import DataError
-from .evaluate import (EvalError, EvalTake, find_models, load_eval_takes, load_onnx, rollout, window,
-                       write_report)
+from .evaluate_inputs import EvalError, EvalTake, find_models, load_eval_takes, load_onnx, window
+from .evaluate_report import write_report
+from .evaluate_rollouts import rollout
 from ..mirror.features import HISTORY, follower_input, foot_contacts
 from ..data.folders import add_folder
 from .motion_matching import build, load_tracks, training_takes
