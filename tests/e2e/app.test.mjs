@@ -213,6 +213,71 @@ describe('phone', () => {
     assert.deepEqual(viewport, [0, 1]);
   });
 
+  test('plain words: every control is explained in the help, research terms only in its details fold', async () => {
+    await page.goto(`${server.url}?seed=1`);
+    await waitReady(page, 60_000);
+    await page.locator('.help-button').click();
+    await page.locator('.help-overlay').waitFor({ state: 'visible', timeout: 5000 });
+    const seen = await page.evaluate(() => {
+      const help = document.querySelector('.help-overlay').textContent;
+      const fold = document.querySelector('.about-details');
+      // Every control of the panel (folders included), open or folded.
+      const labels = [...document.querySelectorAll('.duet-panel .lil-controller .lil-name')].map((e) => e.textContent.trim());
+      const options = [...document.querySelectorAll('.duet-panel select option')].map((o) => o.textContent);
+      // Text a visitor can see: visible text nodes outside the details fold, and the menu's options.
+      const visible = [];
+      const walker = document.createTreeWalker(document.body, NodeFilter.SHOW_TEXT);
+      for (let node = walker.nextNode(); node; node = walker.nextNode()) {
+        const parent = node.parentElement;
+        if (!parent || fold.contains(parent) || parent.closest('script, style, noscript')) continue;
+        if (parent.checkVisibility({ visibilityProperty: true }) && node.textContent.trim()) visible.push(node.textContent.trim());
+      }
+      return { help, labels, options, visible: [...visible, ...options].join(' | '), fold: fold.textContent };
+    });
+    assert.ok(seen.labels.length >= 8, `panel labels: ${seen.labels}`);
+    for (const label of seen.labels) {
+      const plain = label.replace('■ stop recording', '● record');
+      assert.ok(seen.help.includes(plain.replace(/ \(both dancers\)$/, '')), `the help explains "${label}"`);
+    }
+    assert.doesNotMatch(seen.visible, /temperature|ghost|CCM|p95|threads?\b|leashed|FID/i, 'research terms outside the details fold');
+    // ...and they are one click away, in the fold.
+    assert.match(seen.fold, /CCM/);
+    assert.match(seen.fold, /temperature/);
+    await page.locator('.about-details summary').click();
+    assert.match(await page.locator('.engine-figures').textContent(), /step [\d.]+ ms \(p95/);
+    await page.locator('.help-close').click();
+    await page.locator('.help-overlay').waitFor({ state: 'hidden', timeout: 5000 });
+  });
+
+  test('phone layout: title, legend and panel clear of each other and of the dancers (docs/screenshot-phone-panel.png)', async () => {
+    const boxes = async () =>
+      page.evaluate(() => {
+        const box = (selector) => {
+          const r = document.querySelector(selector).getBoundingClientRect();
+          return { x: r.left, y: r.top, w: r.width, h: r.height };
+        };
+        const canvas = box('canvas.stage');
+        // The middle 40 % of the canvas, where the camera keeps the dancers.
+        const centre = { x: canvas.x + 0.3 * canvas.w, y: canvas.y + 0.3 * canvas.h, w: 0.4 * canvas.w, h: 0.4 * canvas.h };
+        return { title: box('.title-row'), hud: box('.hud'), panel: box('.duet-panel'), centre, hudLines: Math.round(box('.hud').h / 16) };
+      });
+    const overlap = (a, b) => a.x < b.x + b.w && b.x < a.x + a.w && a.y < b.y + b.h && b.y < a.y + a.h;
+    const check = (b, state) => {
+      for (const [n1, n2] of [['title', 'hud'], ['title', 'panel'], ['hud', 'panel'], ['title', 'centre'], ['hud', 'centre'], ['panel', 'centre']]) {
+        assert.ok(!overlap(b[n1], b[n2]), `${state}: ${n1} ${JSON.stringify(b[n1])} overlaps ${n2} ${JSON.stringify(b[n2])}`);
+      }
+      assert.equal(b.hudLines, 1, `${state}: the legend is one line`);
+    };
+    check(await boxes(), 'panel folded');
+    await page.locator('.duet-panel > .lil-title').click();
+    await sleep(500); // lil-gui's open animation
+    assert.ok(await page.evaluate(() => !document.querySelector('.duet-panel').classList.contains('lil-closed')), 'panel opened');
+    check(await boxes(), 'panel open');
+    writeFileSync(join(ROOT, 'docs', 'screenshot-phone-panel.png'), await page.screenshot());
+    await page.locator('.duet-panel > .lil-title').click();
+    await sleep(500);
+  });
+
   test('phone screenshot is not blank', async () => {
     await waitSteps(page, 10);
     const png = await page.screenshot();

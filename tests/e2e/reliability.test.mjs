@@ -409,7 +409,7 @@ describe('Content-Security-Policy and crafted URLs', () => {
     await waitSteps(page, 45);
     await page.keyboard.up('ArrowLeft');
     // A model loaded later (the CCM follower) goes through the same policy.
-    await page.locator('.lil-gui select').first().selectOption({ label: 'compare both' });
+    await page.locator('.lil-gui select').first().selectOption({ label: 'both, side by side' });
     await page.waitForFunction(() => window.duet.model === 'compare', null, { timeout: 60_000 });
     await waitSteps(page, 60);
     assert.equal((await duet(page)).error, null);
@@ -451,16 +451,17 @@ describe('Content-Security-Policy and crafted URLs', () => {
     // The panel shows the defaults: the manifest's temperature and the 'ours' follower.
     const defaultTemperature = (await (await fetch(`${server.url}models/manifest.json`)).json()).defaultTemperature;
     const panel = await page.evaluate(() => {
-      const controller = [...document.querySelectorAll('.lil-gui .lil-controller')].find((c) => c.querySelector('.lil-name')?.textContent === 'temperature');
+      // "variety" is the temperature (URL key temperature).
+      const controller = [...document.querySelectorAll('.lil-gui .lil-controller')].find((c) => c.querySelector('.lil-name')?.textContent === 'variety');
       const select = document.querySelector('.lil-gui select');
       return {
         temperature: controller?.querySelector('input')?.value, model: select?.selectedOptions[0]?.textContent,
-        note: select?.closest('.lil-controller')?.title,
+        note: document.querySelector('.about-details')?.textContent,
       };
     });
     assert.equal(Number(panel.temperature), defaultTemperature);
-    assert.equal(panel.model, 'ours (intention)');
-    // The follower menu says what the intention adds on this data (docs/results.md).
+    assert.equal(panel.model, 'reads your intention');
+    // The help's details fold says what the intention adds on this data (docs/results.md).
     assert.match(panel.note ?? '', /cross-validation.*CCM/);
     // Nothing from the URL became markup: no element added, no dialog, no text of it in the DOM.
     assert.deepEqual(await page.evaluate(() => window.__injected), []);

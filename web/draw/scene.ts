@@ -13,6 +13,9 @@ export const COLORS = {
   leader: 0x2f6fe4,
   follower: 0xe0413a,
   compare: 0xf0a030,
+  /** The partner's guess of the leader's future (intentions): a colour of its own, so the guess
+   *  never reads as part of the red dancer. */
+  intention: 0x8a4fd8,
   floor: 0xe9e4dc,
   background: 0xf4f1ec,
 };
@@ -117,7 +120,9 @@ export class Stage {
   readonly ghosts: DancerMeshes;
   readonly trajectories: PathOverlay[];
   readonly intentions: PathOverlay[];
-  /** Leader, follower, compare follower: the indices of setHandContact. */
+  /** Compare mode: a copy of the leader dancing with the second follower, beside the first pair. */
+  readonly leaderCopy: DancerMeshes;
+  /** Leader, follower, compare follower, leader copy: the indices of setHandContact. */
   readonly dancers: DancerMeshes[];
   readonly contacts: ContactMarks;
 
@@ -173,7 +178,9 @@ export class Stage {
     const dancer = (color: number) => new DancerMeshes(parents, 1, solid(color), true);
     this.leader = dancer(COLORS.leader);
     this.followers = [dancer(COLORS.follower), dancer(COLORS.compare)];
-    this.dancers = [this.leader, ...this.followers];
+    this.leaderCopy = dancer(COLORS.leader);
+    this.leaderCopy.setCount(0);
+    this.dancers = [this.leader, ...this.followers, this.leaderCopy];
     this.contacts = new ContactMarks(this.dancers.length);
     const ghostMaterial = new THREE.MeshStandardMaterial({
       color: COLORS.follower,
@@ -183,11 +190,11 @@ export class Stage {
     });
     this.ghosts = new DancerMeshes(parents, Math.max(1, maxGhosts), ghostMaterial, false);
     this.ghosts.setCount(0);
-    this.scene.add(this.leader.group, this.ghosts.group, ...this.followers.map((f) => f.group), this.contacts.group);
+    this.scene.add(this.leader.group, this.ghosts.group, ...this.followers.map((f) => f.group), this.leaderCopy.group, this.contacts.group);
 
     // Trajectories: root + 6 future keys. Intentions: 5 key joints × 6 keys.
     this.trajectories = [COLORS.leader, COLORS.follower, COLORS.compare].map((c) => new PathOverlay(7, c));
-    this.intentions = [COLORS.follower, COLORS.compare].map((c) => new PathOverlay(30, c, 6));
+    this.intentions = [COLORS.intention, COLORS.intention].map((c) => new PathOverlay(30, c, 6));
     for (const overlay of [...this.trajectories, ...this.intentions]) this.scene.add(overlay.group);
 
     this.resize();

@@ -1,6 +1,10 @@
-// Heads-up numbers: how long a simulation step takes, how fast the page draws, how many WASM
-// threads run the models and how many bytes of model were downloaded. Updated a few times a
-// second with textContent (cheap, and never interprets markup).
+// Heads-up display: one line that says who is who (a colour legend, which also explains compare
+// mode), a status line ("loading models…", "paused"), and the engine's figures (step time, frame
+// rate, WASM threads, model bytes, guard counts) in an element the help overlay shows inside its
+// "about / details" fold. Updated a few times a second with textContent (cheap, and never
+// interprets markup).
+
+import type { FollowerChoice } from '../engine/types';
 
 export interface HudStats {
   stepMs: { median: number; p95: number };
@@ -11,20 +15,48 @@ export interface HudStats {
   guards: { resets: number; leashed: number };
 }
 
+/** Legend entries per follower choice: [colour class, words]. */
+const LEGENDS: Record<FollowerChoice, [string, string][]> = {
+  ours: [['you', 'you lead'], ['partner', 'partner follows']],
+  ccm: [['you', 'you lead'], ['partner', 'baseline partner']],
+  compare: [['you', 'you (twice)'], ['partner', 'reads your intention'], ['baseline', 'baseline']],
+};
+
 export class Hud {
-  private readonly element: HTMLElement;
+  private readonly legend: HTMLElement;
   private readonly status: HTMLElement;
+  /** The engine's figures; the help overlay moves this element into its details fold. */
+  readonly details: HTMLElement;
   private lastUpdate = 0;
+  private choice: FollowerChoice | null = null;
 
   constructor(parent: HTMLElement) {
-    this.element = document.createElement('div');
-    this.element.className = 'hud';
+    this.legend = document.createElement('div');
+    this.legend.className = 'hud';
     this.status = document.createElement('div');
     this.status.className = 'status';
-    parent.append(this.element, this.status);
+    this.status.hidden = true;
+    this.details = document.createElement('div');
+    this.details.className = 'engine-figures';
+    parent.append(this.legend, this.status);
+    this.setLegend('ours');
   }
 
-  /** A line under the numbers: "loading models…", "paused", or nothing. */
+  /** Who is who, for the follower choice on screen. */
+  setLegend(choice: FollowerChoice): void {
+    if (choice === this.choice) return;
+    this.choice = choice;
+    this.legend.replaceChildren(
+      ...LEGENDS[choice].map(([kind, words]) => {
+        const item = document.createElement('span');
+        item.className = `legend legend-${kind}`;
+        item.textContent = words;
+        return item;
+      }),
+    );
+  }
+
+  /** A line under the legend: "loading models…", "paused", or nothing. */
   setStatus(text: string): void {
     this.status.textContent = text;
     this.status.hidden = text === '';
@@ -34,9 +66,9 @@ export class Hud {
     if (now - this.lastUpdate < 250) return;
     this.lastUpdate = now;
     const { median, p95 } = stats.stepMs;
-    this.element.textContent =
+    this.details.textContent =
       `step ${median.toFixed(1)} ms (p95 ${p95.toFixed(1)})  ·  ${Math.round(stats.fps)} fps  ·  ` +
-      `${stats.threads} thread${stats.threads === 1 ? '' : 's'}  ·  models ${formatBytes(stats.modelBytes)}` +
+      `${stats.threads} WASM thread${stats.threads === 1 ? '' : 's'}  ·  models ${formatBytes(stats.modelBytes)}` +
       (stats.guards.resets || stats.guards.leashed
         ? `  ·  guards: ${stats.guards.resets} reset${stats.guards.resets === 1 ? '' : 's'}, ${stats.guards.leashed} leashed frames`
         : '');

@@ -19,6 +19,8 @@ import { Stage } from '../draw/scene';
 import { Controls } from './controls';
 import { Hud } from './hud';
 import { Panel } from './panel';
+import { CompareLayout } from './compare';
+import { ViewCentre } from './layout';
 import { LIMITS, type Settings, copyLink, defaultSettings, readSettings, writeSettings } from './share';
 import { FPS, type Motion } from '../mirror/skeleton';
 import { KEYS, N_KEY_JOINTS } from '../mirror/features';
@@ -120,6 +122,10 @@ class Page {
   private ghostPoses: Float32Array[] = [];
   private readonly leader = new DancerTrack();
   private readonly followers = [new DancerTrack(), new DancerTrack()];
+  /** Compare mode draws the second follower beside the first pair, with a copy of the leader. */
+  private readonly compare = new CompareLayout();
+  /** Centres the picture in what the open panel leaves visible. */
+  private readonly viewCentre: ViewCentre;
   /** Steps, resets and model switches must not overlap: they all go through this queue. */
   private queue: Promise<void> = Promise.resolve();
   private leaderFile: { motion: Motion; name: string } | null = null;
@@ -170,6 +176,7 @@ class Page {
       onReset: () => this.reset(),
     });
     const panel = this.createPanel();
+    this.viewCentre = new ViewCentre(panel.gui.domElement, () => !panel.gui._closed);
     this.recorder = new Recorder(MAX_RECORD_FRAMES, () =>
       showToast('Recording stopped', `It reached the ${formatDuration(MAX_RECORD_FRAMES / FPS)} limit. Download the take (“download BVH”).`, 'error', 15_000));
     this.leaderFileInput = new LeaderFileInput({
@@ -196,6 +203,7 @@ class Page {
       onGhosts: () => this.exclusive(() => this.refreshGhosts()).catch(this.fail),
       onReset: () => this.reset(),
       onShare: () => this.share(),
+      details: this.hud.details,
     });
   }
 
@@ -274,6 +282,8 @@ class Page {
       this.simulation = this.createSimulation!({ manifest: this.manifest, leader: leaderPolicy, followers: followerPolicies, seed: this.settings.seed });
       this.applyLeaderFile(); // a new simulation keeps the leader's file
       hook.model = choice;
+      this.compare.setActive(this.stage, choice === 'compare');
+      this.hud.setLegend(choice);
       this.accumulator = 0;
       this.capture(true);
       this.snapCamera();
@@ -400,18 +410,31 @@ class Page {
     // Until the models are in, the pair stands still in the start pose (this.still).
     const count = simulation ? simulation.followers.length : 1;
     stage.leader.setCount(1);
-    stage.leader.setPose(0, leader.interpolate(alpha), leader.interpolateRotations(alpha), leader.contacts);
+    const leaderPose = leader.interpolate(alpha), leaderRotations = leader.interpolateRotations(alpha);
+    stage.leader.setPose(0, leaderPose, leaderRotations, leader.contacts);
     // Hand glows: dancer 0 is the leader, 1 and 2 the followers (Stage.setHandContact).
     for (let h = 0; h < 2; h++) {
       stage.setHandContact(0, h, simulation ? leader.hands[h] : 0);
       for (let i = 0; i < stage.followers.length; i++) stage.setHandContact(i + 1, h, i < count ? followers[i].hands[h] : 0);
     }
+    const compare = this.compare;
+    compare.update(stage);
+    this.viewCentre.update(stage);
     for (let i = 0; i < stage.followers.length; i++) {
       stage.followers[i].setCount(i < count ? 1 : 0);
-      if (i < count) stage.followers[i].setPose(0, followers[i].interpolate(alpha), followers[i].interpolateRotations(alpha), followers[i].contacts);
+      if (i < count) {
+        const pose = followers[i].interpolate(alpha);
+        stage.followers[i].setPose(0, i > 0 ? compare.shiftPoints(pose, i) : pose, followers[i].interpolateRotations(alpha), followers[i].contacts);
+      }
     }
+    const copy = compare.active && count > 1;
+    stage.leaderCopy.setCount(copy ? 1 : 0);
+    if (copy) stage.leaderCopy.setPose(0, compare.shiftPoints(leaderPose, 0), leaderRotations, leader.contacts);
     this.drawOverlays(alpha, count);
-    if (simulation) stage.follow(0.5 * (leader.rootX(alpha) + followers[0].rootX(alpha)), 0.5 * (leader.rootZ(alpha) + followers[0].rootZ(alpha)), elapsed);
+    const midX = 0.5 * (leader.rootX(alpha) + followers[0].rootX(alpha)), midZ = 0.5 * (leader.rootZ(alpha) + followers[0].rootZ(alpha));
+    // In compare mode the camera looks between the two pairs.
+    if (simulation) stage.follow(midX + 0.5 * compare.offset.x, midZ + 0.5 * compare.offset.z, elapsed);
+    compare.placeLabels(stage, midX, midZ);
     stage.render();
   }
 
@@ -422,12 +445,14 @@ class Page {
       const overlay = stage.trajectories[i];
       const track = i === 0 ? leader : followers[i - 1];
       overlay.group.visible = settings.trajectories && this.simulation !== null && i <= count;
-      if (overlay.group.visible) overlay.setFloorPath(track.rootX(alpha), track.rootZ(alpha), track.future);
+      // The compare follower's path moves with it (compare.ts).
+      const dx = i > 1 ? this.compare.offset.x : 0, dz = i > 1 ? this.compare.offset.z : 0;
+      if (overlay.group.visible) overlay.setFloorPath(track.rootX(alpha) + dx, track.rootZ(alpha) + dz, i > 1 ? this.compare.shiftFloor(track.future, i) : track.future);
     }
     for (let i = 0; i < stage.intentions.length; i++) {
       const overlay = stage.intentions[i];
       overlay.group.visible = settings.intentions && i < count && followers[i].hasIntention;
-      if (overlay.group.visible) overlay.setKeyMajorPoints(followers[i].intention, KEYS, N_KEY_JOINTS);
+      if (overlay.group.visible) overlay.setKeyMajorPoints(i > 0 ? this.compare.shiftPoints(followers[i].intention, 10 + i) : followers[i].intention, KEYS, N_KEY_JOINTS);
     }
     const ghosts = settings.ghosts > 0 ? Math.min(this.ghostPoses.length, settings.ghosts) : 0;
     stage.ghosts.setCount(ghosts);

@@ -1,10 +1,13 @@
 // The settings panel (lil-gui). It edits the Settings object in place and tells main.ts what
-// changed; main.ts decides what that means for the simulation.
+// changed; main.ts decides what that means for the simulation. The Settings keys (and so the URL
+// keys of share links) keep their technical names; only the labels people read are plain words.
+// The panel also owns the "?" help overlay, whose text explains every label below.
 
 import GUI from 'lil-gui';
 import type { Settings } from './share';
 import { LIMITS } from './share';
 import type { FollowerChoice } from '../engine/types';
+import { Help } from './help';
 
 export interface PanelOptions {
   settings: Settings;
@@ -14,10 +17,12 @@ export interface PanelOptions {
   onGhosts(count: number): void;
   onReset(): void;
   onShare(): void;
+  /** Live engine figures (the HUD's details line): shown inside the help's "about / details" fold. */
+  details?: HTMLElement;
 }
 
 /** What the intention adds on this data, as measured (docs/results.md, "The paper's claim,
- * cross-validated by take" and "Proximity augmentation"); shown on the follower menu. */
+ * cross-validated by take" and "Proximity augmentation"); shown in the help's details fold. */
 export const INTENTION_NOTE =
   'Measured on the CMU salsa takes: the intention does not make the follower more accurate here ' +
   '(6-fold cross-validation: same pose error as CCM within 0.1 cm; CCM has the better FID). ' +
@@ -25,26 +30,64 @@ export const INTENTION_NOTE =
   "the leader's hands more often than CCM (28.7 % against 22.0 % of frames) and its leader turns faster " +
   '(0.51 against 0.59 s). Details: docs/results.md.';
 
+/** The partner menu: plain names first; the research names live in the details fold. */
+export const MODEL_LABELS: Record<FollowerChoice, string> = {
+  ours: 'reads your intention',
+  ccm: 'baseline, no intention',
+  compare: 'both, side by side',
+};
+
+/** Every control's label and its one-sentence explanation (the help overlay lists them all). */
+export const CONTROLS = {
+  model: ['partner', 'Which network dances with you: one that first guesses where your body is going (your intention), a baseline that does not, or both side by side with a copy of you each.'],
+  temperature: ['variety', 'Low: the partner always makes its most likely move; high: it picks more varied, sometimes wilder moves.'],
+  speed: ['speed', 'Plays the whole dance slower or faster.'],
+  ghosts: ['possible reactions', 'Faint extra partners, each another move the partner could have made right now.'],
+  trajectories: ['floor paths', "Each dancer's path on the floor, a second ahead."],
+  intentions: ['show what the partner expects', "Purple lines: where the partner expects your head, hands and feet to go over the next second."],
+  reset: ['start again (R)', 'Both dancers go back to the opening pose.'],
+  share: ['copy link to this view', 'Copies a link that opens the page with these settings and this camera.'],
+  skeleton: ['skeleton', 'Shows the thin bones inside each body.'],
+  record: ['● record', 'Records both dancers; press again to stop.'],
+  download: ['download BVH', 'Saves the recording as one motion file per dancer (for Blender and other animation tools).'],
+  open: ['leader from BVH file…', 'Your dancer plays a motion file instead of following your keys (you can also drop the file on the page).'],
+  leaderModel: ['leader back to model', 'Gives your dancer back to your keys or thumb.'],
+} as const satisfies Record<string, readonly [string, string]>;
+
+const [label, help] = [(k: keyof typeof CONTROLS) => CONTROLS[k][0], (k: keyof typeof CONTROLS) => CONTROLS[k][1]];
+
 export class Panel {
   readonly gui: GUI;
+  readonly help: Help;
 
   constructor(options: PanelOptions) {
     const { settings } = options;
-    this.gui = new GUI({ title: 'duet' });
-    // Phones: start folded so the dancers are visible.
-    if (window.matchMedia('(max-width: 600px)').matches) this.gui.close();
+    // "settings", not "duet": the page title already says duet, and on a phone both sit on screen.
+    this.gui = new GUI({ title: 'settings' });
+    this.gui.domElement.classList.add('duet-panel');
+    // Phones: start folded so the dancers are visible (the panel is a bottom sheet there).
+    if (window.matchMedia('(max-width: 600px), (max-height: 500px)').matches) this.gui.close();
+    this.gui.onOpenClose((gui) => {
+      if (gui === this.gui) document.body.classList.toggle('panel-open', !gui._closed);
+    });
+    document.body.classList.toggle('panel-open', !this.gui._closed);
 
-    const labels: Record<FollowerChoice, string> = { ours: 'ours (intention)', ccm: 'CCM (no intention)', compare: 'compare both' };
-    const choices = Object.fromEntries(options.models.map((m) => [labels[m], m]));
-    const model = this.gui.add(settings, 'model', choices).name('follower').onChange((m: FollowerChoice) => options.onModel(m));
-    model.domElement.title = INTENTION_NOTE;
-    this.gui.add(settings, 'temperature', ...LIMITS.temperature, 0.05).name('temperature');
-    this.gui.add(settings, 'speed', ...LIMITS.speed, 0.25).name('speed');
-    this.gui.add(settings, 'ghosts', ...LIMITS.ghosts, 1).name('ghost samples').onChange((k: number) => options.onGhosts(k));
-    this.gui.add(settings, 'trajectories').name('trajectories');
-    this.gui.add(settings, 'intentions').name('intentions');
-    this.gui.add({ reset: options.onReset }, 'reset').name('reset (R)');
-    this.gui.add({ share: options.onShare }, 'share').name('copy share link');
+    const choices = Object.fromEntries(options.models.map((m) => [MODEL_LABELS[m], m]));
+    const model = this.gui.add(settings, 'model', choices).name(label('model')).onChange((m: FollowerChoice) => options.onModel(m));
+    model.domElement.title = help('model');
+    this.gui.add(settings, 'temperature', ...LIMITS.temperature, 0.05).name(label('temperature'));
+    this.gui.add(settings, 'speed', ...LIMITS.speed, 0.25).name(label('speed'));
+    this.gui.add(settings, 'ghosts', ...LIMITS.ghosts, 1).name(label('ghosts')).onChange((k: number) => options.onGhosts(k));
+    this.gui.add(settings, 'trajectories').name(label('trajectories'));
+    this.gui.add(settings, 'intentions').name(label('intentions'));
+    this.gui.add({ reset: options.onReset }, 'reset').name(label('reset'));
+    this.gui.add({ share: options.onShare }, 'share').name(label('share'));
+
+    this.help = new Help({
+      controls: Object.values(CONTROLS),
+      note: INTENTION_NOTE,
+      details: options.details,
+    });
   }
 
   /** Show values changed from elsewhere (keyboard, URL). */

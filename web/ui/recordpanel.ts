@@ -6,6 +6,7 @@ import type { Controller } from 'lil-gui';
 import { type RecordableDuet, type Recorder, formatDuration, timestamp } from './record';
 import { downloadText } from './download';
 import { FPS } from '../mirror/skeleton';
+import { CONTROLS } from './panel';
 
 export interface RecordPanelOptions {
   gui: GUI;
@@ -16,8 +17,8 @@ export interface RecordPanelOptions {
   duet(): RecordableDuet | null;
   /** Run a task between simulation steps (main.ts's exclusive queue). */
   between(task: () => void): Promise<void>;
-  /** A short message for people (toast.ts showToast). */
-  notify(title: string, detail: string, kind: 'info' | 'error'): void;
+  /** A short message for people (toast.ts showToast); returns the toast so it can be taken back. */
+  notify(title: string, detail: string, kind: 'info' | 'error'): HTMLElement | void;
   onOpenLeaderFile(): void;
   onLeaderModel(): void;
 }
@@ -30,10 +31,12 @@ export class RecordPanel {
   private leaderFile: string | null = null;
   private lastText = '';
   private lastLabel = '';
+  /** This panel's last complaint ("Nothing recorded yet", "Not yet"): stale once a take starts. */
+  private complaint: HTMLElement | null = null;
 
   constructor(private readonly options: RecordPanelOptions) {
     const { gui } = options;
-    this.folder = gui.addFolder('record · leader file');
+    this.folder = gui.addFolder('record · play a file');
     const actions = {
       record: () => this.toggle(),
       download: () => this.download(),
@@ -41,9 +44,9 @@ export class RecordPanel {
       model: () => options.onLeaderModel(),
     };
     this.recordButton = this.folder.add(actions, 'record');
-    this.folder.add(actions, 'download').name('download BVH (leader + follower)');
-    this.folder.add(actions, 'open').name('leader from BVH file…');
-    this.modelButton = this.folder.add(actions, 'model').name('leader back to model').disable();
+    this.folder.add(actions, 'download').name(`${CONTROLS.download[0]} (both dancers)`);
+    this.folder.add(actions, 'open').name(CONTROLS.open[0]);
+    this.modelButton = this.folder.add(actions, 'model').name(CONTROLS.leaderModel[0]).disable();
     this.indicator = document.createElement('div');
     this.indicator.className = 'record-status';
     this.indicator.hidden = true;
@@ -61,7 +64,7 @@ export class RecordPanel {
   /** Refresh the button label and the indicator (cheap; call after steps). */
   update(): void {
     const { recorder } = this.options;
-    const label = recorder.recording ? '■ stop recording' : '● record';
+    const label = recorder.recording ? '■ stop recording' : CONTROLS.record[0];
     if (label !== this.lastLabel) this.recordButton.name((this.lastLabel = label));
     const lines: string[] = [];
     if (recorder.recording) lines.push(`● REC ${formatDuration(recorder.seconds)}`);
@@ -86,7 +89,7 @@ export class RecordPanel {
     }
     const duet = this.options.duet();
     if (!duet) {
-      notify('Not yet', 'The dancers are still loading; record once they move.', 'error');
+      this.complain(notify('Not yet', 'The dancers are still loading; record once they move.', 'error'));
       return;
     }
     if (recorder.frames > 0 && !recorder.saved &&
@@ -95,9 +98,18 @@ export class RecordPanel {
     }
     this.options.between(() => {
       const current = this.options.duet();
-      if (current) recorder.start(current);
+      if (current) {
+        recorder.start(current);
+        this.complain(null); // "nothing recorded yet" is no longer true
+      }
       this.update();
     }).catch((error) => notify('Could not record', String((error as Error)?.message ?? error), 'error'));
+  }
+
+  /** Replace this panel's standing complaint (or just take it back, with null). */
+  private complain(toast: HTMLElement | void | null): void {
+    this.complaint?.remove();
+    this.complaint = toast ?? null;
   }
 
   download(): void {
@@ -110,7 +122,7 @@ export class RecordPanel {
       return;
     }
     if (!files) {
-      notify('Nothing recorded yet', 'Press “● record”, dance a little, then download.', 'error');
+      this.complain(notify('Nothing recorded yet', 'Press “● record”, dance a little, then download.', 'error'));
       return;
     }
     const stamp = timestamp();
