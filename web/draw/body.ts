@@ -1,9 +1,12 @@
-// How a dancer is drawn: capsules for the limbs (cylinders capped by joint spheres), plus six
+// How a dancer is drawn. By default a skinned character (SkinnedDancer: the geometry and the bone
+// matrices are in figure.ts); with ?bodies=sticks, and for the translucent ghosts, the capsule
+// figure (DancerMeshes): capsules for the limbs (cylinders capped by joint spheres), plus six
 // oriented ellipsoids that make hands, feet and facing readable at a glance: a mitten per hand, a
 // shoe per foot and a nose + visor on the head. The ellipsoids are extra instances of the joint
 // spheres (one geometry, one material, per-instance colour), so they cost no draw call; the floor
 // rings under planted feet and the glow at a hand in contact are one instanced mesh each for all
-// dancers (ContactMarks), drawn only while something is in contact.
+// dancers (ContactMarks), drawn only while something is in contact. A skinned dancer carries a thin
+// capsule figure too: the skeleton overlay, and the source of its contact points.
 //
 // Orientation comes from the simulation's world joint rotations when the view has them (columns
 // of the row-major 3x3: a foot's and the head's local z is forward, a left hand's local +x and a
@@ -12,7 +15,8 @@
 // hands along the forearm. Nothing here allocates per frame.
 
 import * as THREE from 'three';
-import { HEAD, JOINT_NAMES } from '../mirror/skeleton';
+import { HEAD, JOINT_NAMES, N_JOINTS } from '../mirror/skeleton';
+import { type FigureStyle, bindPositions, buildFigure, poseBones } from './figure';
 
 const JOINT_RADIUS = 0.055;
 const HEAD_RADIUS = 0.11;
@@ -72,11 +76,28 @@ export interface ContactState {
   readonly handContact: Float32Array;
 }
 
+/** What the stage and the page need of a dancer, whichever way it is drawn. */
+export interface DancerBody extends ContactState {
+  readonly group: THREE.Group;
+  readonly color: THREE.Color;
+  setCount(count: number): void;
+  setPose(index: number, positions: ArrayLike<number>, rotations?: ArrayLike<number> | null, contacts?: ArrayLike<number> | null): void;
+}
+
+/** How the dancers are drawn: skinned characters (the default) or the capsule figures. */
+export type Bodies = 'skinned' | 'sticks';
+
+/** `?bodies=sticks` draws the capsule figures; `?skeleton=1` shows the skeleton over the bodies. */
+export function readBodies(search: string): { bodies: Bodies; skeleton: boolean } {
+  const query = new URLSearchParams(search);
+  return { bodies: query.get('bodies') === 'sticks' ? 'sticks' : 'skinned', skeleton: query.get('skeleton') === '1' };
+}
+
 /** Several dancers of one look, drawn with two instanced meshes (joint spheres + bone cylinders):
  *  a chain of cylinders capped by spheres at the joints is a chain of capsules, and instancing
  *  keeps it at two draw calls however many ghosts are shown. Hands, feet and the face are extra
  *  sphere instances, scaled and turned into ellipsoids. */
-export class DancerMeshes implements ContactState {
+export class DancerMeshes implements DancerBody {
   readonly group = new THREE.Group();
   readonly feet = new Float32Array(4);
   readonly footContact = new Float32Array(2);
@@ -95,6 +116,8 @@ export class DancerMeshes implements ContactState {
     readonly capacity: number,
     material: THREE.Material,
     castShadow: boolean,
+    /** Radii and shapes scale by this (the skeleton overlay is a thin copy); contact points do not. */
+    private readonly thickness = 1,
   ) {
     // The joints' copy of the material is white: the instance colours carry the dancer's colour
     // and its lighter hands, darker feet and face (same shader, so no extra program).
@@ -148,7 +171,7 @@ export class DancerMeshes implements ContactState {
     const m = _matrix;
     const base = index * this.perDancer;
     for (let j = 0; j < this.jointCount; j++) {
-      const r = j === HEAD ? HEAD_RADIUS : JOINT_RADIUS;
+      const r = (j === HEAD ? HEAD_RADIUS : JOINT_RADIUS) * this.thickness;
       _position.set(positions[3 * j], positions[3 * j + 1], positions[3 * j + 2]);
       _scale.set(r, r, r);
       m.compose(_position, _identity, _scale);
@@ -164,7 +187,7 @@ export class DancerMeshes implements ContactState {
       if (length > 1e-6) _direction.divideScalar(length);
       else _direction.set(0, 1, 0);
       _rotation.setFromUnitVectors(_up, _direction);
-      _scale.set(BONE_RADIUS, length, BONE_RADIUS);
+      _scale.set(BONE_RADIUS * this.thickness, length, BONE_RADIUS * this.thickness);
       m.compose(_position, _rotation, _scale);
       this.bones.setMatrixAt(index * bones.length + b, m);
     }
@@ -229,7 +252,7 @@ export class DancerMeshes implements ContactState {
     shape: { half: readonly number[]; along: number; up: number }, floor: number,
   ): void {
     _r.crossVectors(_p, _q);
-    const [hp, hq, hr] = shape.half;
+    const [hp, hq, hr] = shape.half.map((h) => h * this.thickness);
     _centre.set(positions[3 * j], positions[3 * j + 1], positions[3 * j + 2]);
     _centre.addScaledVector(_p, shape.along).addScaledVector(_q, shape.up);
     // Keep a shoe's lowest point (of the ellipsoid, exactly) above the floor.
@@ -242,6 +265,85 @@ export class DancerMeshes implements ContactState {
       0, 0, 0, 1,
     );
     this.joints.setMatrixAt(instance, _matrix);
+  }
+}
+
+/**
+ * One dancer as a skinned character (figure.ts): one SkinnedMesh, one draw call, its 17 bones set
+ * every frame from the same joint positions and rotations the capsule figure takes. A thin capsule
+ * figure rides along: it is the optional skeleton overlay (drawn through the body), and its pose
+ * gives the contact marks their floor and hand points, exactly as with the capsule figures.
+ */
+export class SkinnedDancer implements DancerBody {
+  readonly group = new THREE.Group();
+  readonly color: THREE.Color;
+  readonly mesh: THREE.SkinnedMesh;
+  /** The thin skeleton drawn over the body when `skeleton` is on. */
+  readonly overlay: DancerMeshes;
+  private readonly bind: Float32Array;
+  private readonly bones: THREE.Bone[];
+  private readonly matrices = new Float32Array(16 * N_JOINTS);
+
+  constructor(parents: number[], offsets: readonly (readonly number[])[], style: FigureStyle, castShadow: boolean) {
+    this.color = new THREE.Color(style.color);
+    this.bind = bindPositions(offsets, parents);
+    const geometry = buildFigure(offsets, parents, style);
+    const material = new THREE.MeshStandardMaterial({ vertexColors: true, roughness: 0.7, metalness: 0.02 });
+    this.mesh = new THREE.SkinnedMesh(geometry, material);
+    // The bones are not in the scene graph: their world matrices are written directly in
+    // setPose(), and nothing else may recompute them.
+    this.bones = Array.from({ length: N_JOINTS }, () => {
+      const bone = new THREE.Bone();
+      bone.matrixAutoUpdate = false;
+      bone.matrixWorldAutoUpdate = false;
+      return bone;
+    });
+    // poseBones() gives each bone's whole bind -> drawn transform, so the inverses are identities.
+    const inverses = this.bones.map(() => new THREE.Matrix4());
+    this.mesh.bind(new THREE.Skeleton(this.bones, inverses), new THREE.Matrix4());
+    this.mesh.castShadow = castShadow;
+    this.mesh.receiveShadow = castShadow;
+    this.mesh.frustumCulled = false; // dancers move anywhere; the bind-pose bounds would cull them
+    const overlayMaterial = new THREE.MeshBasicMaterial({ color: this.color.clone().multiplyScalar(0.45), depthTest: false, transparent: true, opacity: 0.9 });
+    this.overlay = new DancerMeshes(parents, 1, overlayMaterial, false, 0.3);
+    this.overlay.group.renderOrder = 8;
+    for (const child of this.overlay.group.children) child.renderOrder = 8;
+    this.overlay.group.visible = false;
+    this.group.add(this.mesh, this.overlay.group);
+  }
+
+  get feet(): Float32Array { return this.overlay.feet; }
+  get footContact(): Float32Array { return this.overlay.footContact; }
+  get hands(): Float32Array { return this.overlay.hands; }
+  get handContact(): Float32Array { return this.overlay.handContact; }
+
+  /** Whether the thin skeleton shows over the body. */
+  get skeleton(): boolean {
+    return this.showSkeleton;
+  }
+  set skeleton(on: boolean) {
+    this.showSkeleton = on;
+    this.overlay.group.visible = on && this.group.visible;
+  }
+  private showSkeleton = false;
+
+  /** 0 or 1 (one dancer per SkinnedDancer). */
+  setCount(count: number): void {
+    this.group.visible = count > 0;
+    this.overlay.setCount(count > 0 ? 1 : 0);
+    this.overlay.group.visible = this.showSkeleton && count > 0;
+  }
+
+  setPose(index: number, positions: ArrayLike<number>, rotations?: ArrayLike<number> | null, contacts?: ArrayLike<number> | null): void {
+    if (index !== 0) return;
+    this.overlay.setPose(0, positions, rotations, contacts);
+    poseBones(this.bind, positions, rotations ?? null, this.matrices);
+    for (let j = 0; j < N_JOINTS; j++) this.bones[j].matrixWorld.fromArray(this.matrices, 16 * j);
+  }
+
+  /** Bone j's world matrix as last posed (for tests). */
+  boneMatrix(j: number): THREE.Matrix4 {
+    return this.bones[j].matrixWorld;
   }
 }
 
@@ -277,7 +379,7 @@ export class ContactMarks {
   }
 
   /** Rewrite every mark from the dancers' slot-0 contact state (invisible dancers skipped). */
-  update(dancers: readonly DancerMeshes[]): void {
+  update(dancers: readonly DancerBody[]): void {
     let rings = 0;
     let glows = 0;
     for (let d = 0; d < dancers.length && d < this.capacity; d++) {

@@ -1,13 +1,22 @@
-// The three.js scene: a floor, two dancers (capsules with hands, feet and a face: body.ts) and the
+// The three.js scene: a floor, two dancers (skinned characters, or capsule figures: body.ts) and the
 // contact marks under their feet, translucent ghosts, and line + dot overlays for trajectories and
 // intentions. Everything is created once; per frame we only write instance matrices and vertex
 // positions (no allocation in the draw loop).
 
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
-import { ContactMarks, DancerMeshes } from './body';
+import { type Bodies, ContactMarks, type DancerBody, DancerMeshes, SkinnedDancer } from './body';
 
 export { DancerMeshes } from './body';
+
+export interface StageOptions {
+  /** 'skinned' (needs `offsets`) or 'sticks'. */
+  bodies?: Bodies;
+  /** The manifest's bone offsets per role (manifest.skeleton.offsets). */
+  offsets?: { leader: number[][]; follower: number[][] };
+  /** Show the thin skeleton over the skinned bodies. */
+  skeleton?: boolean;
+}
 
 export const COLORS = {
   leader: 0x2f6fe4,
@@ -114,23 +123,25 @@ export class Stage {
   readonly controls: OrbitControls;
   readonly canvas: HTMLCanvasElement;
 
-  readonly leader: DancerMeshes;
+  readonly leader: DancerBody;
   /** Ours, and a second (orange) one in compare mode. */
-  readonly followers: DancerMeshes[];
+  readonly followers: DancerBody[];
+  /** How the leader and the followers are drawn (the ghosts are always capsule figures). */
+  readonly bodies: Bodies;
   readonly ghosts: DancerMeshes;
   readonly trajectories: PathOverlay[];
   readonly intentions: PathOverlay[];
   /** Compare mode: a copy of the leader dancing with the second follower, beside the first pair. */
-  readonly leaderCopy: DancerMeshes;
+  readonly leaderCopy: DancerBody;
   /** Leader, follower, compare follower, leader copy: the indices of setHandContact. */
-  readonly dancers: DancerMeshes[];
+  readonly dancers: DancerBody[];
   readonly contacts: ContactMarks;
 
   private readonly sun: THREE.DirectionalLight;
   private readonly floor: THREE.Mesh;
   private readonly followTarget = new THREE.Vector3(0, TARGET_HEIGHT, 0.4);
 
-  constructor(container: HTMLElement, parents: number[], maxGhosts: number) {
+  constructor(container: HTMLElement, parents: number[], maxGhosts: number, options: StageOptions = {}) {
     this.renderer = new THREE.WebGLRenderer({ antialias: true });
     // Phones report devicePixelRatio 3; 2 looks the same and costs less than half the pixels.
     this.renderer.setPixelRatio(Math.min(window.devicePixelRatio, 2));
@@ -175,12 +186,18 @@ export class Stage {
     this.scene.add(this.floor);
 
     const solid = (color: number) => new THREE.MeshStandardMaterial({ color, roughness: 0.55, metalness: 0.05 });
-    const dancer = (color: number) => new DancerMeshes(parents, 1, solid(color), true);
-    this.leader = dancer(COLORS.leader);
-    this.followers = [dancer(COLORS.follower), dancer(COLORS.compare)];
-    this.leaderCopy = dancer(COLORS.leader);
+    const offsets = options.offsets;
+    this.bodies = options.bodies === 'sticks' || !offsets ? 'sticks' : 'skinned';
+    const dancer = (color: number, kind: 'leader' | 'follower'): DancerBody =>
+      offsets && this.bodies === 'skinned'
+        ? new SkinnedDancer(parents, offsets[kind], { kind, color }, true)
+        : new DancerMeshes(parents, 1, solid(color), true);
+    this.leader = dancer(COLORS.leader, 'leader');
+    this.followers = [dancer(COLORS.follower, 'follower'), dancer(COLORS.compare, 'follower')];
+    this.leaderCopy = dancer(COLORS.leader, 'leader');
     this.leaderCopy.setCount(0);
     this.dancers = [this.leader, ...this.followers, this.leaderCopy];
+    this.skeleton = options.skeleton ?? false;
     this.contacts = new ContactMarks(this.dancers.length);
     const ghostMaterial = new THREE.MeshStandardMaterial({
       color: COLORS.follower,
@@ -201,6 +218,14 @@ export class Stage {
     window.addEventListener('resize', () => this.resize());
     // Layout changes that are not window resizes (mobile URL bar, panels) also change the size.
     new ResizeObserver(() => this.resize()).observe(container);
+  }
+
+  /** The thin skeleton over the skinned bodies (nothing to change with capsule figures). */
+  get skeleton(): boolean {
+    return this.dancers.some((d) => d instanceof SkinnedDancer && d.skeleton);
+  }
+  set skeleton(on: boolean) {
+    for (const d of this.dancers) if (d instanceof SkinnedDancer) d.skeleton = on;
   }
 
   resize(): void {

@@ -140,8 +140,9 @@ export interface DuetHook {
   error: string | null;
   /** Simulation steps taken since the page loaded (not reset by R). */
   frame: number;
-  leader: { root: [number, number]; heading: number };
-  follower: { root: [number, number]; heading: number };
+  /** `hip`: the drawn hip joint's height above the floor, metres. */
+  leader: { root: [number, number]; heading: number; hip?: number };
+  follower: { root: [number, number]; heading: number; hip?: number };
   /** step() wall time over the last 300 steps: features + both models + pose. */
   stepMs: { median: number; p95: number };
   /** Follower model in use: 'ours', 'ccm' or 'compare'. */
@@ -160,6 +161,8 @@ export interface DuetHook {
   sceneMs?: number | null;
   /** Bytes of the first dance's downloads (wasm + models), so far and in all. */
   download?: { loaded: number; total: number };
+  /** How the dancers are drawn: skinned characters, or capsule figures (?bodies=sticks). */
+  bodies?: 'skinned' | 'sticks';
 }
 
 declare global {

@@ -16,6 +16,7 @@ import { standingViews } from '../engine/standing';
 import { assetVersion, keepForOffline, registerOffline } from '../engine/offline';
 import { LoadingBar } from './loading';
 import { Stage } from '../draw/scene';
+import { readBodies } from '../draw/body';
 import { Controls } from './controls';
 import { Hud } from './hud';
 import { Panel } from './panel';
@@ -70,6 +71,7 @@ function publish(target: DuetHook['leader'], view: DancerView): void {
   target.root[0] = view.root[0];
   target.root[1] = view.root[1];
   target.heading = view.heading;
+  target.hip = view.positions[1]; // the drawn hip joint's height, metres
 }
 
 /**
@@ -158,7 +160,10 @@ class Page {
     for (const name of ['leader', ...FOLLOWER_MODELS[this.settings.model]]) this.download(name);
 
     // The floor is up while the models download: something to look at, never a blank canvas.
-    this.stage = new Stage(document.getElementById('app')!, manifest.skeleton.parents, MAX_GHOSTS);
+    // Skinned characters unless ?bodies=sticks (the bench compares both); ?skeleton=1 overlays the bones.
+    const look = readBodies(location.search);
+    this.stage = new Stage(document.getElementById('app')!, manifest.skeleton.parents, MAX_GHOSTS, { ...look, offsets: manifest.skeleton.offsets });
+    hook.bodies = this.stage.bodies;
     if (this.settings.camera) this.stage.setOrbit(this.settings.camera);
     this.still = standingViews(manifest);
     this.leader.capture(this.still.leader, true);
@@ -177,6 +182,7 @@ class Page {
     });
     const panel = this.createPanel();
     this.viewCentre = new ViewCentre(panel.gui.domElement, () => !panel.gui._closed);
+    if (this.stage.bodies === 'skinned') panel.gui.add(this.stage, 'skeleton').name('skeleton');
     this.recorder = new Recorder(MAX_RECORD_FRAMES, () =>
       showToast('Recording stopped', `It reached the ${formatDuration(MAX_RECORD_FRAMES / FPS)} limit. Download the take (“download BVH”).`, 'error', 15_000));
     this.leaderFileInput = new LeaderFileInput({
