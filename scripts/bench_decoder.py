@@ -17,9 +17,9 @@ from training.learning.runs import load_run
 torch.set_num_threads(1)
 m = load_run(Path('runs/models/follower'), 'runs/data').model
 class FullDecode(StepModel):
-    def decode(self, code):   # one-hot [B, C*D] times the full first-layer matrix
+    def decode(self, code, xn):   # one-hot [B, C*D] times the full first-layer matrix
         oh = torch.nn.functional.one_hot(code, self.cfg.classes).float().reshape(code.shape[0], -1)
-        return self.matching.decoder(oh)
+        return self.matching.decode(oh, xn)
 full = FullDecode(m.cfg, m.predictor, m.matching, {k: getattr(m, k) for k in ['input_mean','input_std','output_mean','output_std','intention_mean','intention_std']}).eval()
 out = Path('runs/bench_decoder'); out.mkdir(parents=True, exist_ok=True)
 for name, model in (('gather', m), ('full', full)):

@@ -83,6 +83,15 @@ def test_two_bone_ik_keeps_bones_and_reaches():
     assert np.allclose(p[13], [0.2, 0.2, 0.1], atol=1e-6)
 
 
+def test_two_bone_ik_keeps_the_least_bend_short_of_an_unreachable_target():
+    p = standing()
+    before = bone_lengths(p)
+    two_bone_ik(p, 11, 12, 13, np.array([0.1, -2.0, 0.0]), (0, 0, 1), 0.2)
+    assert np.allclose(bone_lengths(p), before)
+    u, v = p[12] - p[11], p[13] - p[12]
+    assert np.arccos(u @ v / np.linalg.norm(u) / np.linalg.norm(v)) == pytest.approx(0.2, abs=1e-6)
+
+
 def test_foot_lock_holds_a_planted_foot_and_never_sinks():
     lock = FootLock()
     p = standing()

@@ -125,7 +125,13 @@ def test_temperature_and_noise(exported, models, validation, kind):
         differ = (a["code"] != b["code"]).any(1)
         assert differ.mean() > 0.2, f"{name}: only {differ.mean():.0%} of rows changed with the noise"
         assert (np.abs(a["output"] - b["output"]).max(1)[differ] > 1e-6).all()
-        assert (a["output"][~differ] == b["output"][~differ]).all()
+        if kind == "fp32":
+            assert (a["output"][~differ] == b["output"][~differ]).all()
+        else:
+            # int8 quantizes activations with one scale per batch: a row whose code stayed can
+            # still move by the rounding of a scale that other rows' new codes changed.
+            scale = np.abs(a["output"]).max()
+            assert np.abs(a["output"][~differ] - b["output"][~differ]).max(initial=0) <= 0.02 * scale
         # Same noise, same temperature: deterministic.
         np.testing.assert_array_equal(run_onnx(sess, x, 1.0, u1)["output"], a["output"])
 

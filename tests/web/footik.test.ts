@@ -4,14 +4,15 @@
 import { describe, expect, it } from 'vitest';
 import { ANKLE_FLOOR, FootLock, MAX_LOCK_DISTANCE, twoBoneIk } from '../../web/mirror/footik';
 
-/** A left leg: thigh (11) at hip height, knee (12) slightly forward, foot (13) below. */
+/** A left leg: thigh (11) at hip height, knee (12) forward (bent 0.46 rad, more than the least
+ *  bend the foot lock keeps), foot (13) below. */
 function leg(): Float64Array {
   const p = new Float64Array(51);
   p.set([0.1, 0.95, 0], 33);
-  p.set([0.1, 0.52, 0.04], 36);
+  p.set([0.1, 0.52, 0.1], 36);
   p.set([0.1, 0.09, 0], 39);
   p.set([-0.1, 0.95, 0], 42); // right leg, untouched by a left-foot lock
-  p.set([-0.1, 0.52, 0.04], 45);
+  p.set([-0.1, 0.52, 0.1], 45);
   p.set([-0.1, 0.09, 0], 48);
   return p;
 }
@@ -73,5 +74,19 @@ describe('FootLock', () => {
     for (let i = 0; i < 51; i += 3) planted[i + 1] -= 0.08;
     new FootLock().apply(planted, [1, 1], 0);
     expect(planted[40]).toBeCloseTo(ANKLE_FLOOR, 9);
+  });
+});
+
+describe('twoBoneIk with a least bend', () => {
+  it('stops short of a straight chain, keeping the bend and the bone lengths', () => {
+    const p = leg();
+    const lengths = [dist(p, 11, 12), dist(p, 12, 13)];
+    twoBoneIk(p, 11, 12, 13, 0.1, -1, 0, 0, 0, 1, 0.2);
+    expect(dist(p, 11, 12)).toBeCloseTo(lengths[0], 9);
+    expect(dist(p, 12, 13)).toBeCloseTo(lengths[1], 9);
+    const ux = p[36] - p[33], uy = p[37] - p[34], uz = p[38] - p[35];
+    const vx = p[39] - p[36], vy = p[40] - p[37], vz = p[41] - p[38];
+    const bend = Math.acos((ux * vx + uy * vy + uz * vz) / (Math.hypot(ux, uy, uz) * Math.hypot(vx, vy, vz)));
+    expect(bend).toBeCloseTo(0.2, 6);
   });
 });

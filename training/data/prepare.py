@@ -1,7 +1,8 @@
 """python -m training.data.prepare: paired BVH takes -> feature arrays for training (git-ignored).
 
 Reads the BVH couples in --data; writes PREPARED/{train,validation,test}.npz (both roles, all phase
-offsets, mirrored copies in train) and PREPARED/stats.npz (normalization, from the recorded tempo:
+offsets, mirrored copies in train), PREPARED/plausibility.json (the training dancers' range of
+poses and speeds: training.evaluation.plausibility) and PREPARED/stats.npz (normalization, from the recorded tempo:
 recipes with and without tempo copies normalize alike), then prints frames per split and feature
 sizes. With --tempos it also writes PREPARED/train_tempo.npz, the training couples time-warped to
 those tempos (0.9,1.1 when the flag comes alone); only recipes with tempo copies read it, and no
@@ -17,6 +18,7 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
+from ..evaluation import plausibility as P
 from ..mirror import features as F
 from .dataset import (TEST_TAKES, VALIDATION_TAKES, DataError, discover_takes, load_pair, pair_tracks,
                       phases, samples)
@@ -39,6 +41,7 @@ def prepare(data: str, out: str, validation: list[str], test: list[str], leader:
             raise DataError(f"split take {n} is not in {data} (have {', '.join(names)})")
     parts: dict[str, list[dict]] = {"train": [], "validation": [], "test": [], "train_tempo": []}
     dancer_frames = {"train": 0, "validation": 0, "test": 0}
+    recorded_bodies: list[np.ndarray] = []   # world positions of every training dancer, as recorded
     for take in tqdm(takes, desc="prepare", unit="take", disable=quiet):
         lead, follow = load_pair(take)
         split = split_of(take.name, validation, test)
@@ -52,7 +55,10 @@ def prepare(data: str, out: str, validation: list[str], test: list[str], leader:
         for tempo in speeds:
             for phase in range(n_phase):
                 for mirror in mirrors:
-                    s = samples(*pair_tracks(lead, follow, phase, mirror, tempo))
+                    tracks = pair_tracks(lead, follow, phase, mirror, tempo)
+                    s = samples(*tracks)
+                    if split == "train" and tempo == 1.0 and phase == 0 and not mirror:
+                        recorded_bodies += [t.positions for t in tracks]
                     n = len(s["frame"])
                     s["take"] = np.full(n, names.index(take.name), np.int16)
                     s["phase"] = np.full(n, phase, np.int8)
@@ -85,6 +91,9 @@ def prepare(data: str, out: str, validation: list[str], test: list[str], leader:
     lead, follow = load_pair(takes[0])
     stats["leader_offsets"], stats["follower_offsets"] = lead.offsets, follow.offsets
     np.savez(outdir / "stats.npz", **stats)
+    # The recording's range of poses and speeds (evaluation.plausibility): what a generated frame is
+    # judged against, and what the page's guard reads from the manifest.
+    P.save_ranges(outdir / "plausibility.json", P.ranges(recorded_bodies))
     summary["sizes"] = {"input": F.INPUT_SIZE, "output": F.OUTPUT_SIZE, "intention": F.INTENTION_SIZE}
     return summary
 

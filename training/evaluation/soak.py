@@ -6,8 +6,10 @@
 Runs the exported ONNX models through training/mirror/rollout.py (the loop the page mirrors) with a
 steering script that changes every 0.5-3 s: random directions, sharp reversals, long holds and
 idle spells. Per rollout it reports non-finite numbers, the largest leader-follower distance,
-bone-length error, the lowest foot, the share of frozen frames and guard resets; it exits 1 when
-any rollout breaks a limit. The summary adds how the duet reads as a couple (metrics.interaction),
+bone-length error, the lowest foot, the share of frozen frames, guard resets and collapses (hips
+below the recording's lowest for a second: evaluation.plausibility, with the range the manifest
+carries); it exits 1 when any rollout breaks a limit. The summary gives every plausibility share
+with its worst rollout. The summary adds how the duet reads as a couple (metrics.interaction),
 for the networks alone and with the run-time contact layer (training/mirror/contact.py).
 """
 from __future__ import annotations
@@ -24,6 +26,7 @@ from tqdm import tqdm
 from ..data.folders import add_folder
 from ..mirror.rollout import NOW, OnnxPolicy, start_duet, step
 from . import metrics as M
+from . import plausibility as P
 from ..mirror.skeleton import FEET, FPS, PARENTS
 
 MAX_DISTANCE = 3.0        # m between the partners
@@ -141,6 +144,8 @@ def failures(r: dict) -> list[str]:
         out.append("frozen")
     if r["resets"]:
         out.append(f"{r['resets']} resets")
+    for who in r.get("collapsed", []):
+        out.append(f"{who} collapsed")
     return out
 
 
@@ -167,6 +172,7 @@ def main(argv=None) -> int:
     leader = OnnxPolicy(Path(args.models) / manifest["models"]["leader"]["file"])
     follower = OnnxPolicy(Path(args.models) / manifest["models"][args.follower]["file"])
     frames = int(args.minutes * 60 * FPS)
+    ranges = manifest.get("plausibility")
     t0 = time.time()
     results = []
     print(f"{args.rollouts} rollouts x {frames} frames ({args.minutes:g} min at {FPS} Hz), "
@@ -178,6 +184,9 @@ def main(argv=None) -> int:
         r["interaction"] = M.interaction(rec["leader"], rec["follower"], rec["leader_contacts"], rec["follower_contacts"])
         r["interaction_layer"] = M.interaction(rec["leader_shown"], rec["follower_shown"], rec["leader_contacts"],
                                                rec["follower_contacts"])
+        if ranges:   # the recording's range (a manifest from before it has none: skipped)
+            r["plausibility"] = {who: P.dancer(rec[who], ranges) for who in ("leader", "follower")}
+            r["collapsed"] = [who for who, p in r["plausibility"].items() if p["collapse"]]
         r["failures"] = failures(r)
         results.append(r)
         tqdm.write(f"{r['seed']:>5} {r['nonfinite']:>10} {r['max_distance']:>11.2f} "
@@ -193,6 +202,14 @@ def main(argv=None) -> int:
                "resets": sum(r["resets"] for r in results), "seconds": time.time() - t0}
     for key in ("interaction", "interaction_layer"):
         summary[key] = {k: float(np.mean([r[key][k] for r in results])) for k in results[0][key]}
+    if ranges:
+        summary["plausibility"] = P.summarize([{**r["plausibility"], "path_ratio": 0.0} for r in results],
+                                              [frames] * len(results))
+        for who in ("leader", "follower"):
+            q = summary["plausibility"][who]
+            print(f"plausibility, {who}: " + ", ".join(f"{k} {q[k]:.1%} (worst rollout {q[k + '_worst_seed']:.1%})"
+                                                       for k in P.FLAGS) +
+                  f"; {q['collapses']} collapses; longest frozen {q['longest_frozen_s']:.1f} s")
     print(f"summary: {len(bad)} of {len(results)} rollouts failed; max distance {summary['max_distance']:.2f} m; "
           f"bone error {summary['bone_error_mm']:.4f} mm; lowest foot {summary['min_foot_cm']:.1f} cm; "
           f"most frozen {summary['frozen_max']:.3f}; resets {summary['resets']}; {summary['seconds']:.0f} s")

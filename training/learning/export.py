@@ -90,6 +90,15 @@ def start_pose(stats_mean: np.ndarray) -> dict:
             "forward": np.round(pose[:, 6:9], 4).tolist(), "up": np.round(pose[:, 9:12], 4).tolist()}
 
 
+def plausibility_ranges(prepared: str) -> dict:
+    path = Path(prepared) / "plausibility.json"
+    if not path.exists():
+        raise TrainError(f"{path} not found: re-run training.data.prepare (it writes the recording's range)")
+    r = json.loads(path.read_text())
+    return {k: (np.round(v, 4).tolist() if isinstance(v, list) else round(v, 4) if isinstance(v, float) else v)
+            for k, v in r.items()}
+
+
 def write_manifest(out: Path, models: dict[str, StepModel], data: str, prepared: str) -> dict:
     stats = np.load(Path(prepared) / "stats.npz")
     manifest = {
@@ -103,6 +112,9 @@ def write_manifest(out: Path, models: dict[str, StepModel], data: str, prepared:
         "startPose": {role: start_pose(stats[f"{role}_output_mean"]) for role in ("leader", "follower")},
         "models": {},
         "defaultTemperature": DEFAULT_TEMPERATURE,
+        # The training dancers' range (evaluation.plausibility): soak counts a collapse against it
+        # and the page's guard reads the hip height below which a dancer is lying down.
+        "plausibility": plausibility_ranges(prepared),
         "credit": CREDIT,
     }
     for name, m in models.items():

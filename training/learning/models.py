@@ -12,7 +12,8 @@ import torch
 import torch.nn as nn
 import torch.nn.functional as F
 
-from ..mirror.features import INPUT_SIZE, INTENTION_SIZE, OUTPUT_SIZE
+from ..mirror.features import (FOLLOWER_INPUT_LAYOUT, INPUT_SIZE, INTENTION_SIZE, LEADER_INPUT_LAYOUT,
+                               OUTPUT_SIZE, block_slices)
 
 
 @dataclass
@@ -24,6 +25,11 @@ class ModelConfig:
     channels: int = 8                 # C categorical channels ...
     classes: int = 32                 # ... of D classes each
     dropout: float = 0.2
+    # The decoder also reads the dancer's own current joint positions and velocities. Decoded from
+    # the code alone, a pose is the same for as long as the sampled code is: the body holds one
+    # shape between code switches (stop-motion; docs/plausibility.md). With the current motion
+    # beside the code, the same code carries the body on from where it is.
+    decoder_state: bool = False
     input_size: int = INPUT_SIZE
     output_size: int = OUTPUT_SIZE
     intention_size: int = INTENTION_SIZE
@@ -32,8 +38,21 @@ class ModelConfig:
     def latent(self) -> int:
         return self.channels * self.classes
 
+    @property
+    def state_columns(self) -> list[int]:
+        """Columns of the input the decoder reads: the self pose's position and velocity of each
+        joint (6 of its 12 numbers); none without decoder_state."""
+        if not self.decoder_state:
+            return []
+        layout = LEADER_INPUT_LAYOUT if self.role == "leader" else FOLLOWER_INPUT_LAYOUT
+        start = block_slices(layout)["self_pose"].start
+        return [start + 12 * j + k for j in range(POSE_JOINTS) for k in range(6)]
+
     def to_dict(self) -> dict:
         return asdict(self)
+
+
+POSE_JOINTS = 17
 
 
 def mlp(sizes: list[int], dropout: float) -> nn.Sequential:
@@ -92,7 +111,12 @@ class CodebookMatching(nn.Module):
         h, extra = cfg.hidden, (cfg.intention_size if cfg.intention else 0)
         self.input_encoder = mlp([cfg.input_size + extra, h, h, cfg.latent], cfg.dropout)
         self.output_encoder = mlp([cfg.output_size + cfg.input_size + extra, h, h, cfg.latent], cfg.dropout)
-        self.decoder = mlp([cfg.latent, h, h, cfg.output_size], cfg.dropout)
+        self.decoder = mlp([cfg.latent + len(cfg.state_columns), h, h, cfg.output_size], cfg.dropout)
+        self.register_buffer("state_columns", torch.tensor(cfg.state_columns, dtype=torch.long), persistent=False)
+
+    def decode(self, code, x):
+        """One-hot code [B, C*D] (and the normalized input x, read when the decoder reads the state) -> O."""
+        return self.decoder(torch.cat([code, x[:, self.state_columns]], -1))
 
     def _cond(self, x, intention):
         return torch.cat([x, intention], -1) if self.cfg.intention else x
@@ -108,11 +132,11 @@ class CodebookMatching(nn.Module):
         s_hat = self.estimate_logits(x, intention)
         code = sample_codes(s, self.cfg.channels, temperature)
         code_hat = sample_codes(s_hat, self.cfg.channels, temperature)
-        return self.decoder(code), s, s_hat, code, code_hat
+        return self.decode(code, x), s, s_hat, code, code_hat
 
     def generate(self, x, intention=None, temperature: float = 0.0, noise=None):
         code = sample_codes(self.estimate_logits(x, intention), self.cfg.channels, temperature, noise)
-        return self.decoder(code), code
+        return self.decode(code, x), code
 
 
 class Logits(NamedTuple):
@@ -167,24 +191,28 @@ class StepModel(nn.Module):
         return code_logits(self.predictor, self.matching, xn, yn)
 
     def forward(self, x, temperature, noise):
-        logits, _, intention_n = self.logits(x)
+        xn = (x - self.input_mean) / self.input_std
+        logits, _, intention_n = code_logits(self.predictor, self.matching, xn)
         b, c = x.shape[0], self.cfg.channels
         u = noise.clamp(1e-7, 1 - 1e-7)
         z = logits.reshape(b, c, -1) + temperature.reshape(1, 1, 1) * -torch.log(-torch.log(u.reshape(b, c, -1)))
         code = z.argmax(-1)
-        y = self.decode(code)
+        y = self.decode(code, xn)
         out = y * self.output_std + self.output_mean
         if self.cfg.intention:
             return out, intention_n * self.intention_std + self.intention_mean, code
         return out, code
 
-    def decode(self, code):
-        """Decoder on a one-hot code given by indices [B, C]: the first layer is a sum of C
-        weight columns (a gather), not a product with a mostly-zero [C*D] vector."""
+    def decode(self, code, xn):
+        """Decoder on a one-hot code given by indices [B, C] (and the normalized input xn): the
+        code's part of the first layer is a sum of C weight columns (a gather), not a product
+        with a mostly-zero [C*D] vector; the state's part is an ordinary product."""
         first, rest = self.matching.decoder[0], self.matching.decoder[1:]
-        d = self.cfg.classes
+        d, latent = self.cfg.classes, self.cfg.latent
         columns = code + torch.arange(self.cfg.channels, device=code.device) * d   # [B, C]
-        h = first.weight.t()[columns].sum(1) + first.bias
+        h = first.weight[:, :latent].t()[columns].sum(1) + first.bias
+        if self.cfg.decoder_state:
+            h = h + xn[:, self.matching.state_columns] @ first.weight[:, latent:].t()
         return rest(h)
 
 

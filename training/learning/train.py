@@ -73,6 +73,11 @@ class TrainConfig:
     # with its own weight; the interaction term skips them (their recorded distances are moot).
     proximity_share: float = 0.0
     lambda_proximity: float = 0.0
+    # Std of Gaussian noise (in normalized units) on the dancer's own past and pose in the input,
+    # the target staying the recorded next frame: at run time those blocks are the model's own
+    # earlier outputs, and a model that only ever saw recorded ones has never learnt to come back
+    # from its own drift (a follower sinking to the floor and staying there).
+    state_noise: float = 0.0
     # Train on the tempo copies too (prepare's train_tempo.npz): more varied samples, same steps.
     tempo_copies: bool = False
     seed: int = 1
@@ -109,8 +114,21 @@ LEADER_PARTNER = dict(lambda_penetration=100.0, lambda_foot_contact=30.0, lambda
 # training.evaluation.crossval compares them), and the shipped pair.
 OURS_NO_PROXIMITY = TrainConfig(model=FOLLOWER, intention_noise=0.3, **PARTNER)
 CCM_NO_PROXIMITY = TrainConfig(model=replace(FOLLOWER, intention=False), **PARTNER)
-OURS = replace(OURS_NO_PROXIMITY, **PROXIMITY)
-CCM = replace(CCM_NO_PROXIMITY, **PROXIMITY)
+OURS_STOP_MOTION = replace(OURS_NO_PROXIMITY, **PROXIMITY)
+CCM_STOP_MOTION = replace(CCM_NO_PROXIMITY, **PROXIMITY)
+
+
+def steady(cfg: TrainConfig) -> TrainConfig:
+    """A recipe whose decoder reads the current pose beside the code, trained with noise on the
+    dancer's own state (docs/plausibility.md): without them the leader held one body shape in 47 %
+    of steered frames, and followers sank to the floor and stayed there."""
+    return replace(cfg, model=replace(cfg.model, decoder_state=True), state_noise=STATE_NOISE)
+
+
+STATE_NOISE = 0.2   # normalized units: about 1 cm on the hip height, 3-4 cm on a hand, 0.1 m/s on a velocity
+OURS = steady(OURS_STOP_MOTION)
+CCM = steady(CCM_STOP_MOTION)
+LEADER_STOP_MOTION = TrainConfig(model=ModelConfig(role="leader"), **LEADER_PARTNER)
 
 
 def partner_variant(**changes) -> TrainConfig:
@@ -126,7 +144,11 @@ MODELS = {
     "follower": OURS,
     "follower_ccm": CCM,
     # The leader's partner is the follower: it gets the same terms (its own weights, above).
-    "leader": TrainConfig(model=ModelConfig(role="leader"), **LEADER_PARTNER),
+    "leader": steady(LEADER_STOP_MOTION),
+    # The shipped three before their decoders read the pose (stop-motion; docs/plausibility.md).
+    "follower_stop_motion": OURS_STOP_MOTION,
+    "follower_ccm_stop_motion": CCM_STOP_MOTION,
+    "leader_stop_motion": LEADER_STOP_MOTION,
     "follower_small": TrainConfig(model=replace(FOLLOWER, hidden=256, intention_hidden=128), intention_noise=0.3),
     "follower_ccm_large": TrainConfig(model=replace(FOLLOWER, intention=False, channels=3 * FOLLOWER.channels)),
     "follower_no_gan": TrainConfig(model=FOLLOWER, lambda_generator=0.0, intention_noise=0.3),
@@ -136,8 +158,8 @@ MODELS = {
     # The shipped pair trained on the tempo copies too: measured, not kept (docs/results.md,
     # "Learning more from the same frames": FID 89.7 against 107.6, but the follower's feet slide
     # more in the steered duet, and cross-validated no metric moves outside its interval).
-    "follower_tempo": replace(OURS, tempo_copies=True),
-    "follower_ccm_tempo": replace(CCM, tempo_copies=True),
+    "follower_tempo": replace(OURS_STOP_MOTION, tempo_copies=True),
+    "follower_ccm_tempo": replace(CCM_STOP_MOTION, tempo_copies=True),
     # The shipped pair before proximity augmentation (the recipes training.evaluation.crossval compares).
     "follower_no_proximity": OURS_NO_PROXIMITY,
     "follower_ccm_no_proximity": CCM_NO_PROXIMITY,
@@ -275,14 +297,25 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
             if len(idx):
                 yield idx
 
+    slices = feat.block_slices(feat.LEADER_INPUT_LAYOUT if role == "leader" else feat.FOLLOWER_INPUT_LAYOUT)
+    own = torch.cat([torch.arange(slices[k].start, slices[k].stop)
+                     for k in ("self_trajectory_past", "self_key_joints_past", "self_pose")])
+
     def inputs(idx, proximity: bool = False):
-        """Normalized inputs of a batch, and which samples had their partner moved closer."""
+        """Normalized inputs of a batch as the networks read them (with state noise), which samples
+        had their partner moved closer, and the inputs without noise (what the body terms compare
+        the decoded pose with: the pose the dancer really was in)."""
         x, moved = xr[idx], None
         if role == "leader" and cfg.control_noise + cfg.control_rotation > 0:
             x = augment_control(x, cfg, gen)
         if proximity and role == "follower" and cfg.proximity_share > 0:
             x, moved = move_partner_closer(x, cfg.proximity_share, gen)
-        return ((x - stats["input_mean"]) / stats["input_std"]).to(device), moved
+        clean = ((x - stats["input_mean"]) / stats["input_std"]).to(device)
+        if cfg.state_noise == 0:
+            return clean, moved, clean
+        noisy = clean.clone()
+        noisy[:, own] += cfg.state_noise * torch.randn(len(noisy), len(own), generator=gen).to(device)
+        return noisy, moved, clean
 
     def save(stage_, epoch_):
         if rank == 0:
@@ -353,7 +386,7 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
             for o in (opt_g, opt_d):
                 for g in o.param_groups:
                     g["lr"] = lr
-            (x, moved), yb = inputs(idx, proximity=True), y[idx].to(device)
+            (x, moved, x_clean), yb = inputs(idx, proximity=True), y[idx].to(device)
             intention, extra = None, 0.0
             if mcfg.intention:
                 if cfg.end_to_end:
@@ -377,7 +410,7 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
             if any(partner_weights.values()):
                 keep = slice(None) if moved is None else ~moved.to(device)   # recorded relations only
                 off = offsets[mirrored[idx]]
-                terms = partner_terms(raw(recon[keep], "output"), raw(yb[keep], "output"), raw(x[keep], "input"),
+                terms = partner_terms(raw(recon[keep], "output"), raw(yb[keep], "output"), raw(x_clean[keep], "input"),
                                       off[keep], role, cfg.recorded_contacts,
                                       HANDS if cfg.interaction_hands_only else INTERACTION_JOINTS)
                 for k, w in partner_weights.items():
@@ -387,7 +420,7 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
                 if moved is not None and cfg.lambda_proximity > 0 and moved.any():
                     m = moved.to(device)
                     me = decoded_positions(raw(recon[m], "output"), off[m])
-                    l_p = penetration_loss(me, block_positions(raw(x[m], "input"), input_slices(role)["partner_pose"]))
+                    l_p = penetration_loss(me, block_positions(raw(x_clean[m], "input"), input_slices(role)["partner_pose"]))
                     loss = loss + cfg.lambda_proximity * l_p
                     sums["proximity"].append(l_p.item())
             l_g = torch.zeros(())
@@ -444,7 +477,7 @@ def validate(predictor, matching, mcfg, xv, yv, device, stats, batch=4096):
         x, yb = xv[s:s + batch].to(device), yv[s:s + batch].to(device)
         s_hat, s_target, _ = code_logits(predictor, matching, x, yb)
         code_hat, code = (sample_codes(l, mcfg.channels, 0.0) for l in (s_hat, s_target))
-        y_hat = matching.decoder(code_hat)
+        y_hat = matching.decode(code_hat, x)
         se += F.mse_loss(y_hat, yb, reduction="sum").item() / yb.shape[1]
         cb += F.mse_loss(code, code_hat, reduction="sum").item() / code.shape[1]
         pe += pose_error_cm(y_hat, yb, stats).sum().item()

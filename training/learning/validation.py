@@ -35,7 +35,7 @@ def measure(run: Path, prepared: str) -> dict:
     return {"run": str(run), "intention": cfg.intention, "channels": cfg.channels, "seed": r.config["seed"],
             # A wrong channel puts two mismatched ones in a row's C·D one-hot entries.
             "codebook": codebook, "wrong_channels": codebook * cfg.latent / 2,
-            "mpjpe_target_cm": float(pose_error_cm(r.matching.decoder(target), y, stats).mean()), "mpjpe_cm": mpjpe}
+            "mpjpe_target_cm": float(pose_error_cm(r.matching.decode(target, x), y, stats).mean()), "mpjpe_cm": mpjpe}
 
 
 def table(rows: list[dict]) -> str:

@@ -18,16 +18,21 @@ import { HANDS, PARENTS, SPINE } from './skeleton';
 export const TORSO_RADIUS = 0.14;
 /** m between the spines after the push (1 cm to spare). */
 export const SEPARATION = 2 * TORSO_RADIUS + 0.01;
-/** m: a hand pair closer than this starts to meet (a forearm's length). */
-export const HAND_REACH = 0.45;
+// The layer completes a hold the networks nearly make; it does not drag a hand across the gap.
+// Reaching from 45 cm (fully from 25 cm), the hands met in 4-5x as many steered frames as the
+// recorded couple's and the arm bent outside its recorded range (docs/plausibility.md).
+/** m: a hand pair closer than this starts to meet. */
+export const HAND_REACH = 0.25;
 /** m: at or below this the hands meet fully. */
-export const HAND_FULL = 0.25;
+export const HAND_FULL = 0.12;
 /** m between the two hands' joints when they meet (palm to palm). */
 export const GRIP = 0.06;
 /** Share of the way the hold weight moves to its target every step. */
 export const HOLD_RATE = 0.3;
 /** A straight arm bends its elbow downward. */
 export const ELBOW_POLE = [0, -1, 0];
+/** Radians: the recorded elbows bend at least 0.6-0.7 in 99.5 % of frames. */
+export const MIN_ELBOW_BEND = 0.6;
 
 type Positions = Float32Array | Float64Array;
 
@@ -141,7 +146,7 @@ export function reachWeight(distance: number): number {
 /** Two-bone IK of the arm (shoulder - forearm - hand) that ends at `hand`. */
 export function moveHand(positions: Positions, hand: number, tx: number, ty: number, tz: number): void {
   const elbow = PARENTS[hand];
-  twoBoneIk(positions, PARENTS[elbow], elbow, hand, tx, ty, tz, ELBOW_POLE[0], ELBOW_POLE[1], ELBOW_POLE[2]);
+  twoBoneIk(positions, PARENTS[elbow], elbow, hand, tx, ty, tz, ELBOW_POLE[0], ELBOW_POLE[1], ELBOW_POLE[2], MIN_ELBOW_BEND);
 }
 
 const pair = new Float64Array(3);

@@ -1,0 +1,116 @@
+"""training.evaluation.plausibility: flags against the recording's range, collapses, worst cases over
+seeds; and the decoder that reads the pose beside the code (the cure for stop-motion)."""
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import torch
+
+from training.evaluation import plausibility as P
+from training.learning.models import CodebookMatching, IntentionPredictor, ModelConfig, StepModel
+from training.mirror import features as feat
+from training.mirror.skeleton import FPS
+
+
+def standing(frames: int, sway: float = 0.01, seed: int = 0) -> np.ndarray:
+    """[frames, 17, 3]: an upright body (hip at 1 m) that breathes and sways a little."""
+    rng = np.random.default_rng(seed)
+    base = np.zeros((17, 3))
+    base[:, 1] = [1.0, 1.15, 1.3, 1.5, 1.65, 1.45, 1.2, 0.95, 1.45, 1.2, 0.95, 0.95, 0.5, 0.08, 0.95, 0.5, 0.08]
+    base[[5, 6, 7, 11, 12, 13], 0] = 0.2        # left side
+    base[[8, 9, 10, 14, 15, 16], 0] = -0.2      # right side
+    base[[6, 9], 2] = 0.05                      # elbows a little forward: the bends are not degenerate
+    base[[12, 15], 2] = 0.03
+    t = np.arange(frames)[:, None, None]
+    out = base[None] + sway * np.sin(t / 7.0 + np.arange(17)[None, :, None] + np.arange(3))
+    return out + rng.normal(0, 0.002, out.shape)
+
+
+def test_a_recording_like_motion_is_rarely_flagged():
+    walk = standing(600)
+    r = P.ranges([walk])
+    flags = P.frame_flags(standing(600, seed=1), r)
+    for k in ["hips_low", "head_low", "feet_wide"]:
+        assert flags[k].mean() < 0.1, k
+    # 16 angles, each outside its own 0.5..99.5 percentile in about 1 % of such noisy frames
+    assert flags["angles_out"].mean() < 0.3
+    assert flags["frozen"].mean() == 0
+
+
+def test_lying_on_the_floor_is_flagged_and_a_long_one_is_a_collapse():
+    r = P.ranges([standing(600)])
+    lying = standing(2 * FPS)
+    lying[..., 1], lying[..., 2] = 0.3 + 0.02 * lying[..., 2], lying[..., 1]   # the body turned onto its back
+    motion = np.concatenate([standing(FPS), lying, standing(FPS)])
+    flags = P.frame_flags(motion, r)
+    lying_frames = slice(FPS, 3 * FPS)
+    assert flags["hips_low"][lying_frames].all()
+    assert flags["head_low"][lying_frames].all()
+    assert flags["angles_out"][lying_frames].all()    # the torso's lean
+    assert P.collapsed(motion, r)
+    assert abs(P.worst_second(flags) - 1.0) < 1e-9
+    short = np.concatenate([standing(FPS), lying[:FPS // 2], standing(FPS)])
+    assert not P.collapsed(short, r)
+
+
+def test_a_held_body_shape_is_frozen_even_while_the_root_moves():
+    still = np.repeat(standing(1), 40, 0)
+    still[:, :, 0] += np.linspace(0, 1, 40)[:, None]   # carried along, turning nothing: still one shape
+    flags = P.frame_flags(still, P.ranges([standing(600)]))
+    assert flags["frozen"][1:].all() and not flags["frozen"][0]
+    assert P.longest_run(flags["frozen"]) == 39
+
+
+def test_summary_reports_the_worst_seed_not_only_the_mean():
+    r = P.ranges([standing(600)])
+    good = P.duet(standing(300), standing(300, seed=2), r)
+    lying = standing(300)
+    lying[..., 1] = 0.3
+    bad = P.duet(standing(300), lying, r)
+    s = P.summarize([good] * 9 + [bad], [300] * 10)
+    assert 0.1 <= s["follower"]["hips_low"] < 0.15        # one seed in ten lies, the rest barely
+    assert s["follower"]["hips_low_worst_seed"] == 1.0
+    assert s["follower"]["hips_low_worst_seed"] == 1.0
+    assert s["follower"]["collapses"] == 1 and s["follower"]["bad_seconds"] == 1
+    assert s["leader"]["collapses"] == 0
+
+
+def test_path_ratio_follows_travel_not_sway():
+    lead = standing(300)
+    lead[:, :, 0] += np.linspace(0, 3, 300)[:, None]     # 3 m of travel
+    follow = standing(300)
+    follow[:, :, 0] += 0.1 * np.sin(np.arange(300) * 2 * np.pi / 15)[:, None]   # stepping on the spot, 2 Hz
+    d = P.duet(lead, follow, P.ranges([standing(600)]))
+    assert d["path_ratio"] < 0.2
+
+
+def test_a_decoder_that_reads_the_pose_moves_on_under_one_code():
+    """With the same code, the decoder from the code alone gives the same pose whatever the
+    dancer's state (stop-motion); reading the pose, it gives another pose for another state. The
+    step model's gather decoding equals the module's one-hot decoding in both."""
+    torch.manual_seed(0)
+    for state in (False, True):
+        cfg = ModelConfig(hidden=32, intention_hidden=16, channels=3, classes=4, decoder_state=state)
+        matching, predictor = CodebookMatching(cfg).eval(), IntentionPredictor(cfg).eval()
+        stats = {f"{k}_{s}": (torch.zeros(n) if s == "mean" else torch.ones(n))
+                 for k, n in (("input", feat.INPUT_SIZE), ("output", feat.OUTPUT_SIZE),
+                              ("intention", feat.INTENTION_SIZE)) for s in ("mean", "std")}
+        step = StepModel(cfg, predictor, matching, stats).eval()
+        x = torch.randn(2, feat.INPUT_SIZE)
+        code = torch.tensor([[1, 2, 3], [1, 2, 3]])
+        one_hot = torch.nn.functional.one_hot(code, 4).float().reshape(2, -1)
+        with torch.no_grad():
+            y = step.decode(code, x)
+            assert torch.allclose(y, matching.decode(one_hot, x), atol=1e-5)
+        assert torch.allclose(y[0], y[1]) != state
+        assert len(cfg.state_columns) == (17 * 6 if state else 0)
+
+
+def test_state_columns_are_the_own_pose_positions_and_velocities():
+    for role, layout in (("follower", feat.FOLLOWER_INPUT_LAYOUT), ("leader", feat.LEADER_INPUT_LAYOUT)):
+        cols = ModelConfig(role=role, decoder_state=True).state_columns
+        pose = feat.block_slices(layout)["self_pose"]
+        assert min(cols) == pose.start and max(cols) < pose.stop
+        assert cols[:7] == [pose.start + i for i in range(6)] + [pose.start + 12]
+        assert replace(ModelConfig(role=role), decoder_state=False).state_columns == []

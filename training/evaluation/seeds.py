@@ -1,0 +1,218 @@
+"""python -m training.evaluation.seeds: many steered duets, each judged on its own -> seeds.json + .md
+
+    python -m training.evaluation.seeds --models public/models --seeds 100 --seconds 60 --out runs/seeds
+
+Every seed is one steered duet (training.evaluation.soak's steering script and loop, our leader
+model) with each follower method: every follower ONNX in --models and Motion Matching over the
+training takes. Each duet is measured twice, the networks alone and with the contact layer, by
+plausibility (per-frame flags against the recording's range, worst second, collapse) and by
+metrics.interaction (torsos through each other, hands within 20 cm, foot skate). The recording of
+the test takes (--takes) is measured the same way and every share is also given as a ratio to it.
+
+Seeds run in --workers processes (one ONNX thread each); the table is the same for any count.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import multiprocessing
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+from tqdm import tqdm
+
+from ..data.dataset import DataError, discover_takes, TEST_TAKES, VALIDATION_TAKES
+from ..data.folders import add_folder
+from ..mirror.skeleton import FPS
+from . import plausibility as P
+from .evaluate_inputs import EvalError, find_models, load_eval_takes, load_onnx
+from .interaction import contact_labels, measure
+from .motion_matching import build, load_tracks, training_takes
+from .soak import soak_one
+
+INTERACTION = ["interpenetration", "hand_hold", "skate_leader_cm", "skate_follower_cm",
+               "contact_skate_leader_cm", "contact_skate_follower_cm"]
+
+
+def recording_ranges(data: str) -> dict:
+    """plausibility.ranges of every dancer in the training takes (not validation, not test)."""
+    held_out = set(TEST_TAKES) | set(VALIDATION_TAKES)
+    names = [t.name for t in discover_takes(data) if t.name not in held_out]
+    takes = load_eval_takes(data, names, None, None)
+    return P.ranges([t.lead.positions for t in takes] + [t.follow.positions for t in takes])
+
+
+def recording_row(data: str, names: list[str], r: dict) -> dict:
+    takes = load_eval_takes(data, names, None, None)
+    duets, inter, frames = [], [], []
+    for t in takes:
+        lead, follow = t.lead.positions, t.follow.positions
+        duets.append(P.duet(lead, follow, r))
+        inter.append(measure(lead, follow, contact_labels(lead), contact_labels(follow)))
+        frames.append(len(lead))
+    return {**P.summarize(duets, frames), **weighted(inter, frames)}
+
+
+def weighted(rows: list[dict], frames: list[int]) -> dict:
+    w = np.asarray(frames, float) / np.sum(frames)
+    return {k: float(sum(r[k] * wi for r, wi in zip(rows, w))) for k in INTERACTION}
+
+
+# ---------------------------------------------------------------- workers
+
+_WORKER: dict = {}
+
+
+def _init(models: str, method: str, data: str, test: list[str], r: dict):
+    manifest, onnx, leader = find_models(models)
+    follower = (build(load_tracks(training_takes(data, exclude=test)), "follower")
+                if method == "motion_matching" else load_onnx(onnx[method]))
+    _WORKER.update(manifest=manifest, leader=load_onnx(leader), follower=follower, ranges=r)
+
+
+def _one(job: tuple[int, int, float]) -> dict:
+    seed, frames, temperature = job
+    w = _WORKER
+    rec: dict = {}
+    soak = soak_one(w["manifest"], w["leader"], w["follower"], seed, frames, temperature, rec)
+    out = {"seed": seed, "resets": soak["resets"]}
+    for kind, suffix in (("alone", ""), ("layer", "_shown")):
+        lead, follow = rec["leader" + suffix], rec["follower" + suffix]
+        out[kind] = {**P.duet(lead, follow, w["ranges"]),
+                     **measure(lead, follow, rec["leader_contacts"], rec["follower_contacts"])}
+    return out
+
+
+def run_method(args, method: str, r: dict, test: list[str], bar) -> dict:
+    frames = int(args.seconds * FPS)
+    jobs = [(seed, frames, args.temperature) for seed in range(args.first_seed, args.first_seed + args.seeds)]
+    init = (args.models, method, args.data, test, r)
+    if args.workers > 1:
+        with multiprocessing.get_context("spawn").Pool(args.workers, _init, init) as pool:
+            per_seed = []
+            for res in pool.imap(_one, jobs):
+                per_seed.append(res)
+                bar.update(1)
+    else:
+        _init(*init)
+        per_seed = []
+        for job in jobs:
+            per_seed.append(_one(job))
+            bar.update(1)
+    row = {"per_seed": per_seed, "resets": int(sum(s["resets"] for s in per_seed))}
+    for kind in ("alone", "layer"):
+        duets = [s[kind] for s in per_seed]
+        row[kind] = {**P.summarize(duets, [frames] * len(duets)), **weighted(duets, [frames] * len(duets))}
+    return row
+
+
+def ratios(row: dict, ref: dict) -> dict:
+    """Every share and speed of `row` divided by the recording's (None where the recording's is 0)."""
+    out = {}
+    for who in ("leader", "follower"):
+        out[who] = {k: (row[who][k] / ref[who][k] if ref[who][k] else None)
+                    for k in P.FLAGS + ["root_speed_p99"]}
+    out["path_ratio"] = row["path_ratio"] / ref["path_ratio"]
+    out.update({k: (row[k] / ref[k] if ref[k] else None) for k in INTERACTION})
+    return out
+
+
+def run(args) -> dict:
+    t0 = time.time()
+    manifest, onnx, leader = find_models(args.models)
+    if leader is None:
+        raise EvalError(f"{args.models}: no leader.onnx (the steered duet needs it)")
+    test = [t for t in args.takes.split(",") if t]
+    r = recording_ranges(args.data)
+    if args.temperature is None:
+        args.temperature = manifest["defaultTemperature"]
+    methods = [m for m in [*onnx, "motion_matching"] if not args.methods or m in args.methods.split(",")]
+    ref = recording_row(args.data, test, r)
+    res = {"takes": test, "ranges": r, "recording": ref, "methods": {}}
+    bar = tqdm(total=len(methods) * args.seeds, desc="steered duets", unit="duet", file=sys.stderr,
+               disable=args.quiet)
+    for m in methods:
+        row = run_method(args, m, r, test, bar)
+        row["ratio"] = {k: ratios(row[k], ref) for k in ("alone", "layer")}
+        res["methods"][m] = row
+    bar.close()
+    res["config"] = {"models": str(args.models), "seeds": args.seeds, "first_seed": args.first_seed,
+                     "seconds": args.seconds, "temperature": args.temperature,
+                     "wall_seconds": time.time() - t0}
+    return res
+
+
+def fmt(v, digits=2, pct=False) -> str:
+    if v is None:
+        return "–"
+    return f"{100 * v:.{digits - 1}f} %" if pct else f"{v:.{digits}f}"
+
+
+def write_markdown(path: Path, res: dict) -> None:
+    ref, cfg = res["recording"], res["config"]
+    lines = [f"# Plausibility over {cfg['seeds']} steered seeds × {cfg['seconds']:g} s "
+             f"(temperature {cfg['temperature']}), against the recording of takes {', '.join(res['takes'])}", "",
+             "Share of frames flagged (ratio to the recording in brackets); worst = the worst seed's share.", ""]
+    for who in ("leader", "follower"):
+        lines += [f"## {who}", "",
+                  "| method | " + " | ".join(P.FLAGS) + " | root speed p99 (m/s) | worst second | seeds with a bad second | collapses |",
+                  "|---" * (len(P.FLAGS) + 5) + "|"]
+        r0 = ref[who]
+        lines.append("| recording | " + " | ".join(fmt(r0[k], pct=True) for k in P.FLAGS) +
+                     f" | {r0['root_speed_p99']:.2f} | {fmt(r0['worst_second'], pct=True)} | {r0['bad_seconds']} | {r0['collapses']} |")
+        for m, row in res["methods"].items():
+            for kind in ("alone", "layer"):
+                s, q = row[kind][who], row["ratio"][kind][who]
+                cells = [f"{fmt(s[k], pct=True)} ({fmt(q[k], 1)}×) worst {fmt(s[k + '_worst_seed'], pct=True)}"
+                         for k in P.FLAGS]
+                lines.append(f"| {m} {kind} | " + " | ".join(cells) +
+                             f" | {s['root_speed_p99']:.2f} ({fmt(q['root_speed_p99'])}×) | {fmt(s['worst_second'], pct=True)}"
+                             f" | {s['bad_seconds']} / {row[kind]['seeds']} | {s['collapses']} |")
+        lines.append("")
+    lines += ["## The couple", "",
+              "| method | path ratio follower/leader | " + " | ".join(INTERACTION) + " | guard resets |",
+              "|---" * (len(INTERACTION) + 3) + "|",
+              f"| recording | {ref['path_ratio']:.2f} | " + " | ".join(fmt(ref[k], 3) for k in INTERACTION) + " | – |"]
+    for m, row in res["methods"].items():
+        for kind in ("alone", "layer"):
+            s, q = row[kind], row["ratio"][kind]
+            lines.append(f"| {m} {kind} | {s['path_ratio']:.2f} ({fmt(q['path_ratio'])}×) | " +
+                         " | ".join(f"{fmt(s[k], 3)} ({fmt(q[k])}×)" for k in INTERACTION) + f" | {row['resets']} |")
+    lines += ["", f"Wall time {cfg['wall_seconds'] / 60:.1f} min."]
+    path.write_text("\n".join(lines) + "\n")
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m training.evaluation.seeds", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    add_folder(ap, "data", "read")
+    ap.add_argument("--models", default="public/models", help="folder with manifest.json, leader.onnx and followers")
+    ap.add_argument("--takes", default=",".join(TEST_TAKES), help="recorded takes to compare with")
+    ap.add_argument("--seeds", type=int, default=100)
+    ap.add_argument("--first-seed", type=int, default=0)
+    ap.add_argument("--seconds", type=float, default=60.0)
+    ap.add_argument("--temperature", type=float, default=None, help="default: the manifest's")
+    ap.add_argument("--methods", default=None, help="comma-separated subset (follower, follower_ccm, motion_matching)")
+    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--out", default="runs/seeds")
+    ap.add_argument("--quiet", action="store_true")
+    args = ap.parse_args(argv)
+    if args.seeds < 1 or args.seconds < 2:
+        ap.error("--seeds must be at least 1 and --seconds at least 2")
+    try:
+        res = run(args)
+    except (EvalError, DataError) as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "seeds.json").write_text(json.dumps(res, indent=1))
+    write_markdown(out / "seeds.md", res)
+    print(f"wrote {out}/seeds.json and seeds.md")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
