@@ -116,7 +116,7 @@ def test_separate_pushes_overlapping_spines_apart_horizontally():
 
 
 def test_contact_layer_brings_near_hands_together_and_keeps_bones():
-    lead, follow = standing(0, 0), standing(1.6, 0)   # hands 0.3 m apart
+    lead, follow = standing(0, 0), standing(1.4, 0)   # hands 0.1 m apart: within HAND_FULL
     lengths = bone_lengths(follow)
     layer = ContactLayer()
     for _ in range(20):
@@ -124,7 +124,11 @@ def test_contact_layer_brings_near_hands_together_and_keeps_bones():
         layer.apply(a, b, [0, 0], [0, 0], 0.0, 0.0)
     assert layer.hold > 0.6
     gap = np.linalg.norm(a[7] - b[10])
-    assert gap < 0.3 * (1 - 0.6) + 0.06
+    assert gap < 0.1 * (1 - 0.6) + 0.06
+    far = standing(1.75, 0)                            # 0.45 m apart: out of reach, left alone
+    b = far.copy()
+    ContactLayer().apply(standing(0, 0), b, [0, 0], [0, 0], 0.0, 0.0)
+    assert np.allclose(b, far)
     assert np.allclose(bone_lengths(b), lengths)
 
 

@@ -23,9 +23,11 @@ from .skeleton import HANDS, PARENTS, SPINE
 SEPARATION = 2 * TORSO_RADIUS + 0.01   # m between the spines after the push (1 cm to spare)
 # The layer completes a hold the networks nearly make; it does not drag a hand across the gap.
 # Reaching from 45 cm (fully from 25 cm), the hands met in 4-5x as many steered frames as the
-# recorded couple's and the arm bent outside its recorded range (docs/plausibility.md).
-HAND_REACH = 0.25      # m: a hand pair closer than this starts to meet
-HAND_FULL = 0.12       # m: at or below this the hands meet fully
+# recorded couple's and the arm bent outside its recorded range; from 25 cm still 2x. From 20
+# cm (the distance the hand-hold measure counts) it adds little to what the networks do
+# (docs/plausibility.md).
+HAND_REACH = 0.20      # m: a hand pair closer than this starts to meet
+HAND_FULL = 0.10       # m: at or below this the hands meet fully
 GRIP = 0.06            # m between the two hands' joints when they meet (palm to palm)
 HOLD_RATE = 0.3        # share of the way the hold weight moves to its target every step
 ELBOW_POLE = (0.0, -1.0, 0.0)   # a straight arm bends its elbow downward

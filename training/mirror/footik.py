@@ -15,12 +15,12 @@ from .skeleton import FEET, PARENTS
 # keeps the sole above the floor without ever lifting a real flat foot.
 ANKLE_FLOOR = 0.06
 # A lock further than this from the model's foot is stale (a reset, a glitch, a step the model
-# took without lifting the foot): let it go. The re-lock of a stale foot is a jump, and those jumps
-# are nearly all of the shown foot skate. Steered duet of the shipped models, 4 x 60 s, skate in
-# contact of the leader / follower: 0.25 m gave 1.49 / 0.87 cm per frame (first partner-trained
-# models), 0.4 m 1.01 / 1.03, 0.5 m 0.87 / 0.77 (recording 0.67 / 0.72). Half a metre is a long
-# stride: the leg reaches it stretched.
-MAX_LOCK_DISTANCE = 0.5
+# took without lifting the foot): let it go, and the re-lock is a small jump. Holding to half a
+# metre hid most of that skate but stretched the legs out of the recorded range: steered duets of
+# the decoder-reads-pose models, 10 x 30 s, follower with the layer, knee/hip angles out of range
+# and foot skate in contact (ratios to the recording): 0.5 m 4.7x / 1.85x, 0.25 m 1.3x / 2.5x,
+# 0.15 m 0.8x / 3.1x (docs/plausibility.md). A quarter metre keeps the legs plausible.
+MAX_LOCK_DISTANCE = 0.25
 # A knee never straightens further than this (radians between thigh and shin) to reach a lock:
 # the recorded dancers' knees bend at least 0.19-0.30 rad in 99.5 % of frames, and a leg pulled
 # fully straight read as out of the recorded range in 2-6 % of the shown frames.

@@ -20,11 +20,13 @@ export const TORSO_RADIUS = 0.14;
 export const SEPARATION = 2 * TORSO_RADIUS + 0.01;
 // The layer completes a hold the networks nearly make; it does not drag a hand across the gap.
 // Reaching from 45 cm (fully from 25 cm), the hands met in 4-5x as many steered frames as the
-// recorded couple's and the arm bent outside its recorded range (docs/plausibility.md).
+// recorded couple's and the arm bent outside its recorded range; from 25 cm still 2x. From 20
+// cm (the distance the hand-hold measure counts) it adds little to what the networks do
+// (docs/plausibility.md).
 /** m: a hand pair closer than this starts to meet. */
-export const HAND_REACH = 0.25;
+export const HAND_REACH = 0.2;
 /** m: at or below this the hands meet fully. */
-export const HAND_FULL = 0.12;
+export const HAND_FULL = 0.1;
 /** m between the two hands' joints when they meet (palm to palm). */
 export const GRIP = 0.06;
 /** Share of the way the hold weight moves to its target every step. */

@@ -10,8 +10,9 @@ import { FEET, PARENTS } from './skeleton';
  *  keeps the sole above the floor without ever lifting a real flat foot. */
 export const ANKLE_FLOOR = 0.06;
 /** A lock further than this from the model's foot is stale (a reset, a glitch, a step the model
- *  took without lifting the foot): let it go. A long stride (training/mirror/footik.py: measured). */
-export const MAX_LOCK_DISTANCE = 0.5;
+ *  took without lifting the foot): let it go. Further, the legs stretch out of the recorded range
+ *  (training/mirror/footik.py: measured). */
+export const MAX_LOCK_DISTANCE = 0.25;
 /** Radians: a knee never straightens further than this to reach a lock (the recorded knees bend at
  *  least 0.19-0.30 in 99.5 % of frames; a leg pulled fully straight read as out of that range). */
 export const MIN_KNEE_BEND = 0.2;
