@@ -114,3 +114,42 @@ def test_state_columns_are_the_own_pose_positions_and_velocities():
         assert min(cols) == pose.start and max(cols) < pose.stop
         assert cols[:7] == [pose.start + i for i in range(6)] + [pose.start + 12]
         assert replace(ModelConfig(role=role), decoder_state=False).state_columns == []
+
+
+def test_seeds_judges_every_seed_of_the_exported_models_against_the_recording(exported, data3, tmp_path):
+    """training.evaluation.seeds end to end on the smoke models: one row per seed, shares and
+    their ratios to the recording, alone and with the layer."""
+    import json
+
+    from conftest import SMALL_TAKES
+    from training.evaluation import seeds
+
+    out = tmp_path / "seeds"
+    rc = seeds.main(["--data", str(data3), "--models", str(exported["models"]), "--takes", SMALL_TAKES["test"],
+                     "--methods", "ours", "--seeds", "2", "--seconds", "3", "--workers", "1",
+                     "--out", str(out), "--quiet"])
+    assert rc == 0
+    res = json.loads((out / "seeds.json").read_text())
+    row = res["methods"]["ours"]
+    assert [s["seed"] for s in row["per_seed"]] == [0, 1]
+    for kind in ("alone", "layer"):
+        for who in ("leader", "follower"):
+            assert set(P.FLAGS) <= set(row[kind][who]) and row[kind]["seeds"] == 2
+            assert 0 <= row[kind][who]["frozen_worst_seed"] <= 1
+        assert set(seeds.INTERACTION) <= set(row["ratio"][kind])
+    assert "| recording |" in (out / "seeds.md").read_text()
+
+
+def test_seeds_refuses_a_manifest_without_the_range(exported, data3, tmp_path, capsys):
+    import json
+    import shutil
+
+    from training.evaluation import seeds
+
+    models = tmp_path / "models"
+    shutil.copytree(exported["models"], models)
+    manifest = json.loads((models / "manifest.json").read_text())
+    del manifest["plausibility"]
+    (models / "manifest.json").write_text(json.dumps(manifest))
+    assert seeds.main(["--data", str(data3), "--models", str(models), "--out", str(tmp_path / "o")]) == 2
+    assert "no plausibility range" in capsys.readouterr().err

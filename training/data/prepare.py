@@ -92,7 +92,7 @@ def prepare(data: str, out: str, validation: list[str], test: list[str], leader:
     stats["leader_offsets"], stats["follower_offsets"] = lead.offsets, follow.offsets
     np.savez(outdir / "stats.npz", **stats)
     # The recording's range of poses and speeds (evaluation.plausibility): what a generated frame is
-    # judged against, and what the page's guard reads from the manifest.
+    # judged against (export copies it into the manifest).
     P.save_ranges(outdir / "plausibility.json", P.ranges(recorded_bodies))
     summary["sizes"] = {"input": F.INPUT_SIZE, "output": F.OUTPUT_SIZE, "intention": F.INTENTION_SIZE}
     return summary

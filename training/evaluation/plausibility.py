@@ -7,7 +7,7 @@ So every measure here is a share of frames (read as a ratio to the recording's o
 worst case over a duet, never a mean pose error.
 
 The range is taken from the training takes (`ranges`, stored by training.prepare as
-PREPARED/plausibility.json and copied into the manifest for the page's guard) and each flag is
+PREPARED/plausibility.json and copied into the manifest, where soak and seeds read it) and each flag is
 set where a frame leaves it:
 
 - hips_low: hip height below the recording's 1st percentile;

@@ -23,25 +23,17 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from ..data.dataset import DataError, discover_takes, TEST_TAKES, VALIDATION_TAKES
+from ..data.dataset import DataError, TEST_TAKES
 from ..data.folders import add_folder
 from ..mirror.skeleton import FPS
 from . import plausibility as P
 from .evaluate_inputs import EvalError, find_models, load_eval_takes, load_onnx
-from .interaction import contact_labels, measure
+from .interaction import contact_labels, measure, weighted as interaction_weighted
 from .motion_matching import build, load_tracks, training_takes
 from .soak import soak_one
 
 INTERACTION = ["interpenetration", "hand_hold", "skate_leader_cm", "skate_follower_cm",
                "contact_skate_leader_cm", "contact_skate_follower_cm"]
-
-
-def recording_ranges(data: str) -> dict:
-    """plausibility.ranges of every dancer in the training takes (not validation, not test)."""
-    held_out = set(TEST_TAKES) | set(VALIDATION_TAKES)
-    names = [t.name for t in discover_takes(data) if t.name not in held_out]
-    takes = load_eval_takes(data, names, None, None)
-    return P.ranges([t.lead.positions for t in takes] + [t.follow.positions for t in takes])
 
 
 def recording_row(data: str, names: list[str], r: dict) -> dict:
@@ -56,8 +48,9 @@ def recording_row(data: str, names: list[str], r: dict) -> dict:
 
 
 def weighted(rows: list[dict], frames: list[int]) -> dict:
-    w = np.asarray(frames, float) / np.sum(frames)
-    return {k: float(sum(r[k] * wi for r, wi in zip(rows, w))) for k in INTERACTION}
+    """The INTERACTION measures of many duets, weighted by their frames."""
+    means = interaction_weighted([({k: r[k] for k in INTERACTION}, n) for r, n in zip(rows, frames)])
+    return {k: means[k] for k in INTERACTION}
 
 
 # ---------------------------------------------------------------- workers
@@ -89,18 +82,18 @@ def run_method(args, method: str, r: dict, test: list[str], bar) -> dict:
     frames = int(args.seconds * FPS)
     jobs = [(seed, frames, args.temperature) for seed in range(args.first_seed, args.first_seed + args.seeds)]
     init = (args.models, method, args.data, test, r)
+
+    def counted(results):
+        for res in results:
+            bar.update(1)
+            yield res
+
     if args.workers > 1:
         with multiprocessing.get_context("spawn").Pool(args.workers, _init, init) as pool:
-            per_seed = []
-            for res in pool.imap(_one, jobs):
-                per_seed.append(res)
-                bar.update(1)
+            per_seed = list(counted(pool.imap(_one, jobs)))
     else:
         _init(*init)
-        per_seed = []
-        for job in jobs:
-            per_seed.append(_one(job))
-            bar.update(1)
+        per_seed = list(counted(map(_one, jobs)))
     row = {"per_seed": per_seed, "resets": int(sum(s["resets"] for s in per_seed))}
     for kind in ("alone", "layer"):
         duets = [s[kind] for s in per_seed]
@@ -125,7 +118,10 @@ def run(args) -> dict:
     if leader is None:
         raise EvalError(f"{args.models}: no leader.onnx (the steered duet needs it)")
     test = [t for t in args.takes.split(",") if t]
-    r = recording_ranges(args.data)
+    if "plausibility" not in manifest:
+        raise EvalError(f"{args.models}/manifest.json has no plausibility range: re-export it "
+                        f"(python -m training.learning.export, after training.data.prepare)")
+    r = manifest["plausibility"]   # the training dancers' range, as prepare measured it
     if args.temperature is None:
         args.temperature = manifest["defaultTemperature"]
     methods = [m for m in [*onnx, "motion_matching"] if not args.methods or m in args.methods.split(",")]
@@ -188,7 +184,7 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m training.evaluation.seeds", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     add_folder(ap, "data", "read")
-    ap.add_argument("--models", default="public/models", help="folder with manifest.json, leader.onnx and followers")
+    add_folder(ap, "models", "read: the leader and every follower dance")
     ap.add_argument("--takes", default=",".join(TEST_TAKES), help="recorded takes to compare with")
     ap.add_argument("--seeds", type=int, default=100)
     ap.add_argument("--first-seed", type=int, default=0)

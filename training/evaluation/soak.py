@@ -185,8 +185,8 @@ def main(argv=None) -> int:
         r["interaction_layer"] = M.interaction(rec["leader_shown"], rec["follower_shown"], rec["leader_contacts"],
                                                rec["follower_contacts"])
         if ranges:   # the recording's range (a manifest from before it has none: skipped)
-            r["plausibility"] = {who: P.dancer(rec[who], ranges) for who in ("leader", "follower")}
-            r["collapsed"] = [who for who, p in r["plausibility"].items() if p["collapse"]]
+            r["plausibility"] = P.duet(rec["leader"], rec["follower"], ranges)
+            r["collapsed"] = [who for who in ("leader", "follower") if r["plausibility"][who]["collapse"]]
         r["failures"] = failures(r)
         results.append(r)
         tqdm.write(f"{r['seed']:>5} {r['nonfinite']:>10} {r['max_distance']:>11.2f} "
@@ -203,8 +203,7 @@ def main(argv=None) -> int:
     for key in ("interaction", "interaction_layer"):
         summary[key] = {k: float(np.mean([r[key][k] for r in results])) for k in results[0][key]}
     if ranges:
-        summary["plausibility"] = P.summarize([{**r["plausibility"], "path_ratio": 0.0} for r in results],
-                                              [frames] * len(results))
+        summary["plausibility"] = P.summarize([r["plausibility"] for r in results], [frames] * len(results))
         for who in ("leader", "follower"):
             q = summary["plausibility"][who]
             print(f"plausibility, {who}: " + ", ".join(f"{k} {q[k]:.1%} (worst rollout {q[k + '_worst_seed']:.1%})"

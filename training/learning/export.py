@@ -113,7 +113,7 @@ def write_manifest(out: Path, models: dict[str, StepModel], data: str, prepared:
         "models": {},
         "defaultTemperature": DEFAULT_TEMPERATURE,
         # The training dancers' range (evaluation.plausibility): soak counts a collapse against it
-        # and the page's guard reads the hip height below which a dancer is lying down.
+        # and training.evaluation.seeds judges every steered frame against it.
         "plausibility": plausibility_ranges(prepared),
         "credit": CREDIT,
     }
