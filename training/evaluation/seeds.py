@@ -124,7 +124,12 @@ def run(args) -> dict:
     r = manifest["plausibility"]   # the training dancers' range, as prepare measured it
     if args.temperature is None:
         args.temperature = manifest["defaultTemperature"]
-    methods = [m for m in [*onnx, "motion_matching"] if not args.methods or m in args.methods.split(",")]
+    known = [*onnx, "motion_matching"]
+    wanted = [m for m in (args.methods or "").split(",") if m]
+    unknown = [m for m in wanted if m not in known]
+    if unknown:
+        raise EvalError(f"--methods {','.join(unknown)}: not in {args.models} (known: {', '.join(known)})")
+    methods = [m for m in known if not wanted or m in wanted]
     ref = recording_row(args.data, test, r)
     res = {"takes": test, "ranges": r, "recording": ref, "methods": {}}
     bar = tqdm(total=len(methods) * args.seeds, desc="steered duets", unit="duet", file=sys.stderr,
@@ -190,7 +195,7 @@ def main(argv=None) -> int:
     ap.add_argument("--first-seed", type=int, default=0)
     ap.add_argument("--seconds", type=float, default=60.0)
     ap.add_argument("--temperature", type=float, default=None, help="default: the manifest's")
-    ap.add_argument("--methods", default=None, help="comma-separated subset (follower, follower_ccm, motion_matching)")
+    ap.add_argument("--methods", default=None, help="comma-separated subset (ours, ccm, motion_matching; default all)")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--out", default="runs/seeds")
     ap.add_argument("--quiet", action="store_true")

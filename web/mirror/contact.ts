@@ -29,8 +29,10 @@ export const HAND_REACH = 0.2;
 export const HAND_FULL = 0.1;
 /** m between the two hands' joints when they meet (palm to palm). */
 export const GRIP = 0.06;
-/** Share of the way the hold weight moves to its target every step. */
+/** Share of the way the hold weight moves up to its target every step. */
 export const HOLD_RATE = 0.3;
+/** ... and down: a hold ends in about two steps once the networks' hands part (contact.py says why). */
+export const RELEASE_RATE = 0.7;
 /** A straight arm bends its elbow downward. */
 export const ELBOW_POLE = [0, -1, 0];
 /** Radians: the recorded elbows bend at least 0.6-0.7 in 99.5 % of frames. */
@@ -179,7 +181,8 @@ export class ContactLayer {
     this.pushed = separate(leader, follower);
     closestHands(leader, follower, pair);
     const i = pair[0], j = pair[1], d = pair[2];
-    this.hold += (reachWeight(d) - this.hold) * HOLD_RATE;
+    const target = reachWeight(d);
+    this.hold += (target - this.hold) * (target > this.hold ? HOLD_RATE : RELEASE_RATE);
     this.hands[0] = i;
     this.hands[1] = j;
     if (this.hold > 1e-3 && d > 1e-6) {
