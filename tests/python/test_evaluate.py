@@ -183,3 +183,19 @@ def test_bend_plan_turns_and_shifts_the_future_keys(take_tracks):
     shifted = window(lead, t)
     bend_plan(shifted, ("side", 0.6))
     np.testing.assert_allclose(np.linalg.norm(shifted.root[keys[-1]] - w.root[keys[-1]]), 0.6)
+
+
+def test_plausibility_of_the_free_run(result, exported):
+    """Every method gets the follower's implausible share and worst second against the manifest's
+    range; the ground-truth row is the recording itself, judged the same way."""
+    from training.evaluation import plausibility as P
+    _, r = result
+    manifest = json.loads((exported["models"] / "manifest.json").read_text())
+    assert "plausibility" in manifest
+    for name in ("ours", "ccm", "motion_matching", "ground_truth"):
+        m = r["methods"][name]
+        assert 0.0 <= m["implausible"] <= 1.0 and 0.0 <= m["worst_second"] <= 1.0, name
+        assert m["worst_second"] >= m["implausible"] or m["implausible"] == 0.0
+    runs = r["protocols"]["rollout"]["ours"]["runs"]
+    assert r["protocols"]["rollout"]["ours"]["by_temperature"]["0.5"]["worst_second"] == \
+        max(i["worst_second"] for i in runs if i["temperature"] == 0.5)

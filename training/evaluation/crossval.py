@@ -48,8 +48,14 @@ METHODS = {
     "ccm": ("follower_ccm", "follower_ccm_no_proximity", False),
     "ours_tempo": ("follower_tempo", "follower_no_proximity", True),
     "ccm_tempo": ("follower_ccm_tempo", "follower_ccm_no_proximity", True),
+    # The shipped recipes (decoders that read the pose, proximity, state noise).
+    "ours_steady": ("follower_steady", "follower", False),
+    "ccm_steady": ("follower_ccm_steady", "follower_ccm", False),
 }
-METRICS = {"mpjpe_cm": "MPJPE cm", "fid": "FID", "codebook_error": "codebook error"}
+# implausible / worst second: the free-running follower's frames with its body low, folded or split,
+# against the fold's own training range (evaluate's plausibility; n/a for evaluations without it).
+METRICS = {"mpjpe_cm": "MPJPE cm", "fid": "FID", "codebook_error": "codebook error",
+           "implausible": "implausible frames", "worst_second": "worst second"}
 CONFIDENCE = 0.95
 
 
@@ -222,21 +228,27 @@ def report(out: Path, plan: dict, seconds: float, name: str = "crossval") -> dic
                 path = out / f"fold{f['fold']}" / f"seed{s}" / f"eval_{run}" / "metrics.json"
                 if path.exists():
                     res = json.loads(path.read_text())["methods"]
-                    values[m][(f["fold"], s)] = {k: res[NAMES.get(run, run)][k] for k in METRICS}
+                    values[m][(f["fold"], s)] = {k: res[NAMES.get(run, run)].get(k) for k in METRICS}
     fold_ids = [f["fold"] for f in plan["folds"] if all((f["fold"], s) in values[m] for m in methods for s in seeds)]
     comparisons = {}
-    pairs = [(a, b) for a, b in (("ours", "ccm"), ("ours_tempo", "ours"), ("ccm_tempo", "ccm"), ("ours_tempo", "ccm_tempo"))
+    pairs = [(a, b) for a, b in (("ours", "ccm"), ("ours_tempo", "ours"), ("ccm_tempo", "ccm"), ("ours_tempo", "ccm_tempo"),
+                                 ("ours_steady", "ccm_steady"), ("ours_steady", "ours"), ("ccm_steady", "ccm"))
              if a in methods and b in methods]
     for a, b in pairs:
         comparisons[f"{a} - {b}"] = {k: paired(values[a], values[b], fold_ids, seeds, k) for k in METRICS}
     res = {"plan": plan, "complete_folds": fold_ids, "seconds": seconds,
-           "means": {m: {k: float(np.mean([values[m][(f, s)][k] for f in fold_ids for s in seeds]))
-                         if fold_ids else None for k in METRICS} for m in methods},
+           "means": {m: {k: mean_or_none([values[m][(f, s)][k] for f in fold_ids for s in seeds])
+                         for k in METRICS} for m in methods},
            "per_fold": {m: {f"{f}/{s}": v for (f, s), v in values[m].items()} for m in methods},
            "comparisons": comparisons}
     (out / f"{name}.json").write_text(json.dumps(res, indent=1))
     (out / f"{name}.md").write_text(markdown(res))
     return res
+
+
+def mean_or_none(values: list) -> float | None:
+    """The mean, or None when there is nothing or a value is missing (older evaluations)."""
+    return None if not values or any(v is None for v in values) else float(np.mean(values))
 
 
 def _num(v, digits):
@@ -245,7 +257,7 @@ def _num(v, digits):
 
 def markdown(res: dict) -> str:
     plan = res["plan"]
-    digits = {"mpjpe_cm": 2, "fid": 1, "codebook_error": 4}
+    digits = {"mpjpe_cm": 2, "fid": 1, "codebook_error": 4, "implausible": 3, "worst_second": 2}
     lines = [f"Folds {len(res['complete_folds'])} of {len(plan['folds'])} complete, seeds "
              f"{','.join(map(str, plan['seeds']))}, {plan['intention_epochs']} + {plan['epochs']} epochs"
              + (f", tempo copies {plan['tempos']}" if plan["tempos"] else "") + ".", "",

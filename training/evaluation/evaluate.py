@@ -116,6 +116,7 @@ def evaluate(args) -> dict:
             policies[m] = load_onnx(onnx[m])
     leader_policies = {"mm": mm_leader, "model": load_onnx(leader_onnx) if leader_onnx is not None else None}
     start_pose = manifest["startPose"]
+    ranges = manifest.get("plausibility")   # the training takes' range (absent in old manifests)
 
     frames = sum(len(t.frames) for t in takes)
     runs_per_method = {m: (1 if m in DETERMINISTIC else len(seeds) * len(temps)) for m in methods}
@@ -147,7 +148,7 @@ def evaluate(args) -> dict:
         for seed, temp in configs:
             runs = [rollout(t, policies[m], temp, seed, start_pose, bar=bar) for t in takes]
             items.append({"seed": seed, "temperature": None if m in DETERMINISTIC else temp,
-                          **run_metrics(runs, refs, encoder, ref_latents)})
+                          **run_metrics(runs, refs, encoder, ref_latents, ranges)})
         first_run[m] = items[0]
         by_t = ({"any": mean_metrics(items)} if m in DETERMINISTIC else
                 {f"{T:g}": mean_metrics([i for i in items if i["temperature"] == T]) for T in temps})
@@ -160,7 +161,7 @@ def evaluate(args) -> dict:
         for m in methods:
             runs = [rollout(t, policies[m], temps[0], seeds[0], start_pose, lead_mode, bend,
                             leader_policies.get(lead_mode), bar) for t in takes]
-            r = run_metrics(runs, refs, encoder, ref_latents)
+            r = run_metrics(runs, refs, encoder, ref_latents, ranges)
             r["fid_drift"] = r["fid"] - first_run[m]["fid"]
             controlled[cond][m] = r
     bar.close()
@@ -173,7 +174,8 @@ def evaluate(args) -> dict:
                           "codebook_error": teacher[m]["codebook_error"], "foot_skate_cm": roll["foot_skate_cm"],
                           "jitter": roll["jitter"], "hand_distance": roll["hand_distance"],
                           "rollout_mpjpe_cm": roll["mpjpe_cm"], "root_error_m": roll["root_error_m"],
-                          "resets": roll["resets"]}
+                          "resets": roll["resets"], "implausible": roll.get("implausible"),
+                          "worst_second": roll.get("worst_second")}
     if any(v is None for m, v in cb.items() if m != "ground_truth"):
         notes.append(f"codebook error is null where {eval_folder(args.models)} lacks the model's output encoder")
     notes.append("codebook error: the step model's own code at temperature 0 (the exported int8 file) against "

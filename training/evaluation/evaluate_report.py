@@ -17,6 +17,10 @@ def fmt(v, digits=2):
     return f"{v:.{digits}f}" if abs(v) >= 10 ** -digits or v == 0 else f"{v:.2e}"
 
 
+def pct(v):
+    return "n/a" if v is None else f"{100 * v:.1f}"
+
+
 def write_markdown(path: Path, res: dict) -> None:
     L = [f"# Evaluation: takes {', '.join(res['takes'])}", "",
          f"{res['frames']} evaluated frames (30 fps); models `{res['config']['models']}`; seeds "
@@ -24,13 +28,17 @@ def write_markdown(path: Path, res: dict) -> None:
          f"(headline at {res['config']['headline_temperature']}); {res['config']['seconds']:.0f} s.", "",
          "## Headline (paper Table 1)", "",
          "MPJPE and codebook error: teacher-forced (a). The rest: free-running rollout (b), leader "
-         "played back from the recording, mean over seeds. Diversity: closer to ground truth is better.", "",
-         "| method | MPJPE cm ↓ | Diversity → | FID ↓ | Codebook ↓ | foot skate cm ↓ | jitter m/s³ | hand dist m |",
-         "|---|---|---|---|---|---|---|---|"]
+         "played back from the recording, mean over seeds. Diversity: closer to ground truth is better. "
+         "Implausible: share of the follower's frames with its body low, folded or split; worst second: "
+         "the largest share in any one second, worst over seeds and takes (evaluation.plausibility, "
+         "against the training takes' range).", "",
+         "| method | MPJPE cm ↓ | Diversity → | FID ↓ | Codebook ↓ | foot skate cm ↓ | jitter m/s³ | hand dist m "
+         "| implausible % ↓ | worst second % ↓ |",
+         "|---|---|---|---|---|---|---|---|---|---|"]
     for name, m in res["methods"].items():
         L.append(f"| {name} | {fmt(m.get('mpjpe_cm'))} | {fmt(m.get('diversity'))} | {fmt(m.get('fid'))} | "
                  f"{fmt(m.get('codebook_error'), 4)} | {fmt(m.get('foot_skate_cm'))} | {fmt(m.get('jitter'), 1)} | "
-                 f"{fmt(m.get('hand_distance'))} |")
+                 f"{fmt(m.get('hand_distance'))} | {pct(m.get('implausible'))} | {pct(m.get('worst_second'))} |")
     tf = res["protocols"]["teacher_forced"]
     if "motion_matching_oracle" in tf:
         L += ["", f"Motion Matching queried with the recorded follower future (the paper's MM query; "

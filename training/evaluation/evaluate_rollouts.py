@@ -12,6 +12,7 @@ from ..mirror import features as feat
 from ..mirror.features import FUTURE_OFFSETS, HISTORY, Track, follower_input, leader_input
 from ..mirror.rollout import NOW, Dancer, apply_output, output_is_absurd, reset_beside
 from . import metrics as M
+from . import plausibility as P
 from .evaluate_inputs import EvalError, EvalTake, RecordingPolicy, window
 
 DIVERGED = 3.0          # m between the partners' roots: the pair has come apart
@@ -144,8 +145,12 @@ def latents(encoder, r: dict) -> np.ndarray:
     return encoder(M.windows(M.motion_features(as_track(r), frames)))
 
 
-def run_metrics(runs: list[dict], refs: list[dict], encoder, ref_latents: np.ndarray) -> dict:
-    """Metrics of one run over all takes (frame-weighted means; FID and Diversity pooled)."""
+def run_metrics(runs: list[dict], refs: list[dict], encoder, ref_latents: np.ndarray,
+                ranges: dict | None = None) -> dict:
+    """Metrics of one run over all takes (frame-weighted means; FID and Diversity pooled). With
+    the training takes' plausibility range (the manifest's), also the follower's plausibility:
+    `implausible`, the share of frames with its body low, folded or split (plausibility.BODY_FLAGS),
+    `angles_out`, and the worst second over the takes, since a mean pose error never shows a fall."""
     per, weights, lat = [], [], []
     for r, g in zip(runs, refs):
         idx = np.arange(HISTORY + 1, HISTORY + r["steps"] + 1)
@@ -161,10 +166,16 @@ def run_metrics(runs: list[dict], refs: list[dict], encoder, ref_latents: np.nda
             "distance_to_leader": float(apart.mean()),
             "divergence": float((apart > DIVERGED).mean()),
         })
+        if ranges is not None:
+            flags = P.frame_flags(r["positions"][idx], ranges)
+            per[-1].update(implausible=float(np.any([flags[k] for k in P.BODY_FLAGS], axis=0).mean()),
+                           angles_out=float(flags["angles_out"].mean()), worst_second=P.worst_second(flags))
         weights.append(len(idx))
         lat.append(latents(encoder, r))
     w = np.asarray(weights, float) / sum(weights)
     out = {k: float(sum(wi * p[k] for wi, p in zip(w, per))) for k in per[0]}
+    if ranges is not None:
+        out["worst_second"] = float(max(p["worst_second"] for p in per))   # worst over takes, not a mean
     lat = np.concatenate(lat)
     out["fid"] = M.fid(lat, ref_latents)
     out["diversity"] = M.diversity(lat)
@@ -174,4 +185,6 @@ def run_metrics(runs: list[dict], refs: list[dict], encoder, ref_latents: np.nda
 
 
 def mean_metrics(items: list[dict]) -> dict:
-    return {k: float(np.mean([i[k] for i in items])) for k in items[0] if k not in ("seed", "temperature")}
+    """Means over seeds; the worst second stays the worst of them."""
+    return {k: float((np.max if k == "worst_second" else np.mean)([i[k] for i in items]))
+            for k in items[0] if k not in ("seed", "temperature")}
