@@ -329,3 +329,21 @@ def test_command_line_overrides_change_only_what_was_given():
     cfg = T.apply_overrides(base, given)
     assert (cfg.seed, cfg.model.channels, cfg.model.intention_hidden, cfg.intention_best) == (3, 8, 64, True)
     assert replace(cfg, seed=base.seed, model=base.model, intention_best=False) == base
+
+
+def test_state_dropout_hides_the_state_from_the_decoder_only():
+    """state_keep 0 gives the decoder the mean pose (0 in normalized units) and nothing else: the
+    same output as an input whose state columns are 0; 1 changes nothing."""
+    import torch
+    from training.learning.models import CodebookMatching, ModelConfig
+    torch.manual_seed(0)
+    m = CodebookMatching(ModelConfig(decoder_state=True, hidden=32, channels=2, classes=4)).eval()
+    x = torch.randn(3, m.cfg.input_size)
+    code = torch.nn.functional.one_hot(torch.tensor([[1, 2], [0, 3], [3, 3]]), 4).float().reshape(3, -1)
+    zeroed = x.clone()
+    zeroed[:, m.state_columns] = 0
+    keep = torch.tensor([[0.0], [1.0], [0.0]])
+    out = m.decode(code, x, keep)
+    assert torch.allclose(out[[0, 2]], m.decode(code, zeroed)[[0, 2]])
+    assert torch.allclose(out[1], m.decode(code, x)[1])
+    assert not torch.allclose(m.decode(code, x)[0], m.decode(code, zeroed)[0])

@@ -114,9 +114,13 @@ class CodebookMatching(nn.Module):
         self.decoder = mlp([cfg.latent + len(cfg.state_columns), h, h, cfg.output_size], cfg.dropout)
         self.register_buffer("state_columns", torch.tensor(cfg.state_columns, dtype=torch.long), persistent=False)
 
-    def decode(self, code, x):
-        """One-hot code [B, C*D] (and the normalized input x, read when the decoder reads the state) -> O."""
-        return self.decoder(torch.cat([code, x[:, self.state_columns]], -1))
+    def decode(self, code, x, state_keep: torch.Tensor | None = None):
+        """One-hot code [B, C*D] (and the normalized input x, read when the decoder reads the state) -> O.
+        state_keep [B, 1] (training only): 0 hides a sample's state from the decoder (the mean pose)."""
+        state = x[:, self.state_columns]
+        if state_keep is not None:
+            state = state * state_keep
+        return self.decoder(torch.cat([code, state], -1))
 
     def _cond(self, x, intention):
         return torch.cat([x, intention], -1) if self.cfg.intention else x
@@ -127,12 +131,12 @@ class CodebookMatching(nn.Module):
     def target_logits(self, x, y, intention=None):
         return self.output_encoder(torch.cat([y, self._cond(x, intention)], -1))
 
-    def forward(self, x, y, intention=None, temperature: float = 1.0):
+    def forward(self, x, y, intention=None, temperature: float = 1.0, state_keep=None):
         s = self.target_logits(x, y, intention)
         s_hat = self.estimate_logits(x, intention)
         code = sample_codes(s, self.cfg.channels, temperature)
         code_hat = sample_codes(s_hat, self.cfg.channels, temperature)
-        return self.decode(code, x), s, s_hat, code, code_hat
+        return self.decode(code, x, state_keep), s, s_hat, code, code_hat
 
     def generate(self, x, intention=None, temperature: float = 0.0, noise=None):
         code = sample_codes(self.estimate_logits(x, intention), self.cfg.channels, temperature, noise)
