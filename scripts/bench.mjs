@@ -7,6 +7,7 @@
 //   npm run bench                 # threads 1 and 2
 //   node scripts/bench.mjs --seconds 20 --json
 //   npm run bench -- --phone      # a phone on a mobile network: see scripts/bench_phone.mjs
+//   npm run bench -- --phone --boot-only --query threads=1   # only the two visits, extra URL settings
 //
 // Timings on a 2-core machine with software WebGL vary by ±20 % between runs.
 
@@ -88,7 +89,7 @@ async function run(url, threads) {
 
 if (args.includes('--phone')) {
   const { benchPhone } = await import('./bench_phone.mjs');
-  await benchPhone({ json, seconds });
+  await benchPhone({ json, seconds, bootOnly: args.includes('--boot-only'), query: option('query', '') });
   process.exit(0);
 }
 

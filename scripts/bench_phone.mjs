@@ -45,8 +45,63 @@ async function visit(page, url, timeoutMs = 90_000) {
       transferredBytes: transferred,
       controlled: !!navigator.serviceWorker?.controller,
       threads: window.duet.threads,
+      boot: { ...(window.duet.bootTimings ?? {}) },
+      wasmCalls: window.__benchWasmCalls ?? [],
+      navigation: (({ responseStart, responseEnd, domContentLoadedEventEnd }) => ({ responseStart, responseEnd, domContentLoadedEventEnd }))(performance.getEntriesByType('navigation')[0] ?? {}),
+      resources: performance.getEntriesByType('resource').map((e) => ({
+        name: e.name.replace(location.origin, ''),
+        startTime: e.startTime,
+        responseStart: e.responseStart,
+        responseEnd: e.responseEnd,
+        transferSize: e.transferSize,
+        encodedBodySize: e.encodedBodySize,
+      })),
     };
   });
+}
+
+/**
+ * Before any script of the page: time every WebAssembly compile and instantiate call, so that the
+ * boot breakdown shows wasm compilation apart from session creation (onnxruntime does both inside
+ * its first InferenceSession.create). Measurement only: the page works the same without it.
+ */
+function wasmTimingScript() {
+  const calls = (window.__benchWasmCalls = []);
+  for (const name of ['compile', 'instantiate', 'compileStreaming', 'instantiateStreaming']) {
+    const original = WebAssembly[name];
+    if (!original) continue;
+    WebAssembly[name] = function (...args) {
+      const call = { name, start: performance.now(), end: null, module: args[0] instanceof WebAssembly.Module };
+      calls.push(call);
+      const result = original.apply(this, args);
+      result.then(() => (call.end = performance.now()), () => (call.end = -1));
+      return result;
+    };
+  }
+}
+
+/** Stage timings (window.duet.bootTimings) and each downloaded file, for one visit. */
+function printBreakdown(visit) {
+  const s = (ms) => (ms === null || ms === undefined ? '    —  ' : `${(ms / 1000).toFixed(2)} s`.padStart(7));
+  const { boot, navigation } = visit;
+  console.log(`  html: response ${s(navigation.responseStart)} – ${s(navigation.responseEnd)}, DOMContentLoaded ${s(navigation.domContentLoadedEventEnd)}`);
+  const spans = new Map();
+  const points = [];
+  for (const [key, at] of Object.entries(boot)) {
+    const m = /^(.*):(start|end)$/.exec(key);
+    if (m) spans.set(m[1], { ...spans.get(m[1]), [m[2]]: at });
+    else points.push([key, at]);
+  }
+  const lines = [
+    ...points.map(([name, at]) => [at, `  ${name.padEnd(26)} ${s(at)}`]),
+    ...[...spans].map(([name, { start, end }]) => [start, `  ${name.padEnd(26)} ${s(start)} – ${s(end)}  (${end !== undefined ? `${Math.round(end - start)} ms` : 'unfinished'})`]),
+    ...visit.wasmCalls.map((c) => [c.start, `  WebAssembly.${c.name}${c.module ? '(Module)' : ''}`.padEnd(28) + ` ${s(c.start)} – ${s(c.end)}  (${Math.round(c.end - c.start)} ms)`]),
+  ];
+  for (const [, line] of lines.sort((a, b) => a[0] - b[0])) console.log(line);
+  console.log('  resources (start – first byte – end, bytes over the wire / encoded body):');
+  for (const r of [...visit.resources].sort((a, b) => a.startTime - b.startTime)) {
+    console.log(`    ${r.name.slice(0, 48).padEnd(48)} ${s(r.startTime)} ${s(r.responseStart)} ${s(r.responseEnd)}  ${(r.transferSize / 1e3).toFixed(0).padStart(6)} kB / ${(r.encodedBodySize / 1e3).toFixed(0).padStart(6)} kB`);
+  }
 }
 
 /** Entries the service worker has stored, once it holds the wasm and the models (or after 60 s). */
@@ -83,36 +138,41 @@ async function framesPerSecond(page, url, ms = 4000) {
   return { bodies, fps };
 }
 
-export async function benchPhone({ json = false, seconds = 14 } = {}) {
+export async function benchPhone({ json = false, seconds = 14, breakdown = true, bootOnly = false, query = '' } = {}) {
   await build('dist');
   const server = await serve({ dir: 'dist' });
   const browser = await launch(PHONE);
   const result = {};
   try {
     const { page } = browser;
+    await page.addInitScript(wasmTimingScript);
     await throttle(page);
-    const url = `${server.url}?seed=1`;
+    const url = `${server.url}?seed=1${query ? `&${query}` : ''}`;
     result.cold = await visit(page, url);
     result.cached = (await waitOfflineCache(page)).length;
     result.repeat = await visit(page, url);
+    if (!bootOnly) {
+      // Step time at 4× CPU while steering, on the warm page.
+      await page.keyboard.down('ArrowUp');
+      await sleep((seconds * 1000) / 2);
+      await page.keyboard.up('ArrowUp');
+      await sleep((seconds * 1000) / 2);
+      result.stepMs = await page.evaluate(() => window.duet.stepMs);
 
-    // Step time at 4× CPU while steering, on the warm page.
-    await page.keyboard.down('ArrowUp');
-    await sleep((seconds * 1000) / 2);
-    await page.keyboard.up('ArrowUp');
-    await sleep((seconds * 1000) / 2);
-    result.stepMs = await page.evaluate(() => window.duet.stepMs);
-
-    result.fps = {
-      skinned: await framesPerSecond(page, url),
-      sticks: await framesPerSecond(page, `${url}&bodies=sticks`),
-    };
-    result.consoleErrors = browser.consoleErrors;
+      result.fps = {
+        skinned: await framesPerSecond(page, url),
+        sticks: await framesPerSecond(page, `${url}&bodies=sticks`),
+      };
+    }
   } finally {
+    result.consoleErrors = browser.consoleErrors;
     await browser.close();
     await server.stop();
   }
+  return printResult(result, { json, breakdown });
+}
 
+function printResult(result, { json, breakdown }) {
   if (json) {
     console.log(JSON.stringify(result, null, 1));
     return result;
@@ -129,6 +189,10 @@ export async function benchPhone({ json = false, seconds = 14 } = {}) {
   console.log(`  first paint              ${s(repeat.firstPaintMs)}`);
   console.log(`  loading scene drawn      ${s(repeat.sceneMs)}`);
   console.log(`  first dancing frame      ${s(repeat.firstFrameMs)}  target ≤ ${s(TARGETS.repeatMs)}  ${mark(repeat.firstFrameMs, TARGETS.repeatMs)}`);
+  if (!result.stepMs) {
+    printBreakdowns(result, breakdown);
+    return result;
+  }
   console.log(`model step at 4× CPU       median ${result.stepMs.median.toFixed(2)} ms, p95 ${result.stepMs.p95.toFixed(2)} ms  target ≤ ${TARGETS.stepMs} ms  ${mark(result.stepMs.median, TARGETS.stepMs)}`);
   const { skinned, sticks } = result.fps;
   if (!skinned.bodies) {
@@ -136,7 +200,17 @@ export async function benchPhone({ json = false, seconds = 14 } = {}) {
   } else {
     console.log(`drawing both dancers       ${skinned.bodies}: ${skinned.fps.toFixed(1)} fps   ${sticks.bodies}: ${sticks.fps.toFixed(1)} fps  (4× CPU, software WebGL)`);
   }
-  if (cold.error || repeat.error) console.log(`page error: ${cold.error ?? repeat.error}`);
-  if (result.consoleErrors.length) console.log(`console errors: ${result.consoleErrors.join(' | ')}`);
+  printBreakdowns(result, breakdown);
   return result;
+}
+
+function printBreakdowns({ cold, repeat, consoleErrors }, breakdown) {
+  if (breakdown) {
+    console.log('\nfirst visit, stage by stage (ms since navigation):');
+    printBreakdown(cold);
+    console.log('\nrepeat visit, stage by stage:');
+    printBreakdown(repeat);
+  }
+  if (cold.error || repeat.error) console.log(`page error: ${cold.error ?? repeat.error}`);
+  if (consoleErrors.length) console.log(`console errors: ${consoleErrors.join(' | ')}`);
 }

@@ -140,6 +140,10 @@ export class Stage {
   private readonly sun: THREE.DirectionalLight;
   private readonly floor: THREE.Mesh;
   private readonly followTarget = new THREE.Vector3(0, TARGET_HEIGHT, 0.4);
+  /** What the last render() saw: camera matrices, drawing-buffer size, and a change of look. */
+  private readonly rendered = { view: new THREE.Matrix4(), projection: new THREE.Matrix4(), size: new THREE.Vector2(), stale: true };
+  /** The controls were updated by needsRender() since the last render(). */
+  private controlsUpdated = false;
 
   constructor(container: HTMLElement, parents: number[], maxGhosts: number, options: StageOptions = {}) {
     this.renderer = new THREE.WebGLRenderer({ antialias: true });
@@ -226,6 +230,22 @@ export class Stage {
   }
   set skeleton(on: boolean) {
     for (const d of this.dancers) if (d instanceof SkinnedDancer) d.skeleton = on;
+    this.rendered.stale = true;
+  }
+
+  /**
+   * Whether a render now would differ from the last one, for a scene in which nothing else moves
+   * (the standing pair while the models load): the camera moved (a drag, the controls' damping,
+   * a view offset), the canvas changed size, or the look changed. Advances the controls' damping
+   * itself; the render() that follows does not advance it a second time.
+   */
+  needsRender(): boolean {
+    this.controls.update();
+    this.controlsUpdated = true;
+    this.camera.updateMatrixWorld();
+    const { rendered } = this;
+    return rendered.stale || !rendered.view.equals(this.camera.matrixWorld) || !rendered.projection.equals(this.camera.projectionMatrix) ||
+      !rendered.size.equals(this.renderer.getDrawingBufferSize(_size));
   }
 
   resize(): void {
@@ -288,10 +308,26 @@ export class Stage {
     if (d && (hand === 0 || hand === 1)) d.handContact[hand] = Number.isFinite(weight) ? Math.min(1, Math.max(0, weight)) : 0;
   }
 
+  /**
+   * Compile the shaders of everything the scene can show, hidden things included (the paths,
+   * intentions, ghosts, contact marks and the compare pair are hidden while the models load), so
+   * that the first dancing frame does not stall on shader compilation. With
+   * KHR_parallel_shader_compile the compiling happens off this thread.
+   */
+  precompile(): Promise<void> {
+    return this.renderer.compileAsync(this.scene, this.camera).then(() => undefined);
+  }
+
   render(): void {
     this.contacts.update(this.dancers);
-    this.controls.update();
+    if (!this.controlsUpdated) this.controls.update();
+    this.controlsUpdated = false;
     this.renderer.render(this.scene, this.camera);
+    const { rendered } = this;
+    rendered.view.copy(this.camera.matrixWorld);
+    rendered.projection.copy(this.camera.projectionMatrix);
+    this.renderer.getDrawingBufferSize(rendered.size);
+    rendered.stale = false;
   }
 }
 
@@ -316,3 +352,4 @@ function gridFloorMaterial(): THREE.MeshLambertMaterial {
 const _delta = new THREE.Vector3();
 const _offset = new THREE.Vector3();
 const _spherical = new THREE.Spherical();
+const _size = new THREE.Vector2();

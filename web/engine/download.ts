@@ -51,7 +51,7 @@ export class DownloadProgress {
  * The whole body of a response, reporting each chunk to `onBytes`. `expected` (the uncompressed
  * size, when known) lets it fill one buffer instead of concatenating chunks at the end.
  */
-export async function readBody(response: Response, onBytes?: (bytes: number) => void, expected = 0): Promise<Uint8Array> {
+export async function readBody(response: Response, onBytes?: (bytes: number) => void, expected = 0): Promise<Uint8Array<ArrayBuffer>> {
   if (!response.body || !onBytes) {
     const bytes = new Uint8Array(await response.arrayBuffer());
     onBytes?.(bytes.byteLength);
@@ -73,6 +73,20 @@ export async function readBody(response: Response, onBytes?: (bytes: number) => 
     onBytes(value.byteLength);
   }
   return length === buffer.byteLength ? buffer : buffer.slice(0, length);
+}
+
+/** Read a response's body only to count it (its bytes go nowhere), reporting each chunk to
+ *  `onBytes`; resolves to the total. For a clone whose twin is consumed elsewhere. */
+export async function countBody(response: Response, onBytes: (bytes: number) => void): Promise<number> {
+  if (!response.body) return 0;
+  const reader = response.body.getReader();
+  let total = 0;
+  for (;;) {
+    const { done, value } = await reader.read();
+    if (done) return total;
+    total += value.byteLength;
+    onBytes(value.byteLength);
+  }
 }
 
 /** A short hash of a string (FNV-1a), for cache versions. */

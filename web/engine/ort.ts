@@ -5,19 +5,54 @@
 // worker would re-run the whole app after `vite build`, and session creation hangs with
 // numThreads > 1. A dynamic import gives ORT a chunk of its own. `onnxruntime-web/wasm` is the
 // CPU-only build (about 14 MB of wasm, 3.7 MB gzipped) instead of the 28 MB JSEP one.
-// Its .wasm is found with `new URL(..., import.meta.url)`, which Vite rewrites into a relative
-// asset URL, so it also loads when dist/ is served from a sub-path.
 
+import { bootMark } from './boot';
+
+bootMark('ort:import');
 export const ort = await import('onnxruntime-web/wasm');
+bootMark('ort:imported');
 
 /**
- * Set the number of WASM threads. Must run before the first InferenceSession is created.
- * Threads need SharedArrayBuffer, which browsers only give to cross-origin-isolated pages
- * (COOP + COEP headers); without isolation we run on one thread rather than fail.
+ * The smallest valid wasm binary (magic number and version, no sections). onnxruntime is given
+ * this as its `wasmBinary`, so that it fetches nothing itself; useCompiledModule() recognises it
+ * when onnxruntime instantiates it and instantiates the page's compiled module instead.
  */
-export function configureThreads(requested: number | null, wasmBinary?: Uint8Array): number {
-  // The page fetched the wasm itself (wasm.ts), with a progress bar: onnxruntime fetches nothing.
-  if (wasmBinary) ort.env.wasm.wasmBinary = wasmBinary;
+const PLACEHOLDER = new Uint8Array([0x00, 0x61, 0x73, 0x6d, 0x01, 0x00, 0x00, 0x00]);
+
+function isPlaceholder(source: unknown): boolean {
+  const bytes = source instanceof ArrayBuffer ? new Uint8Array(source) : ArrayBuffer.isView(source) ? new Uint8Array(source.buffer, source.byteOffset, source.byteLength) : null;
+  return bytes !== null && bytes.length === PLACEHOLDER.length && PLACEHOLDER.every((b, i) => bytes[i] === b);
+}
+
+/**
+ * Make onnxruntime use `module`, compiled by the page while it downloaded (wasm.ts), instead of
+ * compiling the 14 MB binary a second time. onnxruntime-web has no option for a compiled module:
+ * its loader (Emscripten) calls WebAssembly.instantiate(wasmBinary, imports) once, on this thread,
+ * when the first session is created. That one call, recognised by the placeholder binary, is
+ * answered with an instance of `module` (which is also the module Emscripten sends to its worker
+ * threads); every other call goes straight to the browser's WebAssembly.instantiate, and the
+ * original function is put back after the call.
+ */
+function useCompiledModule(module: WebAssembly.Module): void {
+  const instantiate = WebAssembly.instantiate;
+  const handOver = function (this: unknown, ...args: Parameters<typeof instantiate>) {
+    if (!isPlaceholder(args[0])) return (instantiate as (...a: unknown[]) => unknown).apply(this, args);
+    WebAssembly.instantiate = instantiate;
+    return instantiate(module, args[1]).then((instance) => ({ module, instance }));
+  };
+  WebAssembly.instantiate = handOver as typeof WebAssembly.instantiate;
+  ort.env.wasm.wasmBinary = PLACEHOLDER;
+}
+
+/**
+ * Set the number of WASM threads and hand onnxruntime its compiled module. Must run before the
+ * first InferenceSession is created. Threads need SharedArrayBuffer, which browsers only give to
+ * cross-origin-isolated pages (COOP + COEP headers); without isolation we run on one thread
+ * rather than fail.
+ */
+export function configureThreads(requested: number | null, module?: WebAssembly.Module): number {
+  // The page fetched and compiled the wasm itself (wasm.ts), with a progress bar.
+  if (module) useCompiledModule(module);
   const most = globalThis.crossOriginIsolated ? 2 : 1;
   const threads = requested === null ? most : Math.max(1, Math.min(most, Math.round(requested)));
   ort.env.wasm.numThreads = threads;

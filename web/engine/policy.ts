@@ -132,7 +132,24 @@ export async function createPolicy(manifest: Manifest, name: string, bytes: Uint
     );
   }
   checkSession(name, entry, session);
+  await warmUp(session, entry);
   return new Policy(name, entry, session, seed);
+}
+
+/**
+ * One run on neutral inputs right after the session is created. A session's first run is much
+ * slower than the next ones (onnxruntime allocates and plans its buffers then): done here, it
+ * overlaps with the other downloads instead of delaying the first dancing frame. Tensors of its
+ * own, so the policy's noise stream (and so the dance for a seed) is untouched.
+ */
+async function warmUp(session: Session, entry: ModelEntry): Promise<void> {
+  const noise = entry.channels * entry.classes;
+  const outputs = await session.run({
+    input: new ort.Tensor('float32', new Float32Array(INPUT_SIZE), [1, INPUT_SIZE]),
+    temperature: new ort.Tensor('float32', new Float32Array([1]), [1]),
+    noise: new ort.Tensor('float32', new Float32Array(noise).fill(0.5), [1, noise]),
+  }, entry.intention ? ['output', 'intention'] : ['output']);
+  for (const tensor of Object.values(outputs)) tensor.dispose();
 }
 
 /** The ONNX graph must have the inputs and outputs of the contract, with matching widths. */

@@ -163,6 +163,8 @@ export interface DuetHook {
   download?: { loaded: number; total: number };
   /** How the dancers are drawn: skinned characters, or capsule figures (?bodies=sticks). */
   bodies?: 'skinned' | 'sticks';
+  /** When each stage of the start happened, ms since navigation (web/engine/boot.ts). */
+  bootTimings?: Record<string, number>;
 }
 
 declare global {

@@ -1,13 +1,16 @@
-// onnxruntime's WebAssembly binary, fetched by the page itself rather than by onnxruntime: the
-// page starts it before onnxruntime's JavaScript has even arrived, and counts its bytes for the
-// progress bar. ort.ts hands the bytes to onnxruntime (env.wasm.wasmBinary).
+// onnxruntime's WebAssembly, fetched and compiled by the page itself rather than by onnxruntime:
+// the page starts it before onnxruntime's JavaScript has even arrived, compiles it while it
+// downloads (WebAssembly.compileStreaming: the compiler runs on background threads as the bytes
+// come in, so on a slow network the module is ready moments after its last byte), and counts its
+// bytes for the progress bar. ort.ts hands the compiled module to onnxruntime.
 //
 // `onnxruntime-web/wasm` ships only the SIMD + threads build, and it is the smallest of the four
 // (14.2 MB; the JSPI one is 16.8 MB, asyncify 26.8 MB, JSEP 28.3 MB): the one to keep.
 
 import wasmUrl from 'onnxruntime-web/ort-wasm-simd-threaded.wasm?url';
-import { type DownloadProgress, VERSION_HEADER, readBody } from './download';
+import { type DownloadProgress, VERSION_HEADER, countBody, readBody } from './download';
 import { DuetError } from '../ui/errors';
+import type { DownloadSlots } from './slots';
 
 /** Uncompressed size of the wasm, from vite.config.ts (0 under test runners without it). */
 declare const __ORT_WASM_BYTES__: number | undefined;
@@ -15,16 +18,44 @@ export const WASM_BYTES = typeof __ORT_WASM_BYTES__ === 'number' ? __ORT_WASM_BY
 /** Where the build put the wasm (its name carries a content hash). */
 export const WASM_URL: string = wasmUrl;
 
-/** Download the wasm, reporting bytes as `progress` part "wasm". */
-export async function fetchWasm(progress: DownloadProgress, version = ''): Promise<Uint8Array> {
+/** The wasm on its way: `received` once its last byte is in, `module` once it is compiled. */
+export interface WasmDownload {
+  received: Promise<void>;
+  module: Promise<WebAssembly.Module>;
+}
+
+/**
+ * Download and compile the wasm, reporting bytes as `progress` part "wasm", in a slot of `slots`.
+ *
+ * The response itself goes to compileStreaming (a response straight from fetch, so Chromium can
+ * also keep the compiled code with it); a clone is read only to count bytes. A host that serves
+ * .wasm with another MIME type than application/wasm would make compileStreaming refuse: then the
+ * bytes are read and compiled in one piece.
+ */
+export function loadWasm(progress: DownloadProgress, slots: DownloadSlots, version = ''): WasmDownload {
   progress.expect('wasm', WASM_BYTES);
-  try {
+  const fail = (error: unknown) => {
+    throw new DuetError('Could not load onnxruntime', `${WASM_URL}: ${(error as Error).message}`);
+  };
+  // An object, not the promise itself: the download is over when the bytes are in, while the
+  // compilation may still be going.
+  const download = slots.run(WASM_BYTES, async (): Promise<{ compiled: Promise<WebAssembly.Module> }> => {
     const response = await fetch(WASM_URL, version ? { headers: { [VERSION_HEADER]: version } } : undefined);
     if (!response.ok) throw new Error(`answered ${response.status}`);
+    if (typeof WebAssembly.compileStreaming === 'function' && /^application\/wasm\b/.test(response.headers.get('content-type') ?? '')) {
+      const copy = response.clone();
+      const compiled = WebAssembly.compileStreaming(response);
+      compiled.catch(() => undefined); // reported through `module`
+      await countBody(copy, (n) => progress.add('wasm', n));
+      progress.finish('wasm');
+      return { compiled };
+    }
     const bytes = await readBody(response, (n) => progress.add('wasm', n), WASM_BYTES);
     progress.finish('wasm');
-    return bytes;
-  } catch (error) {
-    throw new DuetError('Could not load onnxruntime', `${WASM_URL}: ${(error as Error).message}`);
-  }
+    return { compiled: WebAssembly.compile(bytes) };
+  });
+  return {
+    received: download.then(() => undefined, () => undefined), // a failure is reported through `module`
+    module: download.then(({ compiled }) => compiled).catch(fail),
+  };
 }

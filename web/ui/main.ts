@@ -11,7 +11,8 @@ import type { Policy } from '../engine/policy';
 import { checkBrowserSupport, installGlobalErrorHandlers, showError } from './errors';
 import { fetchModelBytes, loadManifest } from '../engine/manifest';
 import { DownloadProgress } from '../engine/download';
-import { fetchWasm } from '../engine/wasm';
+import { loadWasm } from '../engine/wasm';
+import { DownloadSlots } from '../engine/slots';
 import { standingViews } from '../engine/standing';
 import { assetVersion, keepForOffline, registerOffline } from '../engine/offline';
 import { LoadingBar } from './loading';
@@ -30,6 +31,10 @@ import { MAX_RECORD_FRAMES, Recorder, formatDuration } from './record';
 import { RecordPanel } from './recordpanel';
 import { LeaderFileInput } from './dropzone';
 import { showToast } from './toast';
+import { bootMark, bootSpan, bootTimings } from '../engine/boot';
+
+// Every static import above (three.js included) has been fetched, parsed and run by now.
+bootMark('main');
 
 const DT = 1 / FPS;
 const NO_GUARDS = { resets: 0, leashed: 0 };
@@ -63,6 +68,7 @@ const hook: DuetHook = {
   modelBytes: 0,
   firstFrameMs: null,
   hold: 0,
+  bootTimings,
 };
 window.duet = hook;
 installGlobalErrorHandlers();
@@ -79,22 +85,27 @@ function publish(target: DuetHook['leader'], view: DancerView): void {
  * models, not with the page (ORT alone is 3.7 MB gzipped).
  */
 function loadRuntime() {
-  const runtime = Promise.all([import('../engine/ort'), import('../engine/policy'), import('../engine/simulation')]);
+  const runtime = bootSpan('runtime', () => Promise.all([import('../engine/ort'), import('../engine/policy'), import('../engine/simulation')]));
   runtime.catch(() => undefined); // reported where it is awaited
   return runtime;
 }
 
 type Runtime = Awaited<ReturnType<typeof loadRuntime>>;
 
-/** Each model file fetched once, from the first time it is asked for (the CCM follower only when
- *  chosen), its bytes counted in `progress`. */
-function modelDownloads(manifest: Manifest, progress: DownloadProgress): (name: string) => Promise<Uint8Array> {
+/**
+ * Each model file fetched once, from the first time it is asked for (the CCM follower only when
+ * chosen), its bytes counted in `progress`, when `slots` lets it start (slots.ts: the order of
+ * the first downloads).
+ */
+function modelDownloads(manifest: Manifest, progress: DownloadProgress, slots: DownloadSlots): (name: string) => Promise<Uint8Array> {
   const downloads = new Map<string, Promise<Uint8Array>>();
   const version = assetVersion(manifest);
   return (name) => {
     if (!downloads.has(name)) {
       progress.expect(name, manifest.models[name]?.bytes ?? 0);
-      const bytes = fetchModelBytes(manifest, name, (n) => progress.add(name, n), version);
+      const bytes = slots.run(manifest.models[name]?.bytes ?? 0, () =>
+        bootSpan(`download:${name}`, () => fetchModelBytes(manifest, name, (n) => progress.add(name, n), version)),
+      );
       bytes.catch(() => undefined); // reported where it is awaited
       downloads.set(name, bytes);
     }
@@ -142,7 +153,6 @@ class Page {
   private fps = 0;
   private fpsSince = 0;
   private last = 0;
-  private lastIdleDraw = -Infinity;
 
   /** Both dancers in their start pose, drawn until the simulation exists. */
   private readonly still: { leader: DancerView; followers: DancerView[] };
@@ -150,14 +160,18 @@ class Page {
   constructor(
     private readonly manifest: Manifest,
     progress: DownloadProgress,
+    slots: DownloadSlots,
     private readonly loading: LoadingBar,
   ) {
     this.defaults = defaultSettings(manifest.defaultTemperature);
     this.settings = readSettings(location.search, this.defaults);
     this.hasCcm = 'follower_ccm' in manifest.models;
     if (!this.hasCcm) this.settings.model = 'ours';
-    this.download = modelDownloads(manifest, progress);
-    for (const name of ['leader', ...FOLLOWER_MODELS[this.settings.model]]) this.download(name);
+    this.download = modelDownloads(manifest, progress, slots);
+    // Largest first: the smallest model comes in last (slots.ts).
+    const firstDance = ['leader', ...FOLLOWER_MODELS[this.settings.model]];
+    const size = (name: string) => manifest.models[name]?.bytes ?? 0;
+    for (const name of firstDance.sort((a, b) => size(b) - size(a))) this.download(name);
 
     // The floor is up while the models download: something to look at, never a blank canvas.
     // Skinned characters unless ?bodies=sticks (the bench compares both); ?skeleton=1 overlays the bones.
@@ -271,7 +285,7 @@ class Page {
     let loading = this.policies.get(name);
     if (!loading) {
       const seed = (this.settings.seed + MODEL_NAMES.indexOf(name) * 0x9e3779b9) >>> 0;
-      loading = this.download(name).then((bytes) => this.createPolicy!(this.manifest, name, bytes, seed)).then((p) => {
+      loading = this.download(name).then((bytes) => bootSpan(`session:${name}`, () => this.createPolicy!(this.manifest, name, bytes, seed))).then((p) => {
         hook.modelBytes += p.entry.bytes;
         return p;
       });
@@ -348,7 +362,10 @@ class Page {
       const duet = this.simulation?.duet;
       if (this.recorder.recording && duet) this.recorder.capture(duet);
       hook.frame++;
-      if (hook.firstFrameMs === null) hook.firstFrameMs = performance.now();
+      if (hook.firstFrameMs === null) {
+        hook.firstFrameMs = performance.now();
+        bootMark('first-step');
+      }
       hook.ready = true;
       // Draw between steps when stepping is slow (software rendering, big models, high speed).
       if (performance.now() - began > Math.max(MIN_STEP_BUDGET_MS, this.drawMs)) break;
@@ -364,9 +381,13 @@ class Page {
     this.last = performance.now();
     // The standing pair at once, not a frame later: the loading scene's moment for the bench.
     this.draw(0, 0);
-    this.lastIdleDraw = this.last;
     hook.sceneMs = performance.now();
-    performance.mark('duet-scene');
+    bootMark('scene');
+    // Once the loading scene is on screen (a task later), while the models are still coming.
+    setTimeout(() => {
+      bootMark('shaders:start');
+      this.stage.precompile().then(() => bootMark('shaders:end'), () => undefined); // only an optimisation
+    }, 0);
     requestAnimationFrame(this.frame);
     // Browsers stop animation frames in hidden tabs: start timing afresh when the tab comes back.
     document.addEventListener('visibilitychange', () => {
@@ -392,12 +413,14 @@ class Page {
         .finally(() => (this.stepping = false));
     }
 
-    // While models load (or after an error) there is nothing moving: redraw rarely and leave the
-    // CPU to downloading and compiling.
-    if (this.simulation || now - this.lastIdleDraw > 250) {
-      this.lastIdleDraw = now;
-      this.draw(Math.min(1, this.accumulator / DT), elapsed);
-    }
+    // While the models load (or after an error) nothing moves but the camera: redraw only when
+    // the picture would change, and leave the main thread to the downloads and to starting the
+    // models (in the phone bench, at 4x CPU, each redraw of the standing pair was a 0.2-0.5 s
+    // task, and they took most of the main thread while loading). The same until the first step
+    // of the first dance is in: a draw of the not yet moving pair would only delay that step.
+    const dancing = this.simulation !== null && hook.frame > 0;
+    if (!dancing) this.viewCentre.update(this.stage);
+    if (dancing || this.stage.needsRender()) this.draw(Math.min(1, this.accumulator / DT), elapsed);
     const guards = this.simulation ? this.simulation.guards() : NO_GUARDS;
     this.hud.update(now, { stepMs: hook.stepMs, fps: this.fps, threads: hook.threads, modelBytes: hook.modelBytes, guards });
   };
@@ -442,6 +465,7 @@ class Page {
     if (simulation) stage.follow(midX + 0.5 * compare.offset.x, midZ + 0.5 * compare.offset.z, elapsed);
     compare.placeLabels(stage, midX, midZ);
     stage.render();
+    if (hook.frame > 0) bootMark('first-drawn');
   }
 
   /** The leader's and each follower's future root path; the followers' intentions; the ghosts. */
@@ -466,7 +490,8 @@ class Page {
   }
 
   /** The runtime is in: make the policies and the simulation, and start dancing. */
-  async attach([ortModule, policyModule, simulationModule]: Runtime, wasm: Uint8Array): Promise<void> {
+  async attach([ortModule, policyModule, simulationModule]: Runtime, wasm: WebAssembly.Module): Promise<void> {
+    bootMark('attach');
     this.loading.compiling();
     hook.threads = ortModule.configureThreads(this.settings.threads, wasm);
     this.createPolicy = policyModule.createPolicy;
@@ -487,14 +512,16 @@ async function start(): Promise<void> {
     hook.download = { loaded, total };
     loading.update(loaded, total);
   });
-  const wasm = fetchWasm(progress);
-  wasm.catch(() => undefined); // reported where it is awaited
-  const manifest = await loadManifest();
+  const slots = new DownloadSlots();
+  const wasm = loadWasm(progress, slots);
+  bootSpan('download:wasm', () => wasm.received);
+  bootSpan('compile:wasm', () => wasm.module).catch(() => undefined); // reported where it is awaited
+  const manifest = await bootSpan('manifest', () => loadManifest());
   registerOffline(assetVersion(manifest));
-  const page = new Page(manifest, progress, loading);
+  const page = new Page(manifest, progress, slots, loading);
   page.startLoop();
-  const [modules, wasmBytes] = await Promise.all([runtime, wasm]);
-  await page.attach(modules, wasmBytes);
+  const [modules, wasmModule] = await Promise.all([runtime, wasm.module]);
+  await page.attach(modules, wasmModule);
 }
 
 start().catch(showError);

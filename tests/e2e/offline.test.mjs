@@ -1,0 +1,68 @@
+// The service worker (public/sw.js): after one visit of the built site, the page starts and
+// dances with the network gone, and a second visit downloads nothing. Guards the path by which
+// the page gets onnxruntime's wasm and the models (web/engine/wasm.ts, offline.ts): whatever
+// fetches them must be seen by the worker, or the offline start breaks without any other test
+// noticing.
+
+import { after, before, test } from 'node:test';
+import assert from 'node:assert/strict';
+import { join } from 'node:path';
+import { ROOT, build, duet, launch, sleep, waitReady, waitSteps } from './harness.mjs';
+import { serve } from '../../scripts/serve.mjs';
+
+let server;
+let browser;
+
+before(async () => {
+  await build('dist');
+  server = await serve({ dir: join(ROOT, 'dist'), base: '/duet/' });
+  browser = await launch();
+});
+
+after(async () => {
+  await browser?.close();
+  await server?.stop();
+});
+
+/** URLs the service worker has stored, once it holds the wasm and the two first models. */
+async function cachedUrls(page, timeoutMs = 60_000) {
+  const deadline = Date.now() + timeoutMs;
+  for (;;) {
+    const urls = await page.evaluate(async () => {
+      const all = [];
+      for (const name of await caches.keys()) for (const request of await (await caches.open(name)).keys()) all.push(request.url);
+      return all;
+    });
+    if ((urls.some((u) => u.endsWith('.wasm')) && urls.filter((u) => u.endsWith('.onnx')).length >= 2) || Date.now() > deadline) return urls;
+    await sleep(250);
+  }
+}
+
+test('after one visit: a repeat visit downloads nothing, and the page dances offline', async () => {
+  const { page, context } = browser;
+  const url = `${server.url}?seed=2`;
+  await page.goto(url);
+  await waitReady(page, 60_000);
+  const urls = await cachedUrls(page);
+  assert.ok(urls.some((u) => u.endsWith('.wasm')), `the wasm is cached: ${urls.join(', ')}`);
+  for (const model of ['leader.onnx', 'follower.onnx']) assert.ok(urls.some((u) => u.endsWith(model)), `${model} is cached`);
+
+  await page.goto(url);
+  await waitReady(page, 30_000);
+  const transferred = await page.evaluate(() => performance.getEntriesByType('resource').reduce((sum, e) => sum + e.transferSize, 0));
+  assert.equal(transferred, 0, 'repeat visit: nothing over the network');
+  assert.equal(await page.evaluate(() => !!navigator.serviceWorker.controller), true, 'the worker controls the page');
+
+  await context.setOffline(true);
+  try {
+    await page.reload();
+    await waitReady(page, 30_000);
+    await waitSteps(page, 30);
+    const state = await duet(page);
+    assert.equal(state.error, null);
+    assert.equal(await page.locator('#loading').isVisible(), false, 'loading bar gone');
+  } finally {
+    await context.setOffline(false);
+  }
+  assert.deepEqual(browser.consoleErrors, []);
+});
