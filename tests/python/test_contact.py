@@ -172,5 +172,9 @@ def test_interaction_command_on_fresh_models(exported, data3, tmp_path, capsys):
     for row in res["methods"].values():
         for proto in ("teacher_forced", "free_running", "free_running_layer", "steered", "steered_layer"):
             assert 0.0 <= row[proto]["interpenetration"] <= 1.0
+            for who in ("leader", "follower"):   # plausibility against the manifest's range
+                assert 0.0 <= row[proto][f"implausible_{who}"] <= 1.0
+                assert 0.0 <= row[proto][f"angles_out_{who}"] <= 1.0
         assert row["steering"]["trials"] == 8
+    assert 0.0 <= res["recording"]["implausible_follower"] <= 1.0
     assert "recording" in (tmp_path / "interaction.md").read_text()

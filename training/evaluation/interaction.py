@@ -32,6 +32,7 @@ from tqdm import tqdm
 
 from ..mirror import features as feat
 from . import metrics as M
+from . import plausibility as P
 from ..mirror.contact import ContactLayer
 from ..data.dataset import DataError
 from .evaluate_inputs import EvalError, EvalTake, find_models, load_eval_takes, load_onnx, window
@@ -44,7 +45,8 @@ from ..mirror.rollout import NOW, Dancer, OnnxPolicy, apply_output
 from .soak import soak_one, steering_trials
 
 KEYS = ["interpenetration", "hand_hold", "closest_hand_m", "skate_leader_cm", "skate_follower_cm",
-        "contact_skate_leader_cm", "contact_skate_follower_cm", "contact_share_leader", "contact_share_follower"]
+        "contact_skate_leader_cm", "contact_skate_follower_cm", "contact_share_leader", "contact_share_follower",
+        "implausible_leader", "implausible_follower", "angles_out_leader", "angles_out_follower"]
 
 
 def contact_labels(positions: np.ndarray) -> np.ndarray:
@@ -54,10 +56,19 @@ def contact_labels(positions: np.ndarray) -> np.ndarray:
     return np.concatenate([c[:1], c])
 
 
-def measure(leader, follower, leader_contacts, follower_contacts) -> dict:
+def measure(leader, follower, leader_contacts, follower_contacts, ranges: dict | None = None) -> dict:
+    """metrics.interaction, the share of frames with a foot in contact and, given the training
+    takes' plausibility range, per dancer the share of frames with the body low, folded or split
+    (`implausible`) or a joint angle outside that range (evaluation.plausibility)."""
     out = M.interaction(leader, follower, leader_contacts, follower_contacts)
     out["contact_share_leader"] = float((np.asarray(leader_contacts) > 0.5).any(-1).mean())
     out["contact_share_follower"] = float((np.asarray(follower_contacts) > 0.5).any(-1).mean())
+    if ranges is None:
+        return out
+    for who, pos in (("leader", leader), ("follower", follower)):
+        flags = P.frame_flags(pos, ranges)
+        out[f"implausible_{who}"] = float(np.any([flags[k] for k in P.BODY_FLAGS], axis=0).mean())
+        out[f"angles_out_{who}"] = float(flags["angles_out"].mean())
     return out
 
 
@@ -77,17 +88,17 @@ def weighted(items: list[tuple[dict, int]]) -> dict:
     return {k: float(sum(r[k] * n for r, n in items) / total) for k in items[0][0]}
 
 
-def recording_row(takes: list[EvalTake]) -> dict:
+def recording_row(takes: list[EvalTake], ranges: dict) -> dict:
     items = []
     for t in takes:
         sl = slice(int(t.frames[0]), int(t.frames[-1]) + 2)
         lp, fp = t.lead.positions[sl], t.follow.positions[sl]
-        items.append((measure(lp, fp, contact_labels(t.lead.positions)[sl], contact_labels(t.follow.positions)[sl]),
+        items.append((measure(lp, fp, contact_labels(t.lead.positions)[sl], contact_labels(t.follow.positions)[sl], ranges),
                       len(lp)))
     return weighted(items)
 
 
-def teacher_forced_row(takes: list[EvalTake], policy) -> dict:
+def teacher_forced_row(takes: list[EvalTake], policy, ranges: dict) -> dict:
     """One step from the recorded state at every frame: the follower's next pose (forward
     kinematics from its decoded rotations, as the loop places it) against the recorded leader."""
     items = []
@@ -106,11 +117,12 @@ def teacher_forced_row(takes: list[EvalTake], policy) -> dict:
             fol[i] = d.positions
         contacts = np.clip(out[:, -2:], 0, 1)
         lead = t.lead.positions[t.frames + 1]
-        items.append((measure(lead, fol, contact_labels(t.lead.positions)[t.frames + 1], contacts), len(fol)))
+        items.append((measure(lead, fol, contact_labels(t.lead.positions)[t.frames + 1], contacts, ranges), len(fol)))
     return weighted(items)
 
 
-def free_running_rows(takes: list[EvalTake], policy, start_pose: dict, temperature: float) -> tuple[dict, dict]:
+def free_running_rows(takes: list[EvalTake], policy, start_pose: dict, temperature: float,
+                      ranges: dict) -> tuple[dict, dict]:
     alone, layered = [], []
     for t in takes:
         r = rollout(t, policy, temperature, 0, start_pose)
@@ -119,20 +131,22 @@ def free_running_rows(takes: list[EvalTake], policy, start_pose: dict, temperatu
         lc = contact_labels(t.lead.positions)[sl][idx]
         fc = r["contacts"][idx]
         lp, fp = r["leader_positions"][idx], r["positions"][idx]
-        alone.append((measure(lp, fp, lc, fc), len(idx)))
+        alone.append((measure(lp, fp, lc, fc, ranges), len(idx)))
         sl_, sf_ = with_layer(lp, fp, lc, fc, t.lead.heading[sl][idx], r["heading"][idx])
-        layered.append((measure(sl_, sf_, lc, fc), len(idx)))
+        layered.append((measure(sl_, sf_, lc, fc, ranges), len(idx)))
     return weighted(alone), weighted(layered)
 
 
-def steered_rows(manifest, leader, follower, seeds: int, frames: int, temperature: float, bar) -> tuple[dict, dict]:
+def steered_rows(manifest, leader, follower, seeds: int, frames: int, temperature: float, bar,
+                 ranges: dict) -> tuple[dict, dict]:
     alone, layered = [], []
     for seed in range(seeds):
         rec = {}
         soak_one(manifest, leader, follower, seed, frames, temperature, rec)
-        alone.append((measure(rec["leader"], rec["follower"], rec["leader_contacts"], rec["follower_contacts"]), frames))
+        alone.append((measure(rec["leader"], rec["follower"], rec["leader_contacts"], rec["follower_contacts"], ranges),
+                      frames))
         layered.append((measure(rec["leader_shown"], rec["follower_shown"], rec["leader_contacts"],
-                                rec["follower_contacts"]), frames))
+                                rec["follower_contacts"], ranges), frames))
         bar.update(1)
     return weighted(alone), weighted(layered)
 
@@ -148,16 +162,20 @@ def run(args) -> dict:
     if not args.methods or "motion_matching" in args.methods.split(","):
         train = training_takes(args.data, exclude=names)
         methods["motion_matching"] = build(load_tracks(train), "follower")
+    if "plausibility" not in manifest:
+        raise EvalError(f"{args.models}/manifest.json has no plausibility range: re-export it "
+                        f"(python -m training.learning.export, after training.data.prepare)")
+    ranges = manifest["plausibility"]
     leader = load_onnx(leader_onnx)
     temperature = manifest["defaultTemperature"] if args.temperature is None else args.temperature
     frames = int(args.seconds * feat.FPS)
-    res = {"takes": names, "recording": recording_row(takes), "methods": {}}
+    res = {"takes": names, "recording": recording_row(takes, ranges), "methods": {}}
     bar = tqdm(total=len(methods) * args.seeds, desc="steered duets", unit="duet", file=sys.stderr,
                disable=args.quiet)
     for m, policy in methods.items():
-        row = {"teacher_forced": teacher_forced_row(takes, policy)}
-        row["free_running"], row["free_running_layer"] = free_running_rows(takes, policy, manifest["startPose"], temperature)
-        row["steered"], row["steered_layer"] = steered_rows(manifest, leader, policy, args.seeds, frames, temperature, bar)
+        row = {"teacher_forced": teacher_forced_row(takes, policy, ranges)}
+        row["free_running"], row["free_running_layer"] = free_running_rows(takes, policy, manifest["startPose"], temperature, ranges)
+        row["steered"], row["steered_layer"] = steered_rows(manifest, leader, policy, args.seeds, frames, temperature, bar, ranges)
         row["steering"] = steering_trials(manifest, leader, policy, temperature)
         res["methods"][m] = row
     bar.close()
@@ -170,7 +188,8 @@ def run(args) -> dict:
 def write_markdown(path: Path, res: dict) -> None:
     ref = res["recording"]
     heads = ["interpenetration", "hand hold", "closest hand m", "skate L cm", "skate F cm",
-             "contact skate L cm", "contact skate F cm", "contact share L", "contact share F"]
+             "contact skate L cm", "contact skate F cm", "contact share L", "contact share F",
+             "implausible L", "implausible F", "angles out L", "angles out F"]
     L = [f"# Interaction: takes {', '.join(res['takes'])}", "",
          f"Steered: {res['config']['seeds']} x {res['config']['seconds']:g} s of training.evaluation.soak steering; "
          f"temperature {res['config']['temperature']}; models `{res['config']['models']}`. "
