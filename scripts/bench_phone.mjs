@@ -33,7 +33,10 @@ async function visit(page, url, timeoutMs = 90_000) {
   await page.waitForFunction(() => window.duet && (window.duet.firstFrameMs || window.duet.error), null, { timeout: timeoutMs, polling: 50 });
   return page.evaluate(() => {
     const paint = Object.fromEntries(performance.getEntriesByType('paint').map((e) => [e.name, e.startTime]));
+    // The runtime worker's downloads (wasm, models) are in its own resource timing, not the page's.
+    const workerFiles = window.duet.workerFiles ?? [];
     const transferred = performance.getEntriesByType('resource').reduce((sum, e) => sum + e.transferSize, 0) +
+      workerFiles.reduce((sum, f) => sum + f.transferSize, 0) +
       (performance.getEntriesByType('navigation')[0]?.transferSize ?? 0);
     return {
       error: window.duet.error,
@@ -48,14 +51,24 @@ async function visit(page, url, timeoutMs = 90_000) {
       boot: { ...(window.duet.bootTimings ?? {}) },
       wasmCalls: window.__benchWasmCalls ?? [],
       navigation: (({ responseStart, responseEnd, domContentLoadedEventEnd }) => ({ responseStart, responseEnd, domContentLoadedEventEnd }))(performance.getEntriesByType('navigation')[0] ?? {}),
-      resources: performance.getEntriesByType('resource').map((e) => ({
-        name: e.name.replace(location.origin, ''),
-        startTime: e.startTime,
-        responseStart: e.responseStart,
-        responseEnd: e.responseEnd,
-        transferSize: e.transferSize,
-        encodedBodySize: e.encodedBodySize,
-      })),
+      resources: [
+        ...performance.getEntriesByType('resource').map((e) => ({
+          name: e.name.replace(location.origin, ''),
+          startTime: e.startTime,
+          responseStart: e.responseStart,
+          responseEnd: e.responseEnd,
+          transferSize: e.transferSize,
+          encodedBodySize: e.encodedBodySize,
+        })),
+        ...workerFiles.map((f) => ({
+          name: `${f.url.replace(location.origin, '')} (worker)`,
+          startTime: f.start,
+          responseStart: f.firstByte,
+          responseEnd: f.end,
+          transferSize: f.transferSize,
+          encodedBodySize: f.encodedBodySize,
+        })),
+      ],
     };
   });
 }
@@ -125,12 +138,21 @@ async function framesPerSecond(page, url, ms = 4000) {
   await page.waitForFunction(() => window.duet && (window.duet.ready || window.duet.error), null, { timeout: 90_000, polling: 50 });
   const bodies = await page.evaluate(() => window.duet.bodies ?? null);
   await sleep(1000);
+  // Frames the page drew (window.duet.drawn): it skips the draw of an animation frame in which it
+  // waits for the models, so animation frames alone would overstate it.
   const fps = await page.evaluate(
     (duration) =>
       new Promise((resolve) => {
-        let frames = 0;
+        const drawn = () => window.duet.drawn ?? 0;
         const start = performance.now();
-        const tick = () => (++frames, performance.now() - start < duration ? requestAnimationFrame(tick) : resolve((frames * 1000) / (performance.now() - start)));
+        const first = drawn();
+        let frames = 0;
+        const tick = () => {
+          frames++;
+          if (performance.now() - start < duration) return requestAnimationFrame(tick);
+          const elapsed = performance.now() - start;
+          resolve((((window.duet.drawn === undefined ? frames : drawn() - first)) * 1000) / elapsed);
+        };
         requestAnimationFrame(tick);
       }),
     ms,

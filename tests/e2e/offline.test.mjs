@@ -1,8 +1,8 @@
 // The service worker (public/sw.js): after one visit of the built site, the page starts and
 // dances with the network gone, and a second visit downloads nothing. Guards the path by which
-// the page gets onnxruntime's wasm and the models (web/engine/wasm.ts, offline.ts): whatever
-// fetches them must be seen by the worker, or the offline start breaks without any other test
-// noticing.
+// the page gets onnxruntime's wasm and the models (the fetcher worker, web/engine/fetcher.ts,
+// and offline.ts): whatever fetches them must be seen by the service worker, or the offline
+// start breaks without any other test noticing.
 
 import { after, before, test } from 'node:test';
 import assert from 'node:assert/strict';
@@ -49,7 +49,12 @@ test('after one visit: a repeat visit downloads nothing, and the page dances off
 
   await page.goto(url);
   await waitReady(page, 30_000);
-  const transferred = await page.evaluate(() => performance.getEntriesByType('resource').reduce((sum, e) => sum + e.transferSize, 0));
+  // The page's own downloads, and the fetcher worker's (wasm, manifest, models: window.duet.workerFiles).
+  const transferred = await page.evaluate(() =>
+    [...performance.getEntriesByType('resource'), ...(window.duet.workerFiles ?? [])].reduce((sum, e) => sum + e.transferSize, 0),
+  );
+  const workerFiles = await page.evaluate(() => (window.duet.workerFiles ?? []).map((f) => f.url));
+  assert.ok(workerFiles.some((u) => u.endsWith('.wasm')) && workerFiles.some((u) => u.endsWith('.onnx')), `the worker's downloads are listed: ${workerFiles}`);
   assert.equal(transferred, 0, 'repeat visit: nothing over the network');
   assert.equal(await page.evaluate(() => !!navigator.serviceWorker.controller), true, 'the worker controls the page');
 

@@ -79,19 +79,21 @@ export function firstDifference(blocks: unknown, expected: Layout): string | nul
 
 /** Download one model's bytes and check them against the manifest. Independent of ORT, so the
  *  downloads run while onnxruntime itself is still loading. `onBytes` sees each chunk as it
- *  arrives (the progress bar); `version` goes to the service worker (download.ts). */
+ *  arrives (the progress bar); `version` goes to the service worker (download.ts); `base` is the
+ *  page's address (models/ is relative to the page, also when a worker fetches). */
 export async function fetchModelBytes(
   manifest: Manifest,
   name: string,
   onBytes?: (bytes: number) => void,
   version = '',
+  base = location.href,
 ): Promise<Uint8Array> {
   const entry = manifest.models[name];
   if (!entry) throw new DuetError('Model not found', `"${name}" is not in manifest.json`);
   const url = `models/${entry.file}`;
   let bytes: Uint8Array;
   try {
-    const response = await fetch(url, version ? { headers: { [VERSION_HEADER]: version } } : undefined);
+    const response = await fetch(new URL(url, base), version ? { headers: { [VERSION_HEADER]: version } } : undefined);
     if (!response.ok) throw new Error(`answered ${response.status}`);
     bytes = await readBody(response, onBytes, entry.bytes);
   } catch (error) {

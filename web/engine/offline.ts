@@ -24,12 +24,13 @@ export function registerOffline(version: string): void {
 
 /**
  * Once the dance runs: ask the worker to keep everything this visit downloaded from this origin
- * (the first visit is not controlled by the worker yet, so it saw none of it). Most of it comes
- * out of the HTTP cache, not the network.
+ * (the first visit is not controlled by the worker yet, so it saw none of it): what this page's
+ * resource timing lists, and `fetchedElsewhere` (the runtime worker's downloads, which it does
+ * not). Most of it comes out of the HTTP cache, not the network.
  */
-export function keepForOffline(): void {
+export function keepForOffline(fetchedElsewhere: string[] = []): void {
   if (!available()) return;
-  const urls = [location.href, ...performance.getEntriesByType('resource').map((entry) => entry.name)]
+  const urls = [location.href, ...performance.getEntriesByType('resource').map((entry) => entry.name), ...fetchedElsewhere]
     .filter((url) => url.startsWith(location.origin));
   navigator.serviceWorker.ready
     .then((registration) => registration.active?.postMessage({ type: 'keep', urls }))

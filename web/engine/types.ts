@@ -163,8 +163,13 @@ export interface DuetHook {
   download?: { loaded: number; total: number };
   /** How the dancers are drawn: skinned characters, or capsule figures (?bodies=sticks). */
   bodies?: 'skinned' | 'sticks';
+  /** Frames drawn so far (animation frames that drew nothing are not counted). */
+  drawn?: number;
   /** When each stage of the start happened, ms since navigation (web/engine/boot.ts). */
   bootTimings?: Record<string, number>;
+  /** What the runtime worker downloaded (this page's resource timing does not list it): sizes,
+   *  and times in ms since navigation. */
+  workerFiles?: { url: string; transferSize: number; encodedBodySize: number; start: number; firstByte: number; end: number }[];
 }
 
 declare global {

@@ -1,8 +1,9 @@
-// onnxruntime's WebAssembly, fetched and compiled by the page itself rather than by onnxruntime:
-// the page starts it before onnxruntime's JavaScript has even arrived, compiles it while it
-// downloads (WebAssembly.compileStreaming: the compiler runs on background threads as the bytes
-// come in, so on a slow network the module is ready moments after its last byte), and counts its
-// bytes for the progress bar. ort.ts hands the compiled module to onnxruntime.
+// onnxruntime's WebAssembly, fetched and compiled by the fetcher worker (fetcher.worker.ts)
+// rather than by onnxruntime: the worker starts it before onnxruntime's JavaScript has even
+// arrived, compiles it while it downloads (WebAssembly.compileStreaming: the compiler runs on
+// background threads as the bytes come in, so on a slow network the module is ready moments
+// after its last byte), and counts its bytes for the progress bar. ort.ts hands the compiled
+// module to onnxruntime.
 //
 // `onnxruntime-web/wasm` ships only the SIMD + threads build, and it is the smallest of the four
 // (14.2 MB; the JSPI one is 16.8 MB, asyncify 26.8 MB, JSEP 28.3 MB): the one to keep.

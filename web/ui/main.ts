@@ -9,10 +9,9 @@ import './style.css';
 import type { CreateSimulation, DancerView, DuetHook, FollowerChoice, Manifest, Simulation } from '../engine/types';
 import type { Policy } from '../engine/policy';
 import { checkBrowserSupport, installGlobalErrorHandlers, showError } from './errors';
-import { fetchModelBytes, loadManifest } from '../engine/manifest';
-import { DownloadProgress } from '../engine/download';
-import { loadWasm } from '../engine/wasm';
-import { DownloadSlots } from '../engine/slots';
+import { loadManifest } from '../engine/manifest';
+import { Fetcher } from '../engine/fetcher';
+import { FOLLOWER_MODELS } from '../engine/firstdance';
 import { standingViews } from '../engine/standing';
 import { assetVersion, keepForOffline, registerOffline } from '../engine/offline';
 import { LoadingBar } from './loading';
@@ -46,12 +45,9 @@ const MAX_BACKLOG_SECONDS = 0.5;
  *  took to draw, so that slow drawing (software WebGL) cannot starve the simulation either. */
 const MIN_STEP_BUDGET_MS = 50;
 const MAX_GHOSTS = LIMITS.ghosts[1];
+const WORKER_START_WAIT_MS = 300;
+const PRECOMPILE_DELAY_MS = 500;
 const PAUSED_STATUS = 'paused — Space to resume';
-const FOLLOWER_MODELS: Record<FollowerChoice, string[]> = {
-  ours: ['follower'],
-  ccm: ['follower_ccm'],
-  compare: ['follower', 'follower_ccm'],
-};
 /** Each model gets its own noise stream, all derived from the one seed in the URL. */
 const MODEL_NAMES = ['leader', 'follower', 'follower_ccm'];
 
@@ -92,33 +88,11 @@ function loadRuntime() {
 
 type Runtime = Awaited<ReturnType<typeof loadRuntime>>;
 
-/**
- * Each model file fetched once, from the first time it is asked for (the CCM follower only when
- * chosen), its bytes counted in `progress`, when `slots` lets it start (slots.ts: the order of
- * the first downloads).
- */
-function modelDownloads(manifest: Manifest, progress: DownloadProgress, slots: DownloadSlots): (name: string) => Promise<Uint8Array> {
-  const downloads = new Map<string, Promise<Uint8Array>>();
-  const version = assetVersion(manifest);
-  return (name) => {
-    if (!downloads.has(name)) {
-      progress.expect(name, manifest.models[name]?.bytes ?? 0);
-      const bytes = slots.run(manifest.models[name]?.bytes ?? 0, () =>
-        bootSpan(`download:${name}`, () => fetchModelBytes(manifest, name, (n) => progress.add(name, n), version)),
-      );
-      bytes.catch(() => undefined); // reported where it is awaited
-      downloads.set(name, bytes);
-    }
-    return downloads.get(name)!;
-  };
-}
-
 /** The page once the manifest is in: floor, controls, panel, recording, and the animation loop. */
 class Page {
   private readonly defaults: Settings;
   private readonly settings: Settings;
   private readonly hasCcm: boolean;
-  private readonly download: (name: string) => Promise<Uint8Array>;
   private readonly stage: Stage;
   private readonly hud: Hud;
   private readonly controls: Controls;
@@ -159,19 +133,13 @@ class Page {
 
   constructor(
     private readonly manifest: Manifest,
-    progress: DownloadProgress,
-    slots: DownloadSlots,
+    private readonly fetcher: Fetcher,
     private readonly loading: LoadingBar,
   ) {
     this.defaults = defaultSettings(manifest.defaultTemperature);
     this.settings = readSettings(location.search, this.defaults);
     this.hasCcm = 'follower_ccm' in manifest.models;
     if (!this.hasCcm) this.settings.model = 'ours';
-    this.download = modelDownloads(manifest, progress, slots);
-    // Largest first: the smallest model comes in last (slots.ts).
-    const firstDance = ['leader', ...FOLLOWER_MODELS[this.settings.model]];
-    const size = (name: string) => manifest.models[name]?.bytes ?? 0;
-    for (const name of firstDance.sort((a, b) => size(b) - size(a))) this.download(name);
 
     // The floor is up while the models download: something to look at, never a blank canvas.
     // Skinned characters unless ?bodies=sticks (the bench compares both); ?skeleton=1 overlays the bones.
@@ -285,7 +253,7 @@ class Page {
     let loading = this.policies.get(name);
     if (!loading) {
       const seed = (this.settings.seed + MODEL_NAMES.indexOf(name) * 0x9e3779b9) >>> 0;
-      loading = this.download(name).then((bytes) => bootSpan(`session:${name}`, () => this.createPolicy!(this.manifest, name, bytes, seed))).then((p) => {
+      loading = this.fetcher.model(name).then((bytes) => bootSpan(`session:${name}`, () => this.createPolicy!(this.manifest, name, bytes, seed))).then((p) => {
         hook.modelBytes += p.entry.bytes;
         return p;
       });
@@ -383,11 +351,13 @@ class Page {
     this.draw(0, 0);
     hook.sceneMs = performance.now();
     bootMark('scene');
-    // Once the loading scene is on screen (a task later), while the models are still coming.
+    // While the models are still coming (a moment after the loading scene is on screen): when
+    // they are in already (a repeat visit), the first step comes first.
     setTimeout(() => {
+      if (this.simulation) return;
       bootMark('shaders:start');
       this.stage.precompile().then(() => bootMark('shaders:end'), () => undefined); // only an optimisation
-    }, 0);
+    }, PRECOMPILE_DELAY_MS);
     requestAnimationFrame(this.frame);
     // Browsers stop animation frames in hidden tabs: start timing afresh when the tab comes back.
     document.addEventListener('visibilitychange', () => {
@@ -465,6 +435,7 @@ class Page {
     if (simulation) stage.follow(midX + 0.5 * compare.offset.x, midZ + 0.5 * compare.offset.z, elapsed);
     compare.placeLabels(stage, midX, midZ);
     stage.render();
+    hook.drawn = (hook.drawn ?? 0) + 1;
     if (hook.frame > 0) bootMark('first-drawn');
   }
 
@@ -498,29 +469,34 @@ class Page {
     this.createSimulation = simulationModule.createSimulation;
     await this.useModel(this.settings.model);
     this.loading.hide();
-    keepForOffline();
+    const since = (epoch: number) => epoch - performance.timeOrigin;
+    hook.workerFiles = this.fetcher.files.map((f) => ({ ...f, start: since(f.start), firstByte: since(f.firstByte), end: since(f.end) }));
+    // The worker's downloads are not in this page's resource timing: name them.
+    keepForOffline([this.fetcher.scriptUrl.href, ...this.fetcher.files.map((file) => file.url)]);
   }
 }
 
 async function start(): Promise<void> {
   checkBrowserSupport();
-  // Start every download at once: onnxruntime and the simulation code now, the models as soon as
-  // the manifest names them; the floor is drawn meanwhile.
+  // Start every download at once: the fetcher worker downloads onnxruntime's wasm (compiling it),
+  // the manifest and the first dance's models by itself; onnxruntime's and the simulation's code
+  // now; the floor is drawn meanwhile.
+  const fetcher = new Fetcher();
   const runtime = loadRuntime();
   const loading = new LoadingBar();
-  const progress = new DownloadProgress((loaded, total) => {
+  fetcher.onProgress = (loaded, total) => {
     hook.download = { loaded, total };
     loading.update(loaded, total);
-  });
-  const slots = new DownloadSlots();
-  const wasm = loadWasm(progress, slots);
-  bootSpan('download:wasm', () => wasm.received);
-  bootSpan('compile:wasm', () => wasm.module).catch(() => undefined); // reported where it is awaited
+  };
   const manifest = await bootSpan('manifest', () => loadManifest());
   registerOffline(assetVersion(manifest));
-  const page = new Page(manifest, progress, slots, loading);
+  // Building the page is one long task, and a worker only gets going once this thread has taken
+  // note of its start: let it start first (it usually has; at most WORKER_START_WAIT_MS of the
+  // loading scene's time), or its downloads wait for the whole task.
+  await Promise.race([fetcher.started, new Promise((resolve) => setTimeout(resolve, WORKER_START_WAIT_MS))]);
+  const page = new Page(manifest, fetcher, loading);
   page.startLoop();
-  const [modules, wasmModule] = await Promise.all([runtime, wasm.module]);
+  const [modules, wasmModule] = await Promise.all([runtime, fetcher.wasm]);
   await page.attach(modules, wasmModule);
 }
 
