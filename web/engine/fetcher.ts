@@ -29,6 +29,8 @@ export class Fetcher {
   readonly started: Promise<void>;
   /** Files the worker fetched (its own resource timing), as of its last delivered model. */
   files: FetchedFile[] = [];
+  /** Every download asked for so far is in (its last byte; the wasm may still be compiling). */
+  done = false;
 
   private readonly worker: Worker;
   private readonly compiled = deferred<WebAssembly.Module>();
@@ -85,6 +87,7 @@ export class Fetcher {
     switch (message.type) {
       case 'progress':
         this.lastProgress = [message.loaded, message.total];
+        this.done = message.total > 0 && message.loaded >= message.total;
         this.progress?.(message.loaded, message.total);
         break;
       case 'mark':

@@ -352,9 +352,9 @@ class Page {
     hook.sceneMs = performance.now();
     bootMark('scene');
     // While the models are still coming (a moment after the loading scene is on screen): when
-    // they are in already (a repeat visit), the first step comes first.
+    // they are in already (a repeat visit), starting them and the first step come first.
     setTimeout(() => {
-      if (this.simulation) return;
+      if (this.simulation || this.fetcher.done) return;
       bootMark('shaders:start');
       this.stage.precompile().then(() => bootMark('shaders:end'), () => undefined); // only an optimisation
     }, PRECOMPILE_DELAY_MS);
