@@ -7,10 +7,18 @@
 // loading bar: window.duet.sceneMs), the first dancing frame (window.duet.firstFrameMs); the same
 // for a repeat visit with the service worker warm; the model step median at 4× CPU; and frames per
 // second drawing both dancers as skinned bodies and as ?bodies=sticks (skipped when the page has
-// no window.duet.bodies).
+// no window.duet.bodies). Then, for each visit, where the time went: the page's boot stages
+// (window.duet.bootTimings: main.ts running, the manifest, the fetcher worker's downloads and wasm
+// compilation, each session, the first step and the first drawn dancing frame), every
+// WebAssembly compile/instantiate call, and every file with its timing and bytes (the fetcher
+// worker's too, from window.duet.workerFiles).
 //
-// CPU throttling applies to the page's main thread; onnxruntime's second thread (a worker) and
-// Chromium's software WebGL run unthrottled, so the step and frame-rate numbers flatter a phone.
+//   npm run bench -- --phone --boot-only                 # the two visits only
+//   npm run bench -- --phone --boot-only --query threads=1
+//
+// CPU throttling applies to the page's main thread only (Chromium cannot throttle workers):
+// onnxruntime's second thread, the fetcher worker and Chromium's software WebGL run at full
+// speed, so the step and frame-rate numbers flatter a phone.
 
 import { build, launch, sleep } from '../tests/e2e/harness.mjs';
 import { serve } from './serve.mjs';
