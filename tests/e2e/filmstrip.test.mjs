@@ -1,5 +1,5 @@
-// Film strips of the skinned dancers: for three seeds, 6 s of the running page at 1280×800, one
-// frame every 0.5 s (ArrowUp held for the first 2 s, ArrowLeft for the next 2 s, then nothing),
+// Film strips of the skinned dancers: for three seeds, 6 s of the running page at 1280×800 (and one
+// seed at a phone's 390×844: docs/filmstrip-phone-seed-2.png), one frame every 0.5 s (ArrowUp held for the first 2 s, ArrowLeft for the next 2 s, then nothing),
 // composed into one PNG per seed: docs/filmstrip-seed-N.png. Also docs/screenshot-desktop.png and
 // docs/screenshot-phone.png. The frames are copied from the stage canvas and composed with a 2D
 // canvas inside the page (see captureStrip), so no image library is needed.
@@ -20,9 +20,17 @@ const SEEDS = (process.env.DUET_FILMSTRIP_SEEDS ?? '1,2,3').split(',').map(Numbe
 const FRAMES = 12;
 const INTERVAL_MS = 500;
 const COLUMNS = 4;
-/** The part of each 1280×800 frame kept in the strip (the dancers stay near the centre). */
-const CROP = { x: 200, y: 110, width: 880, height: 600 };
-const THUMB_SCALE = 0.5;
+/** The two viewports: the part of each frame kept in the strip (the dancers stay near the centre,
+ *  on the phone between the title card and the settings bar) and its scale in the strip. */
+const DESKTOP = {
+  name: 'desktop', launch: { viewport: { width: 1280, height: 800 } },
+  crop: { x: 200, y: 110, width: 880, height: 600 }, scale: 0.5, file: (seed) => `filmstrip-seed-${seed}.png`,
+};
+const PHONE = {
+  name: 'phone', launch: { viewport: { width: 390, height: 844 }, deviceScaleFactor: 2, isMobile: true, hasTouch: true },
+  crop: { x: 0, y: 170, width: 390, height: 560 }, scale: 0.6, file: (seed) => `filmstrip-phone-seed-${seed}.png`,
+};
+const PHONE_SEED = 2;
 const MIN_HIP = 0.5; // metres
 const MIN_VARIANCE = 20; // luminance variance; a blank canvas is ~0
 const READY_MS = 120_000; // the machine is shared: first loads can be slow
@@ -107,9 +115,9 @@ function captureStrip({ frames, interval, crop, scale, columns, title, keys }) {
   })();
 }
 
-/** One seed: load, steer, copy 12 frames, write the strip, check what window.duet said. */
-async function filmstrip(seed) {
-  const browser = await launch({ viewport: { width: 1280, height: 800 } });
+/** One seed in one viewport: load, steer, copy 12 frames, write the strip, check what window.duet said. */
+async function filmstrip(seed, view = DESKTOP) {
+  const browser = await launch(view.launch);
   try {
     const { page, consoleErrors } = browser;
     page.setDefaultTimeout(READY_MS);
@@ -120,8 +128,8 @@ async function filmstrip(seed) {
     // Keys from here while the page copies its frames (ArrowUp 0-2 s, ArrowLeft 2-4 s).
     const keys = Array.from({ length: FRAMES }, (_, k) => (k < 4 ? '↑ held' : k < 8 ? '← held' : ''));
     const capture = page.evaluate(captureStrip, {
-      frames: FRAMES, interval: INTERVAL_MS, crop: CROP, scale: THUMB_SCALE, columns: COLUMNS, keys,
-      title: `duet · seed ${seed} · one frame every 0.5 s · ↑ held 0–2 s, ← held 2–4 s`,
+      frames: FRAMES, interval: INTERVAL_MS, crop: view.crop, scale: view.scale, columns: COLUMNS, keys,
+      title: `duet · ${view.name} · seed ${seed} · every 0.5 s · ↑ 0–2 s, ← 2–4 s`,
     });
     await page.keyboard.down('ArrowUp');
     await sleep(4 * INTERVAL_MS);
@@ -130,7 +138,7 @@ async function filmstrip(seed) {
     await sleep(4 * INTERVAL_MS);
     await page.keyboard.up('ArrowLeft');
     const { png, states, variances } = await capture;
-    writeFileSync(join(ROOT, 'docs', `filmstrip-seed-${seed}.png`), Buffer.from(png.slice(png.indexOf(',') + 1), 'base64'));
+    writeFileSync(join(ROOT, 'docs', view.file(seed)), Buffer.from(png.slice(png.indexOf(',') + 1), 'base64'));
 
     assert.equal(states.length, FRAMES);
     for (let k = 0; k < FRAMES; k++) {
@@ -154,19 +162,22 @@ async function filmstrip(seed) {
   }
 }
 
+/** The dev server reloads the page when a source file changes under it (someone editing while
+ *  the test runs): that run says nothing about the page, so it is run once more. */
+async function filmstripOnce(seed, view) {
+  try {
+    await filmstrip(seed, view);
+  } catch (error) {
+    if (!RELOADED.test(String(error))) throw error;
+    await filmstrip(seed, view);
+  }
+}
+
 describe('film strips of the skinned dancers', () => {
   for (const seed of SEEDS) {
-    test(`seed ${seed}: 12 frames over 6 s (docs/filmstrip-seed-${seed}.png)`, async () => {
-      // The dev server reloads the page when a source file changes under it (someone editing while
-      // the test runs): that run says nothing about the page, so it is run once more.
-      try {
-        await filmstrip(seed);
-      } catch (error) {
-        if (!RELOADED.test(String(error))) throw error;
-        await filmstrip(seed);
-      }
-    });
+    test(`seed ${seed}: 12 frames over 6 s (docs/${DESKTOP.file(seed)})`, () => filmstripOnce(seed, DESKTOP));
   }
+  test(`phone, seed ${PHONE_SEED}: 12 frames over 6 s (docs/${PHONE.file(PHONE_SEED)})`, () => filmstripOnce(PHONE_SEED, PHONE));
 
   test('desktop and phone screenshots (docs/screenshot-desktop.png, docs/screenshot-phone.png)', async () => {
     for (const [name, options] of [

@@ -32,6 +32,7 @@ def test_failures_name_each_broken_limit():
     bad = dict(ok, nonfinite=3, max_distance=3.5, min_foot=-0.05, frozen_follower=0.9, resets=1)
     assert len(soak.failures(bad)) == 5
     assert soak.failures(dict(ok, collapsed=["follower"])) == ["follower collapsed"]
+    assert soak.failures(dict(ok, fell=True)) == ["follower fell"]
 
 
 @pytest.mark.skipif(not (MODELS / "manifest.json").exists(), reason="no shipped models")

@@ -2,9 +2,9 @@
 
 Reads the BVH couples in --data; writes PREPARED/{train,validation,test}.npz (both roles, all phase
 offsets, mirrored copies in train), PREPARED/plausibility.json (the training dancers' range of
-poses and speeds: training.evaluation.plausibility) and PREPARED/stats.npz (normalization, from the recorded tempo:
-recipes with and without tempo copies normalize alike), then prints frames per split and feature
-sizes. With --tempos it also writes PREPARED/train_tempo.npz, the training couples time-warped to
+poses and speeds: training.evaluation.plausibility) and PREPARED/stats.npz (normalization, from
+the recorded tempo: recipes with and without tempo copies normalize alike), then prints frames
+per split and feature sizes. With --tempos it also writes PREPARED/train_tempo.npz, the training couples time-warped to
 those tempos (0.9,1.1 when the flag comes alone); only recipes with tempo copies read it, and no
 shipped model does, so it is not written unless asked for.
 """

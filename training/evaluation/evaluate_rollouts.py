@@ -168,7 +168,7 @@ def run_metrics(runs: list[dict], refs: list[dict], encoder, ref_latents: np.nda
         })
         if ranges is not None:
             flags = P.frame_flags(r["positions"][idx], ranges)
-            per[-1].update(implausible=float(np.any([flags[k] for k in P.BODY_FLAGS], axis=0).mean()),
+            per[-1].update(implausible=float(P.body_flagged(flags).mean()),
                            angles_out=float(flags["angles_out"].mean()), worst_second=P.worst_second(flags))
         weights.append(len(idx))
         lat.append(latents(encoder, r))

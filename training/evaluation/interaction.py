@@ -67,7 +67,7 @@ def measure(leader, follower, leader_contacts, follower_contacts, ranges: dict |
         return out
     for who, pos in (("leader", leader), ("follower", follower)):
         flags = P.frame_flags(pos, ranges)
-        out[f"implausible_{who}"] = float(np.any([flags[k] for k in P.BODY_FLAGS], axis=0).mean())
+        out[f"implausible_{who}"] = float(P.body_flagged(flags).mean())
         out[f"angles_out_{who}"] = float(flags["angles_out"].mean())
     return out
 

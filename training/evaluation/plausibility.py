@@ -35,6 +35,7 @@ FROZEN_MM = 1.0
 FAST_WINDOW = 6                  # frames (0.2 s): root speed over this span, so hip sway is not speed
 PATH_SMOOTHING = 15              # frames (0.5 s) of moving average before path lengths are summed
 COLLAPSE_SECONDS = 1.0
+BAD_SECOND = 0.5                 # a second with more than this share of body flags is a bad second
 BODY_FLAGS = ["hips_low", "head_low", "feet_wide"]
 POSE_FLAGS = BODY_FLAGS + ["angles_out"]
 FLAGS = POSE_FLAGS + ["frozen", "fast"]
@@ -141,10 +142,15 @@ def collapsed(positions: np.ndarray, r: dict) -> bool:
     return longest_run(np.asarray(positions)[:, 0, 1] < r["hip_min"]) >= COLLAPSE_SECONDS * FPS
 
 
+def body_flagged(flags: dict[str, np.ndarray]) -> np.ndarray:
+    """[T] bool: the body low, folded or split (any of BODY_FLAGS; the joint angles have their own
+    share, as one bent wrist is no fallen dancer)."""
+    return np.any([flags[k] for k in BODY_FLAGS], axis=0)
+
+
 def worst_second(flags: dict[str, np.ndarray]) -> float:
-    """The largest share of frames in any one second with the body low, folded or split (any of
-    BODY_FLAGS; the joint angles have their own share, as one bent wrist is no fallen dancer)."""
-    bad = np.any([flags[k] for k in BODY_FLAGS], axis=0).astype(float)
+    """The largest share of frames in any one second with the body low, folded or split."""
+    bad = body_flagged(flags).astype(float)
     if len(bad) < FPS:
         return float(bad.mean()) if len(bad) else 0.0
     return float(np.convolve(bad, np.ones(FPS) / FPS, "valid").max())
@@ -173,7 +179,7 @@ def summarize(duets: list[dict], frames: list[int]) -> dict:
 
     For each dancer: every flag's share over all frames, the root speed's p99 (the largest of the
     seeds' p99s too: `root_speed_p99_worst`), the worst second over seeds, how many seeds have a
-    second mostly in implausible poses (`bad_seconds`: worst second > 0.5) and how many collapse.
+    second mostly in implausible poses (`bad_seconds`: worst second > BAD_SECOND) and how many collapse.
     """
     w = np.asarray(frames, float) / np.sum(frames)
     out: dict = {"seeds": len(duets)}
@@ -183,7 +189,7 @@ def summarize(duets: list[dict], frames: list[int]) -> dict:
         s["root_speed_p99"] = float(np.median([r["root_speed_p99"] for r in rows]))
         s["root_speed_p99_worst"] = float(np.max([r["root_speed_p99"] for r in rows]))
         s["worst_second"] = float(np.max([r["worst_second"] for r in rows]))
-        s["bad_seconds"] = int(np.sum([r["worst_second"] > 0.5 for r in rows]))
+        s["bad_seconds"] = int(np.sum([r["worst_second"] > BAD_SECOND for r in rows]))
         s["collapses"] = int(np.sum([r["collapse"] for r in rows]))
         s["longest_frozen_s"] = float(np.max([r["longest_frozen_s"] for r in rows]))
         for k in FLAGS:   # the worst seed's share too: a mean over seeds can hide one bad session

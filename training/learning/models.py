@@ -13,7 +13,7 @@ import torch.nn as nn
 import torch.nn.functional as F
 
 from ..mirror.features import (FOLLOWER_INPUT_LAYOUT, INPUT_SIZE, INTENTION_SIZE, LEADER_INPUT_LAYOUT,
-                               OUTPUT_SIZE, block_slices)
+                               N_JOINTS, OUTPUT_SIZE, POSE_SIZE, block_slices)
 
 
 @dataclass
@@ -45,14 +45,11 @@ class ModelConfig:
         if not self.decoder_state:
             return []
         layout = LEADER_INPUT_LAYOUT if self.role == "leader" else FOLLOWER_INPUT_LAYOUT
-        start = block_slices(layout)["self_pose"].start
-        return [start + 12 * j + k for j in range(POSE_JOINTS) for k in range(6)]
+        start, per_joint = block_slices(layout)["self_pose"].start, POSE_SIZE // N_JOINTS   # features.pose_block
+        return [start + per_joint * j + k for j in range(N_JOINTS) for k in range(6)]
 
     def to_dict(self) -> dict:
         return asdict(self)
-
-
-POSE_JOINTS = 17
 
 
 def mlp(sizes: list[int], dropout: float) -> nn.Sequential:

@@ -32,8 +32,8 @@ RELEASE_DECAY = 0.5
 def two_bone_ik(positions: np.ndarray, a: int, b: int, c: int, target, pole, min_bend: float = 0.0) -> None:
     """In place on positions [17, 3]: joints a -> b -> c keep their bone lengths, c goes to the
     target (or as near as the chain reaches while the middle joint bends at least `min_bend`
-    radians between the two bones, or as much as it bends now if that is less), and the middle joint stays on the side it bends to now (the
-    pole direction when the chain is straight)."""
+    radians between the two bones, or as much as it bends now if that is less), and the middle
+    joint stays on the side it bends to now (the pole direction when the chain is straight)."""
     pa, pb, pc = positions[a].copy(), positions[b], positions[c]
     upper = float(np.linalg.norm(pb - pa))
     lower = float(np.linalg.norm(pc - pb))

@@ -1,8 +1,8 @@
 // Boot timings: when each stage of the start happened (ms since navigation, performance.now()),
 // so that the phone bench (scripts/bench_phone.mjs) can say where the time to the first dancing
 // frame goes instead of guessing. Published as window.duet.bootTimings; each stage is also a
-// performance.mark('duet:<stage>'), visible in a DevTools performance recording. The runtime
-// worker's stages (downloads, compilation, sessions) reach the page as messages.
+// performance.mark('duet:<stage>'), visible in a DevTools performance recording. The fetcher
+// worker's stages (downloads, the wasm's compilation) reach the page as messages.
 //
 // A stage is recorded once (the first time), so a later model switch does not overwrite the
 // numbers of the first dance.
@@ -13,7 +13,7 @@ export const bootTimings: BootTimings = {};
 
 let listener: ((stage: string, at: number) => void) | null = null;
 
-/** Also tell `listen` about every stage recorded from now on (the runtime worker forwards its
+/** Also tell `listen` about every stage recorded from now on (the fetcher worker forwards its
  *  stages to the page this way). */
 export function onBootMark(listen: (stage: string, at: number) => void): void {
   listener = listen;

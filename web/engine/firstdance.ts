@@ -1,6 +1,6 @@
 // Which models a dance needs, and which the first dance of this page needs: the leader and the
-// follower choice of the page's URL (?model=). Read by the runtime worker, which starts
-// downloading them on its own (runtime.worker.ts), and by the page.
+// follower choice of the page's URL (?model=). Read by the fetcher worker, which starts
+// downloading them on its own (fetcher.worker.ts), and by the page.
 
 import type { FollowerChoice, Manifest } from './types';
 import { defaultSettings, readSettings } from '../ui/share';

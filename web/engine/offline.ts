@@ -25,7 +25,7 @@ export function registerOffline(version: string): void {
 /**
  * Once the dance runs: ask the worker to keep everything this visit downloaded from this origin
  * (the first visit is not controlled by the worker yet, so it saw none of it): what this page's
- * resource timing lists, and `fetchedElsewhere` (the runtime worker's downloads, which it does
+ * resource timing lists, and `fetchedElsewhere` (the fetcher worker's downloads, which it does
  * not). Most of it comes out of the HTTP cache, not the network.
  */
 export function keepForOffline(fetchedElsewhere: string[] = []): void {

@@ -167,7 +167,7 @@ export interface DuetHook {
   drawn?: number;
   /** When each stage of the start happened, ms since navigation (web/engine/boot.ts). */
   bootTimings?: Record<string, number>;
-  /** What the runtime worker downloaded (this page's resource timing does not list it): sizes,
+  /** What the fetcher worker downloaded (this page's resource timing does not list it): sizes,
    *  and times in ms since navigation. */
   workerFiles?: { url: string; transferSize: number; encodedBodySize: number; start: number; firstByte: number; end: number }[];
 }
