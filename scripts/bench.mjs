@@ -89,7 +89,7 @@ async function run(url, threads) {
 
 if (args.includes('--phone')) {
   const { benchPhone } = await import('./bench_phone.mjs');
-  await benchPhone({ json, seconds, bootOnly: args.includes('--boot-only'), query: option('query', '') });
+  await benchPhone({ json, seconds, bootOnly: args.includes('--boot-only'), query: option('query', ''), dist: option('dist', null) });
   process.exit(0);
 }
 

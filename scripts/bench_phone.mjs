@@ -15,6 +15,7 @@
 //
 //   npm run bench -- --phone --boot-only                 # the two visits only
 //   npm run bench -- --phone --boot-only --query threads=1
+//   npm run bench -- --phone --boot-only --dist /tmp/dist-old   # a site built before (A/B runs)
 //
 // CPU throttling applies to the page's main thread only (Chromium cannot throttle workers):
 // onnxruntime's second thread, the fetcher worker and Chromium's software WebGL run at full
@@ -168,9 +169,9 @@ async function framesPerSecond(page, url, ms = 4000) {
   return { bodies, fps };
 }
 
-export async function benchPhone({ json = false, seconds = 14, breakdown = true, bootOnly = false, query = '' } = {}) {
-  await build('dist');
-  const server = await serve({ dir: 'dist' });
+export async function benchPhone({ json = false, seconds = 14, breakdown = true, bootOnly = false, query = '', dist = null } = {}) {
+  if (!dist) await build('dist');
+  const server = await serve({ dir: dist ?? 'dist' });
   const browser = await launch(PHONE);
   const result = {};
   try {

@@ -170,6 +170,16 @@ MODELS = {
     "follower_state_dropout": replace(steady(OURS), state_dropout=0.5),
     "follower_state_dropout_20": replace(steady(OURS), state_dropout=0.2),
     "follower_steady_noise_10": replace(steady(OURS), state_noise=0.1),
+    # Hidden half the time, with twice the noise on the state it reads the other half: the
+    # decoder keeps reading the code, and the encoders see more of the drift they must come back from.
+    "follower_state_dropout_noise_40": replace(steady(OURS), state_dropout=0.5, state_noise=0.4),
+    # ... and with half the noise, the state trusted more where it is shown.
+    "follower_state_dropout_noise_10": replace(steady(OURS), state_dropout=0.5, state_noise=0.1),
+    "follower_state_dropout_30": replace(steady(OURS), state_dropout=0.3),
+    # Narrower networks (hidden 384 instead of 512): a quarter fewer bytes for a phone's first
+    # visit to download (docs/measurements.md), if the quality tables accept them.
+    "follower_narrow": steady(replace(OURS, model=replace(FOLLOWER, hidden=384))),
+    "leader_narrow": steady(replace(LEADER_STOP_MOTION, model=replace(LEADER_STOP_MOTION.model, hidden=384))),
     "follower_small": TrainConfig(model=replace(FOLLOWER, hidden=256, intention_hidden=128), intention_noise=0.3),
     "follower_ccm_large": TrainConfig(model=replace(FOLLOWER, intention=False, channels=3 * FOLLOWER.channels)),
     "follower_no_gan": TrainConfig(model=FOLLOWER, lambda_generator=0.0, intention_noise=0.3),

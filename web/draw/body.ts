@@ -274,6 +274,20 @@ export class DancerMeshes implements DancerBody {
  * figure rides along: it is the optional skeleton overlay (drawn through the body), and its pose
  * gives the contact marks their floor and hand points, exactly as with the capsule figures.
  */
+/** Bodies built so far, by skeleton offsets, kind and colour: building one is most of the page's
+ *  start-up work on a slow phone after parsing (bench --phone), and the leader's copy in compare
+ *  mode wears the same body as the leader. Nothing disposes them: the page keeps its dancers. */
+const figures = new WeakMap<object, Map<string, THREE.BufferGeometry>>();
+
+function figureGeometry(offsets: readonly (readonly number[])[], parents: number[], style: FigureStyle): THREE.BufferGeometry {
+  let byStyle = figures.get(offsets);
+  if (!byStyle) figures.set(offsets, (byStyle = new Map()));
+  const key = `${style.kind}:${style.color}`;
+  let geometry = byStyle.get(key);
+  if (!geometry) byStyle.set(key, (geometry = buildFigure(offsets, parents, style)));
+  return geometry;
+}
+
 export class SkinnedDancer implements DancerBody {
   readonly group = new THREE.Group();
   readonly color: THREE.Color;
@@ -287,7 +301,7 @@ export class SkinnedDancer implements DancerBody {
   constructor(parents: number[], offsets: readonly (readonly number[])[], style: FigureStyle, castShadow: boolean) {
     this.color = new THREE.Color(style.color);
     this.bind = bindPositions(offsets, parents);
-    const geometry = buildFigure(offsets, parents, style);
+    const geometry = figureGeometry(offsets, parents, style);
     const material = new THREE.MeshStandardMaterial({ vertexColors: true, roughness: 0.7, metalness: 0.02 });
     this.mesh = new THREE.SkinnedMesh(geometry, material);
     // The bones are not in the scene graph: their world matrices are written directly in

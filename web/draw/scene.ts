@@ -252,6 +252,10 @@ export class Stage {
     const parent = this.canvas.parentElement ?? document.body;
     const width = Math.max(1, parent.clientWidth);
     const height = Math.max(1, parent.clientHeight);
+    // Setting a canvas's size, even to the one it has, reallocates its drawing buffer: the resize
+    // observer's first call (same size, right after the constructor's) would pay for it again.
+    const now = this.renderer.getSize(_size);
+    if (now.x === width && now.y === height) return;
     this.renderer.setSize(width, height, false);
     this.camera.aspect = width / height;
     this.camera.updateProjectionMatrix();

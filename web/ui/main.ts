@@ -144,7 +144,9 @@ class Page {
     // The floor is up while the models download: something to look at, never a blank canvas.
     // Skinned characters unless ?bodies=sticks (the bench compares both); ?skeleton=1 overlays the bones.
     const look = readBodies(location.search);
+    bootMark('stage:start');
     this.stage = new Stage(document.getElementById('app')!, manifest.skeleton.parents, MAX_GHOSTS, { ...look, offsets: manifest.skeleton.offsets });
+    bootMark('stage:end'); // the renderer and the dancers' bodies: most of the loading scene's own work
     hook.bodies = this.stage.bodies;
     if (this.settings.camera) this.stage.setOrbit(this.settings.camera);
     this.still = standingViews(manifest);
