@@ -153,3 +153,55 @@ def test_seeds_refuses_a_manifest_without_the_range(exported, data3, tmp_path, c
     (models / "manifest.json").write_text(json.dumps(manifest))
     assert seeds.main(["--data", str(data3), "--models", str(models), "--out", str(tmp_path / "o")]) == 2
     assert "no plausibility range" in capsys.readouterr().err
+
+
+def test_the_upright_guard_takes_the_most_upright_of_the_networks_own_samples():
+    """guard.py (an evaluation experiment): an upright first sample passes untouched; a low one
+    is replaced by the most upright of K fresh samples, and the step is counted."""
+    from training.evaluation.guard import POSE, UprightGuard, upright_margin
+    from training.mirror.skeleton import HEAD
+
+    r = {"hip_low": 0.7, "head_above_hip_low": 0.6, "feet_wide": 1.0}
+
+    def output(hip: float) -> np.ndarray:
+        out = np.zeros(feat.OUTPUT_SIZE, np.float32)
+        pose = out[POSE].reshape(feat.N_JOINTS, 12)
+        pose[:, 1] = hip                  # every joint at the hip's height, feet together ...
+        pose[HEAD, 1] = hip + 0.7         # ... the head 0.7 m above
+        out[POSE] = pose.reshape(-1)
+        return out
+
+    hips = iter([1.0, 0.5, 0.4, 0.9, 0.6])   # the first call: one sample; the second: the guard's batch
+    calls = []
+
+    def policy(x, temperature, rng):
+        calls.append((len(np.atleast_2d(x)), temperature))
+        outs = np.stack([output(next(hips)) for _ in range(len(np.atleast_2d(x)))])
+        return {"output": outs, "code": np.arange(len(outs))[:, None]}
+
+    assert np.allclose(upright_margin(np.stack([output(1.0), output(0.5)]), r), [0.1, -0.2])
+    guard = UprightGuard(policy, r, samples=3, temperature=1.0)
+    x = np.zeros(feat.INPUT_SIZE, np.float32)
+    rng = np.random.default_rng(0)
+    assert guard(x, 0.5, rng)["output"][0][POSE][1] == 1.0 and guard.guarded == 0
+    chosen = guard(x, 0.5, rng)          # 0.5 is low: the batch offers 0.4, 0.9, 0.6
+    assert chosen["output"][0][POSE][1] == np.float32(0.9) and chosen["code"][0, 0] == 1
+    assert guard.guarded == 1 and calls == [(1, 1.0), (1, 1.0), (3, 1.0)]
+
+
+def test_seeds_runs_the_guard_experiment_and_refuses_a_guard_of_one(exported, data3, tmp_path, capsys):
+    import json
+
+    from conftest import SMALL_TAKES
+    from training.evaluation import seeds
+
+    base = ["--data", str(data3), "--models", str(exported["models"]), "--takes", SMALL_TAKES["test"],
+            "--methods", "ours", "--seeds", "1", "--seconds", "2", "--workers", "1", "--quiet"]
+    assert seeds.main(base + ["--guard", "4", "--follower-temperature", "1", "--out", str(tmp_path / "g")]) == 0
+    res = json.loads((tmp_path / "g" / "seeds.json").read_text())
+    assert res["config"]["guard"] == 4 and res["config"]["follower_temperature"] == 1.0
+    row = res["methods"]["ours"]
+    assert row["guarded"] == row["per_seed"][0]["guarded"] >= 0
+    assert "upright guard with 4 samples" in (tmp_path / "g" / "seeds.md").read_text()
+    assert seeds.main(base + ["--guard", "1", "--out", str(tmp_path / "o")]) == 2
+    assert "--guard 1" in capsys.readouterr().err

@@ -28,6 +28,7 @@ from ..data.folders import add_folder
 from ..mirror.skeleton import FPS
 from . import plausibility as P
 from .evaluate_inputs import EvalError, find_models, load_eval_takes, load_onnx
+from .guard import UprightGuard, Variety
 from .interaction import contact_labels, measure, weighted as interaction_weighted
 from .motion_matching import build, load_tracks, training_takes
 from .soak import soak_one
@@ -58,10 +59,15 @@ def weighted(rows: list[dict], frames: list[int]) -> dict:
 _WORKER: dict = {}
 
 
-def _init(models: str, method: str, data: str, test: list[str], r: dict):
+def _init(models: str, method: str, data: str, test: list[str], r: dict, guard: int = 0,
+          follower_temperature: float | None = None, guard_margin: float = 0.0):
     manifest, onnx, leader = find_models(models)
     follower = (build(load_tracks(training_takes(data, exclude=test)), "follower")
                 if method == "motion_matching" else load_onnx(onnx[method]))
+    if guard:   # an experiment (guard.py): the networks' own samples, the most upright taken
+        follower = UprightGuard(follower, r, guard, follower_temperature, guard_margin)
+    elif follower_temperature is not None:
+        follower = Variety(follower, follower_temperature)
     _WORKER.update(manifest=manifest, leader=load_onnx(leader), follower=follower, ranges=r)
 
 
@@ -69,8 +75,10 @@ def _one(job: tuple[int, int, float]) -> dict:
     seed, frames, temperature = job
     w = _WORKER
     rec: dict = {}
+    if hasattr(w["follower"], "guarded"):
+        w["follower"].guarded = 0
     soak = soak_one(w["manifest"], w["leader"], w["follower"], seed, frames, temperature, rec)
-    out = {"seed": seed, "resets": soak["resets"]}
+    out = {"seed": seed, "resets": soak["resets"], "guarded": getattr(w["follower"], "guarded", 0)}
     for kind, suffix in (("alone", ""), ("layer", "_shown")):
         lead, follow = rec["leader" + suffix], rec["follower" + suffix]
         out[kind] = {**P.duet(lead, follow, w["ranges"]),
@@ -81,7 +89,8 @@ def _one(job: tuple[int, int, float]) -> dict:
 def run_method(args, method: str, r: dict, test: list[str], bar) -> dict:
     frames = int(args.seconds * FPS)
     jobs = [(seed, frames, args.temperature) for seed in range(args.first_seed, args.first_seed + args.seeds)]
-    init = (args.models, method, args.data, test, r)
+    init = (args.models, method, args.data, test, r, args.guard if method != "motion_matching" else 0,
+            args.follower_temperature if method != "motion_matching" else None, args.guard_margin)
 
     def counted(results):
         for res in results:
@@ -94,7 +103,9 @@ def run_method(args, method: str, r: dict, test: list[str], bar) -> dict:
     else:
         _init(*init)
         per_seed = list(counted(map(_one, jobs)))
-    row = {"per_seed": per_seed, "resets": int(sum(s["resets"] for s in per_seed))}
+    row = {"per_seed": per_seed, "resets": int(sum(s["resets"] for s in per_seed)),
+           "guarded": int(sum(s["guarded"] for s in per_seed)),
+           "seeds_guarded": int(sum(s["guarded"] > 0 for s in per_seed))}
     for kind in ("alone", "layer"):
         duets = [s[kind] for s in per_seed]
         row[kind] = {**P.summarize(duets, [frames] * len(duets)), **weighted(duets, [frames] * len(duets))}
@@ -122,6 +133,8 @@ def run(args) -> dict:
         raise EvalError(f"{args.models}/manifest.json has no plausibility range: re-export it "
                         f"(python -m training.learning.export, after training.data.prepare)")
     r = manifest["plausibility"]   # the training dancers' range, as prepare measured it
+    if args.guard < 0 or args.guard == 1:
+        raise EvalError(f"--guard {args.guard}: 0 (off) or at least 2 samples to choose from")
     if args.temperature is None:
         args.temperature = manifest["defaultTemperature"]
     known = [*onnx, "motion_matching"]
@@ -141,6 +154,8 @@ def run(args) -> dict:
     bar.close()
     res["config"] = {"models": str(args.models), "seeds": args.seeds, "first_seed": args.first_seed,
                      "seconds": args.seconds, "temperature": args.temperature,
+                     "follower_temperature": args.follower_temperature, "guard": args.guard,
+                     "guard_margin": args.guard_margin,
                      "wall_seconds": time.time() - t0}
     return res
 
@@ -181,6 +196,16 @@ def write_markdown(path: Path, res: dict) -> None:
             s, q = row[kind], row["ratio"][kind]
             lines.append(f"| {m} {kind} | {s['path_ratio']:.2f} ({fmt(q['path_ratio'])}×) | " +
                          " | ".join(f"{fmt(s[k], 3)} ({fmt(q[k])}×)" for k in INTERACTION) + f" | {row['resets']} |")
+    if cfg.get("guard") or cfg.get("follower_temperature") is not None:
+        lines += ["", f"Experiment (training/evaluation/guard.py): network followers at temperature "
+                      f"{cfg.get('follower_temperature') or cfg['temperature']}, upright guard with "
+                      f"{cfg.get('guard') or 'no'} samples" +
+                      (f", acting {cfg['guard_margin']:g} m before the range's edge." if cfg.get("guard_margin") else ".")]
+        for m, row in res["methods"].items():
+            if m != "motion_matching":
+                lines.append(f"- {m}: the guard chose another sample in {row['guarded']} steps "
+                             f"({100 * row['guarded'] / (cfg['seeds'] * cfg['seconds'] * FPS):.2f} % of frames), "
+                             f"in {row['seeds_guarded']} of {cfg['seeds']} seeds.")
     lines += ["", f"Wall time {cfg['wall_seconds'] / 60:.1f} min."]
     path.write_text("\n".join(lines) + "\n")
 
@@ -197,6 +222,12 @@ def main(argv=None) -> int:
     ap.add_argument("--temperature", type=float, default=None, help="default: the manifest's")
     ap.add_argument("--methods", default=None, help="comma-separated subset (ours, ccm, motion_matching; default all)")
     ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--guard", type=int, default=0, metavar="K",
+                    help="experiment: the network followers' upright guard with K samples (guard.py; 0: off)")
+    ap.add_argument("--guard-margin", type=float, default=0.0, metavar="M",
+                    help="experiment: the guard acts once the decoded pose is within M metres of the range's edge")
+    ap.add_argument("--follower-temperature", type=float, default=None,
+                    help="experiment: the network followers' own temperature (default: the duet's)")
     ap.add_argument("--out", default="runs/seeds")
     ap.add_argument("--quiet", action="store_true")
     args = ap.parse_args(argv)

@@ -1,0 +1,68 @@
+"""An experiment, not on the page: the follower's policy with an upright guard and its own variety.
+
+A follower whose decoder is kept reading its code (train.py's `follower_state_dropout`) is as
+varied as the recording again, but now and then it sinks to the floor (docs/plausibility.md). The
+guard asks whether a sample the network already offers would have stayed up: when the decoded
+pose of a step leaves the recording's range (hips low, head low over the hips, feet too wide:
+plausibility.BODY_FLAGS), the same input is run again with `samples` fresh Gumbel draws and the
+most upright of them is taken. Every candidate is one step on from the current pose, decoded by
+the network from the same state, so the body never jumps; the guard only chooses among the
+network's own reactions, and it counts every step it chose (reported beside the flags).
+
+`margin` (metres) lets it act before the pose leaves the range: once the body is low, every
+sample the network offers from there is low too. `temperature` overrides the variety the duet
+asks for (the leader keeps the duet's).
+
+    python -m training.evaluation.seeds --models SCRATCH --methods ours --guard 8 --follower-temperature 1
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..mirror import features as feat
+from ..mirror.skeleton import FEET, HEAD
+
+POSE = feat.block_slices(feat.OUTPUT_LAYOUT)["pose"]
+
+
+def upright_margin(outputs: np.ndarray, r: dict) -> np.ndarray:
+    """[B, 323] raw outputs -> [B] metres by which the decoded pose stays inside the recording's
+    range on hips, head over hips and feet apart (negative: that far outside). The pose is in the
+    next root's space, whose y is the height above the floor."""
+    pose = np.atleast_2d(outputs)[:, POSE].reshape(-1, feat.N_JOINTS, 12)[..., :3]
+    hip, head = pose[:, 0, 1], pose[:, HEAD, 1]
+    feet = np.linalg.norm(pose[:, FEET[0]] - pose[:, FEET[1]], axis=-1)
+    return np.minimum.reduce([hip - r["hip_low"], head - hip - r["head_above_hip_low"], r["feet_wide"] - feet])
+
+
+class UprightGuard:
+    """Wraps a policy (x, temperature, rng) -> {output, intention, ...}; `guarded` counts the steps
+    in which it picked another sample (reset it per duet)."""
+
+    def __init__(self, policy, ranges: dict, samples: int = 8, temperature: float | None = None,
+                 margin: float = 0.0):
+        if samples < 2:
+            raise ValueError("the guard needs at least 2 samples to choose from")
+        self.policy, self.ranges, self.samples, self.temperature = policy, ranges, samples, temperature
+        self.margin = margin
+        self.guarded = 0
+
+    def __call__(self, x: np.ndarray, temperature: float, rng: np.random.Generator) -> dict:
+        t = temperature if self.temperature is None else self.temperature
+        out = self.policy(x, t, rng)
+        if upright_margin(out["output"], self.ranges)[0] >= self.margin:
+            return out
+        self.guarded += 1
+        many = self.policy(np.repeat(np.atleast_2d(x), self.samples, 0), t, rng)
+        best = int(np.argmax(upright_margin(many["output"], self.ranges)))
+        return {k: v[best:best + 1] for k, v in many.items()}
+
+
+class Variety:
+    """A policy run at its own temperature, whatever the duet asks for (the guard's baseline)."""
+
+    def __init__(self, policy, temperature: float):
+        self.policy, self.temperature, self.guarded = policy, temperature, 0
+
+    def __call__(self, x: np.ndarray, temperature: float, rng: np.random.Generator) -> dict:
+        return self.policy(x, self.temperature, rng)
