@@ -176,6 +176,9 @@ MODELS = {
     # ... and with half the noise, the state trusted more where it is shown.
     "follower_state_dropout_noise_10": replace(steady(OURS), state_dropout=0.5, state_noise=0.1),
     "follower_state_dropout_30": replace(steady(OURS), state_dropout=0.3),
+    # CCM by the same recipe: the fair baseline if the state-dropout follower (with the upright
+    # guard, training/evaluation/guard.py) is ever shipped.
+    "follower_ccm_state_dropout": replace(steady(CCM), state_dropout=0.5),
     # Narrower networks (hidden 384 instead of 512): a quarter fewer bytes for a phone's first
     # visit to download (docs/measurements.md), if the quality tables accept them.
     "follower_narrow": steady(replace(OURS, model=replace(FOLLOWER, hidden=384))),
