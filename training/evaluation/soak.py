@@ -28,6 +28,7 @@ from ..data.folders import add_folder
 from ..mirror.rollout import NOW, OnnxPolicy, start_duet, step
 from . import metrics as M
 from . import plausibility as P
+from .guard import UprightGuard, Variety
 from ..mirror.skeleton import FEET, FPS, PARENTS
 
 MAX_DISTANCE = 3.0        # m between the partners
@@ -165,6 +166,12 @@ def main(argv=None) -> int:
     ap.add_argument("--temperature", type=float, default=None, help="default: the manifest's")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--out", default=None, help="write the table as JSON here")
+    ap.add_argument("--guard", type=int, default=0, metavar="K",
+                    help="experiment: the follower's upright guard with K samples (evaluation/guard.py; 0: off)")
+    ap.add_argument("--guard-margin", type=float, default=0.0, metavar="M",
+                    help="experiment: the guard acts once the decoded pose is within M metres of the range's edge")
+    ap.add_argument("--follower-temperature", type=float, default=None,
+                    help="experiment: the follower's own temperature (default: the duet's)")
     args = ap.parse_args(argv)
     manifest_path = Path(args.models) / "manifest.json"
     if not manifest_path.exists():
@@ -179,14 +186,27 @@ def main(argv=None) -> int:
     follower = OnnxPolicy(Path(args.models) / manifest["models"][args.follower]["file"])
     frames = int(args.minutes * 60 * FPS)
     ranges = manifest.get("plausibility")
+    if args.guard < 0 or args.guard == 1 or (args.guard and not ranges):
+        print(f"error: --guard {args.guard}: 0 (off) or at least 2 samples, with a manifest that has "
+              f"the plausibility range", file=sys.stderr)
+        return 2
+    if args.guard:
+        follower = UprightGuard(follower, ranges, args.guard, args.follower_temperature, args.guard_margin)
+    elif args.follower_temperature is not None:
+        follower = Variety(follower, args.follower_temperature)
     t0 = time.time()
     results = []
     print(f"{args.rollouts} rollouts x {frames} frames ({args.minutes:g} min at {FPS} Hz), "
-          f"follower {args.follower}, temperature {temperature}")
+          f"follower {args.follower}, temperature {temperature}" +
+          (f" (follower {args.follower_temperature})" if args.follower_temperature is not None else "") +
+          (f", upright guard K={args.guard} margin {args.guard_margin:g} m (experiment)" if args.guard else ""))
     print(" seed  nonfinite  max dist m  bone err mm  min foot cm  frozen L  frozen F  resets  result")
     for i in tqdm(range(args.rollouts), desc="soak", unit="rollout", leave=False):
         rec = {}
+        if hasattr(follower, "guarded"):
+            follower.guarded = 0
         r = soak_one(manifest, leader, follower, args.seed + i, frames, temperature, rec)
+        r["guarded"] = getattr(follower, "guarded", 0)
         r["interaction"] = M.interaction(rec["leader"], rec["follower"], rec["leader_contacts"], rec["follower_contacts"])
         r["interaction_layer"] = M.interaction(rec["leader_shown"], rec["follower_shown"], rec["leader_contacts"],
                                                rec["follower_contacts"])
@@ -206,7 +226,8 @@ def main(argv=None) -> int:
                "bone_error_mm": max(r["bone_error"] for r in results) * 1000,
                "min_foot_cm": min(r["min_foot"] for r in results) * 100,
                "frozen_max": max(max(r["frozen_leader"], r["frozen_follower"]) for r in results),
-               "resets": sum(r["resets"] for r in results), "seconds": time.time() - t0}
+               "resets": sum(r["resets"] for r in results), "seconds": time.time() - t0,
+               "guarded": sum(r["guarded"] for r in results)}
     for key in ("interaction", "interaction_layer"):
         summary[key] = {k: float(np.mean([r[key][k] for r in results])) for k in results[0][key]}
     if ranges:
@@ -219,6 +240,9 @@ def main(argv=None) -> int:
     print(f"summary: {len(bad)} of {len(results)} rollouts failed; max distance {summary['max_distance']:.2f} m; "
           f"bone error {summary['bone_error_mm']:.4f} mm; lowest foot {summary['min_foot_cm']:.1f} cm; "
           f"most frozen {summary['frozen_max']:.3f}; resets {summary['resets']}; {summary['seconds']:.0f} s")
+    if args.guard:
+        print(f"upright guard (experiment): chose another sample in {summary['guarded']} steps "
+              f"({summary['guarded'] / (frames * len(results)):.2%} of frames)")
     for key, title in (("interaction", "networks alone"), ("interaction_layer", "with the contact layer")):
         m = summary[key]
         print(f"interaction, {title}: torsos through each other {m['interpenetration']:.1%} of frames, "
