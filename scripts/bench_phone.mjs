@@ -21,6 +21,7 @@
 // onnxruntime's second thread, the fetcher worker and Chromium's software WebGL run at full
 // speed, so the step and frame-rate numbers flatter a phone.
 
+import { existsSync } from 'node:fs';
 import { build, launch, sleep } from '../tests/e2e/harness.mjs';
 import { serve } from './serve.mjs';
 
@@ -171,6 +172,7 @@ async function framesPerSecond(page, url, ms = 4000) {
 
 export async function benchPhone({ json = false, seconds = 14, breakdown = true, bootOnly = false, query = '', dist = null } = {}) {
   if (!dist) await build('dist');
+  else if (!existsSync(`${dist}/index.html`)) throw new Error(`--dist ${dist}: no index.html there (build one with: npx vite build --outDir ${dist})`);
   const server = await serve({ dir: dist ?? 'dist' });
   const browser = await launch(PHONE);
   const result = {};

@@ -268,15 +268,10 @@ export class DancerMeshes implements DancerBody {
   }
 }
 
-/**
- * One dancer as a skinned character (figure.ts): one SkinnedMesh, one draw call, its 17 bones set
- * every frame from the same joint positions and rotations the capsule figure takes. A thin capsule
- * figure rides along: it is the optional skeleton overlay (drawn through the body), and its pose
- * gives the contact marks their floor and hand points, exactly as with the capsule figures.
- */
-/** Bodies built so far, by skeleton offsets, kind and colour: building one is most of the page's
- *  start-up work on a slow phone after parsing (bench --phone), and the leader's copy in compare
- *  mode wears the same body as the leader. Nothing disposes them: the page keeps its dancers. */
+/** Bodies built so far, by skeleton offsets, kind and colour: the leader's copy in compare mode
+ *  wears the same body as the leader, so it is built once (building the scene at the phone
+ *  bench's 4x CPU: 405 against 428 ms, docs/measurements.md). Nothing disposes them: the page
+ *  keeps its dancers. */
 const figures = new WeakMap<object, Map<string, THREE.BufferGeometry>>();
 
 function figureGeometry(offsets: readonly (readonly number[])[], parents: number[], style: FigureStyle): THREE.BufferGeometry {
@@ -288,6 +283,12 @@ function figureGeometry(offsets: readonly (readonly number[])[], parents: number
   return geometry;
 }
 
+/**
+ * One dancer as a skinned character (figure.ts): one SkinnedMesh, one draw call, its 17 bones set
+ * every frame from the same joint positions and rotations the capsule figure takes. A thin capsule
+ * figure rides along: it is the optional skeleton overlay (drawn through the body), and its pose
+ * gives the contact marks their floor and hand points, exactly as with the capsule figures.
+ */
 export class SkinnedDancer implements DancerBody {
   readonly group = new THREE.Group();
   readonly color: THREE.Color;

@@ -30,7 +30,11 @@ export function registerOffline(version: string): void {
  */
 export function keepForOffline(fetchedElsewhere: string[] = []): void {
   if (!available()) return;
-  const urls = [location.href, ...performance.getEntriesByType('resource').map((entry) => entry.name), ...fetchedElsewhere]
+  // The wasm by name too: the fetcher worker lists its files as of its last model, and on a fast
+  // link the wasm's own entry can come after that (its body is read by the compiler); without it
+  // the repeat visit downloaded the wasm again (tests/e2e/offline.test.mjs failed once in two runs).
+  const urls = [location.href, new URL(WASM_URL, location.href).href,
+    ...performance.getEntriesByType('resource').map((entry) => entry.name), ...fetchedElsewhere]
     .filter((url) => url.startsWith(location.origin));
   navigator.serviceWorker.ready
     .then((registration) => registration.active?.postMessage({ type: 'keep', urls }))
