@@ -3,6 +3,10 @@ training.evaluation.seeds, with the contact layer): the 6 s with most follower f
 that the worst seed of a seeds table can be looked at, not only counted.
 
     PYTHONPATH=. .venv/bin/python scripts/worst_seed.py SEED OUT.png [--models DIR] [--flag angles_out|body]
+        [--seconds 60] [--guard K --guard-margin M --follower-temperature T]
+
+The guard options are training.evaluation.guard's (an experiment); with --seconds 600 a seed is
+the soak's rollout of that seed.
 
 --flag angles_out (default): joint angles out of the recorded range; body: hips low, head low or
 feet wide (plausibility.BODY_FLAGS, what a bad second counts).
@@ -15,6 +19,7 @@ import numpy as np
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
+from training.evaluation import guard as G
 from training.evaluation import plausibility as P
 from training.evaluation.evaluate_inputs import find_models, load_onnx
 from training.evaluation.soak import soak_one
@@ -25,11 +30,16 @@ ap.add_argument("seed", type=int)
 ap.add_argument("out")
 ap.add_argument("--models", default="public/models")
 ap.add_argument("--flag", choices=["angles_out", "body"], default="angles_out")
+ap.add_argument("--seconds", type=float, default=60.0)
+G.add_options(ap)
 args = ap.parse_args()
 
 manifest, onnx, leader = find_models(args.models)
 rec = {}
-soak_one(manifest, load_onnx(leader), load_onnx(onnx["ours"]), args.seed, 60 * FPS, manifest["defaultTemperature"], rec)
+if G.option_error(args):
+    ap.error(G.option_error(args))
+follower = G.wrap(load_onnx(onnx["ours"]), manifest["plausibility"], args.guard, args.guard_margin, args.follower_temperature)
+soak_one(manifest, load_onnx(leader), follower, args.seed, int(args.seconds * FPS), manifest["defaultTemperature"], rec)
 L, F = rec["leader_shown"], rec["follower_shown"]
 flags = P.frame_flags(F, manifest["plausibility"])
 bad = (P.body_flagged(flags) if args.flag == "body" else flags[args.flag]).astype(float)
@@ -45,8 +55,9 @@ for k, ax in enumerate(axes.flat):
                 ax.plot([pos[j, 0] - c[0], pos[p, 0] - c[0]], [pos[j, 1], pos[p, 1]], color=col, lw=2)
     ax.set_xlim(-1.2, 1.2); ax.set_ylim(0, 1.9); ax.set_aspect("equal"); ax.set_xticks([]); ax.set_yticks([])
     ax.set_title(f"t={t / FPS:.1f} s{'  ' + label if bad[t] else ''}", fontsize=9)
-fig.suptitle(f"{args.models}, steered seed {args.seed}: the 6 s with most follower frames flagged "
+fig.suptitle(f"{args.models}, steered seed {args.seed}" + (f" (guard K={args.guard}, {args.guard_margin:g} m)" if args.guard else "") + ": the 6 s with most follower frames flagged "
              f"({label}), side view (x, height), a frame every 0.5 s")
 fig.tight_layout()
 fig.savefig(args.out, dpi=80)
-print(f"worst 6 s from {start / FPS:.1f} s; {label}: {bad.mean():.1%} of the minute")
+print(f"worst 6 s from {start / FPS:.1f} s; {label}: {bad.mean():.1%} of the {args.seconds:g} s"
+      + (f"; the guard chose {follower.guarded} steps" if args.guard else ""))

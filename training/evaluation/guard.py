@@ -13,9 +13,14 @@ network's own reactions, and it counts every step it chose (reported beside the 
 sample the network offers from there is low too. `temperature` overrides the variety the duet
 asks for (the leader keeps the duet's).
 
-    python -m training.evaluation.seeds --models SCRATCH --methods ours --guard 8 --follower-temperature 1
+    python -m training.evaluation.seeds --models SCRATCH --methods ours --guard 8 --guard-margin 0.05 --follower-temperature 1
+    python -m training.evaluation.soak  --models SCRATCH --guard 8 --guard-margin 0.05 --follower-temperature 1
+
+Both commands take the options from `add_options` and wrap their follower with `wrap`.
 """
 from __future__ import annotations
+
+import argparse
 
 import numpy as np
 
@@ -66,3 +71,35 @@ class Variety:
 
     def __call__(self, x: np.ndarray, temperature: float, rng: np.random.Generator) -> dict:
         return self.policy(x, self.temperature, rng)
+
+
+def add_options(ap: argparse.ArgumentParser) -> None:
+    """The experiment's command-line options (seeds and soak)."""
+    ap.add_argument("--guard", type=int, default=0, metavar="K",
+                    help="experiment: the follower's upright guard with K samples (evaluation/guard.py; 0: off)")
+    ap.add_argument("--guard-margin", type=float, default=0.0, metavar="M",
+                    help="experiment: the guard acts once the decoded pose is within M metres of the range's edge")
+    ap.add_argument("--follower-temperature", type=float, default=None,
+                    help="experiment: the follower's own temperature (default: the duet's)")
+
+
+def option_error(args) -> str | None:
+    """What is wrong with the options, in one line (None: nothing)."""
+    if args.guard < 0 or args.guard == 1:
+        return f"--guard {args.guard}: 0 (off) or at least 2 samples to choose from"
+    return None
+
+
+def wrap(policy, ranges: dict | None, guard: int = 0, margin: float = 0.0, temperature: float | None = None):
+    """The follower's policy as the options ask: guarded, at its own variety, or as it is."""
+    if guard:
+        if not ranges:
+            raise ValueError("the upright guard needs the manifest's plausibility range")
+        return UprightGuard(policy, ranges, guard, temperature, margin)
+    return policy if temperature is None else Variety(policy, temperature)
+
+
+def restart_count(policy) -> None:
+    """Zero the guard's count before a duet (a plain policy has none)."""
+    if hasattr(policy, "guarded"):
+        policy.guarded = 0

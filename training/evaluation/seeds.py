@@ -26,9 +26,9 @@ from tqdm import tqdm
 from ..data.dataset import DataError, TEST_TAKES
 from ..data.folders import add_folder
 from ..mirror.skeleton import FPS
+from . import guard as G
 from . import plausibility as P
 from .evaluate_inputs import EvalError, find_models, load_eval_takes, load_onnx
-from .guard import UprightGuard, Variety
 from .interaction import contact_labels, measure, weighted as interaction_weighted
 from .motion_matching import build, load_tracks, training_takes
 from .soak import soak_one
@@ -64,10 +64,7 @@ def _init(models: str, method: str, data: str, test: list[str], r: dict, guard: 
     manifest, onnx, leader = find_models(models)
     follower = (build(load_tracks(training_takes(data, exclude=test)), "follower")
                 if method == "motion_matching" else load_onnx(onnx[method]))
-    if guard:   # an experiment (guard.py): the networks' own samples, the most upright taken
-        follower = UprightGuard(follower, r, guard, follower_temperature, guard_margin)
-    elif follower_temperature is not None:
-        follower = Variety(follower, follower_temperature)
+    follower = G.wrap(follower, r, guard, guard_margin, follower_temperature)   # an experiment: guard.py
     _WORKER.update(manifest=manifest, leader=load_onnx(leader), follower=follower, ranges=r)
 
 
@@ -75,8 +72,7 @@ def _one(job: tuple[int, int, float]) -> dict:
     seed, frames, temperature = job
     w = _WORKER
     rec: dict = {}
-    if hasattr(w["follower"], "guarded"):
-        w["follower"].guarded = 0
+    G.restart_count(w["follower"])
     soak = soak_one(w["manifest"], w["leader"], w["follower"], seed, frames, temperature, rec)
     out = {"seed": seed, "resets": soak["resets"], "guarded": getattr(w["follower"], "guarded", 0)}
     for kind, suffix in (("alone", ""), ("layer", "_shown")):
@@ -133,8 +129,8 @@ def run(args) -> dict:
         raise EvalError(f"{args.models}/manifest.json has no plausibility range: re-export it "
                         f"(python -m training.learning.export, after training.data.prepare)")
     r = manifest["plausibility"]   # the training dancers' range, as prepare measured it
-    if args.guard < 0 or args.guard == 1:
-        raise EvalError(f"--guard {args.guard}: 0 (off) or at least 2 samples to choose from")
+    if G.option_error(args):
+        raise EvalError(G.option_error(args))
     if args.temperature is None:
         args.temperature = manifest["defaultTemperature"]
     known = [*onnx, "motion_matching"]
@@ -222,12 +218,7 @@ def main(argv=None) -> int:
     ap.add_argument("--temperature", type=float, default=None, help="default: the manifest's")
     ap.add_argument("--methods", default=None, help="comma-separated subset (ours, ccm, motion_matching; default all)")
     ap.add_argument("--workers", type=int, default=2)
-    ap.add_argument("--guard", type=int, default=0, metavar="K",
-                    help="experiment: the network followers' upright guard with K samples (guard.py; 0: off)")
-    ap.add_argument("--guard-margin", type=float, default=0.0, metavar="M",
-                    help="experiment: the guard acts once the decoded pose is within M metres of the range's edge")
-    ap.add_argument("--follower-temperature", type=float, default=None,
-                    help="experiment: the network followers' own temperature (default: the duet's)")
+    G.add_options(ap)   # the network followers only; Motion Matching dances as it is
     ap.add_argument("--out", default="runs/seeds")
     ap.add_argument("--quiet", action="store_true")
     args = ap.parse_args(argv)

@@ -26,9 +26,9 @@ from tqdm import tqdm
 
 from ..data.folders import add_folder
 from ..mirror.rollout import NOW, OnnxPolicy, start_duet, step
+from . import guard as G
 from . import metrics as M
 from . import plausibility as P
-from .guard import UprightGuard, Variety
 from ..mirror.skeleton import FEET, FPS, PARENTS
 
 MAX_DISTANCE = 3.0        # m between the partners
@@ -166,12 +166,7 @@ def main(argv=None) -> int:
     ap.add_argument("--temperature", type=float, default=None, help="default: the manifest's")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--out", default=None, help="write the table as JSON here")
-    ap.add_argument("--guard", type=int, default=0, metavar="K",
-                    help="experiment: the follower's upright guard with K samples (evaluation/guard.py; 0: off)")
-    ap.add_argument("--guard-margin", type=float, default=0.0, metavar="M",
-                    help="experiment: the guard acts once the decoded pose is within M metres of the range's edge")
-    ap.add_argument("--follower-temperature", type=float, default=None,
-                    help="experiment: the follower's own temperature (default: the duet's)")
+    G.add_options(ap)
     args = ap.parse_args(argv)
     manifest_path = Path(args.models) / "manifest.json"
     if not manifest_path.exists():
@@ -186,14 +181,11 @@ def main(argv=None) -> int:
     follower = OnnxPolicy(Path(args.models) / manifest["models"][args.follower]["file"])
     frames = int(args.minutes * 60 * FPS)
     ranges = manifest.get("plausibility")
-    if args.guard < 0 or args.guard == 1 or (args.guard and not ranges):
-        print(f"error: --guard {args.guard}: 0 (off) or at least 2 samples, with a manifest that has "
-              f"the plausibility range", file=sys.stderr)
+    error = G.option_error(args) or (args.guard and not ranges and f"{manifest_path} has no plausibility range for --guard")
+    if error:
+        print(f"error: {error}", file=sys.stderr)
         return 2
-    if args.guard:
-        follower = UprightGuard(follower, ranges, args.guard, args.follower_temperature, args.guard_margin)
-    elif args.follower_temperature is not None:
-        follower = Variety(follower, args.follower_temperature)
+    follower = G.wrap(follower, ranges, args.guard, args.guard_margin, args.follower_temperature)
     t0 = time.time()
     results = []
     print(f"{args.rollouts} rollouts x {frames} frames ({args.minutes:g} min at {FPS} Hz), "
@@ -203,8 +195,7 @@ def main(argv=None) -> int:
     print(" seed  nonfinite  max dist m  bone err mm  min foot cm  frozen L  frozen F  resets  result")
     for i in tqdm(range(args.rollouts), desc="soak", unit="rollout", leave=False):
         rec = {}
-        if hasattr(follower, "guarded"):
-            follower.guarded = 0
+        G.restart_count(follower)
         r = soak_one(manifest, leader, follower, args.seed + i, frames, temperature, rec)
         r["guarded"] = getattr(follower, "guarded", 0)
         r["interaction"] = M.interaction(rec["leader"], rec["follower"], rec["leader_contacts"], rec["follower_contacts"])

@@ -170,17 +170,17 @@ MODELS = {
     "follower_state_dropout": replace(steady(OURS), state_dropout=0.5),
     "follower_state_dropout_20": replace(steady(OURS), state_dropout=0.2),
     "follower_steady_noise_10": replace(steady(OURS), state_noise=0.1),
-    # Hidden half the time, with twice the noise on the state it reads the other half: the
-    # decoder keeps reading the code, and the encoders see more of the drift they must come back from.
+    # More dials on the same (docs/plausibility.md, "More dials, and an upright guard"): hidden
+    # half the time with twice or half the state noise, the free runs at variety 0.5 swing wide
+    # (FID 446 and 377); hidden in 30 %, FID 124 but the steered follower falls in 74 of 100 seeds.
     "follower_state_dropout_noise_40": replace(steady(OURS), state_dropout=0.5, state_noise=0.4),
-    # ... and with half the noise, the state trusted more where it is shown.
     "follower_state_dropout_noise_10": replace(steady(OURS), state_dropout=0.5, state_noise=0.1),
     "follower_state_dropout_30": replace(steady(OURS), state_dropout=0.3),
     # CCM by the same recipe: the fair baseline if the state-dropout follower (with the upright
     # guard, training/evaluation/guard.py) is ever shipped.
     "follower_ccm_state_dropout": replace(steady(CCM), state_dropout=0.5),
-    # Narrower networks (hidden 384 instead of 512): a quarter fewer bytes for a phone's first
-    # visit to download (docs/measurements.md), if the quality tables accept them.
+    # Narrower networks (hidden 384 instead of 512): 1.03 MB fewer for a phone's first visit, but
+    # the steered tables refuse them (joint angles, hands, foot skate worse; docs/measurements.md).
     "follower_narrow": steady(replace(OURS, model=replace(FOLLOWER, hidden=384))),
     "leader_narrow": steady(replace(LEADER_STOP_MOTION, model=replace(LEADER_STOP_MOTION.model, hidden=384))),
     "follower_small": TrainConfig(model=replace(FOLLOWER, hidden=256, intention_hidden=128), intention_noise=0.3),
