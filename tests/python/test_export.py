@@ -245,3 +245,22 @@ def test_evaluation_files_share_the_training_fingerprint(exported, models, valid
             ref = model.logits(torch.from_numpy(x), torch.from_numpy(y)).target.numpy()
         np.testing.assert_allclose(got, ref, atol=1e-4, rtol=1e-4)
 
+
+
+def test_int8_weights_lie_on_the_coarse_grid(exported):
+    """export.coarsen: every weight (less its zero point) is a multiple of WEIGHT_STEP, or the type's
+    end where the grid's last level does not fit, so brotli can pack the files tighter."""
+    from onnx import numpy_helper
+    for name in SHIPPED:
+        m = onnx.load(str(exported["models"] / f"{name}.onnx"))
+        inits = {i.name: numpy_helper.to_array(i) for i in m.graph.initializer}
+        weights = [k for k in inits if k.endswith("_quantized")]
+        assert weights, f"{name}: no quantized weights"
+        for k in weights:
+            q = inits[k].astype(np.int32)
+            zp = inits.get(k[: -len("_quantized")] + "_zero_point", np.zeros(()))
+            zp = zp.astype(np.int32)[None, :] if zp.ndim == 1 else zp.astype(np.int32)
+            info = np.iinfo(inits[k].dtype)
+            on_grid = ((q - zp) % E.WEIGHT_STEP == 0) | (q == info.min) | (q == info.max)
+            assert on_grid.all(), f"{name} {k}: {np.count_nonzero(~on_grid)} weights off the grid"
+            assert len(np.unique(q)) <= 256 // E.WEIGHT_STEP + 2, f"{name} {k}: {len(np.unique(q))} levels"

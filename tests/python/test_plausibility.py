@@ -159,15 +159,18 @@ def test_the_upright_guard_takes_the_most_upright_of_the_networks_own_samples():
     """guard.py (an evaluation experiment): an upright first sample passes untouched; a low one
     is replaced by the most upright of K fresh samples, and the step is counted."""
     from training.evaluation.guard import POSE, UprightGuard, upright_margin
+    from training.evaluation.plausibility import CHEST
     from training.mirror.skeleton import HEAD
 
-    r = {"hip_low": 0.7, "head_above_hip_low": 0.6, "feet_wide": 1.0}
+    lean = 0.6                            # the steepest torso the range allows (radians)
+    r = {"hip_low": 0.7, "head_above_hip_low": 0.6, "feet_wide": 1.0, "angle_high": [3.0, lean]}
 
-    def output(hip: float) -> np.ndarray:
+    def output(hip: float, chest_sideways: float = 0.0) -> np.ndarray:
         out = np.zeros(feat.OUTPUT_SIZE, np.float32)
         pose = out[POSE].reshape(feat.N_JOINTS, 12)
         pose[:, 1] = hip                  # every joint at the hip's height, feet together ...
         pose[HEAD, 1] = hip + 0.7         # ... the head 0.7 m above
+        pose[CHEST, :2] = chest_sideways, hip + 0.4 - chest_sideways   # the chest above the hips
         out[POSE] = pose.reshape(-1)
         return out
 
@@ -180,6 +183,9 @@ def test_the_upright_guard_takes_the_most_upright_of_the_networks_own_samples():
         return {"output": outs, "code": np.arange(len(outs))[:, None]}
 
     assert np.allclose(upright_margin(np.stack([output(1.0), output(0.5)]), r), [0.1, -0.2])
+    # Hips and head high, the torso tipped: the chest 0.3 m out over 0.1 m up leans past 0.6 rad.
+    tipped = np.hypot(0.3, 0.1) * np.sin(lean) - 0.3
+    assert tipped < 0 and np.allclose(upright_margin(output(1.0, 0.3), r), [tipped], atol=1e-6)
     guard = UprightGuard(policy, r, samples=3, temperature=1.0)
     x = np.zeros(feat.INPUT_SIZE, np.float32)
     rng = np.random.default_rng(0)

@@ -4,7 +4,7 @@ A follower whose decoder is kept reading its code (train.py's `follower_state_dr
 varied as the recording again, but now and then it sinks to the floor (docs/plausibility.md). The
 guard asks whether a sample the network already offers would have stayed up: when the decoded
 pose of a step leaves the recording's range (hips low, head low over the hips, feet too wide:
-plausibility.BODY_FLAGS), the same input is run again with `samples` fresh Gumbel draws and the
+plausibility.BODY_FLAGS, or the torso leaning further than the recording's steepest), the same input is run again with `samples` fresh Gumbel draws and the
 most upright of them is taken. Every candidate is one step on from the current pose, decoded by
 the network from the same state, so the body never jumps; the guard only chooses among the
 network's own reactions, and it counts every step it chose (reported beside the flags).
@@ -26,18 +26,28 @@ import numpy as np
 
 from ..mirror import features as feat
 from ..mirror.skeleton import FEET, HEAD
+from .plausibility import CHEST
 
 POSE = feat.block_slices(feat.OUTPUT_LAYOUT)["pose"]
 
 
 def upright_margin(outputs: np.ndarray, r: dict) -> np.ndarray:
     """[B, 323] raw outputs -> [B] metres by which the decoded pose stays inside the recording's
-    range on hips, head over hips and feet apart (negative: that far outside). The pose is in the
-    next root's space, whose y is the height above the floor."""
+    range on hips, head over hips, feet apart and the torso's lean (negative: that far outside).
+    The pose is in the next root's space, whose y is the height above the floor.
+
+    The lean is measured in metres too: how far the chest may still move sideways over the hips
+    before the torso leans more than the recording's steepest (plausibility's last angle). A
+    dancer can tip over backwards with the hips still high (docs/worst-seed-guard-3.png), so
+    heights alone see that fall only once the head is already down."""
     pose = np.atleast_2d(outputs)[:, POSE].reshape(-1, feat.N_JOINTS, 12)[..., :3]
     hip, head = pose[:, 0, 1], pose[:, HEAD, 1]
     feet = np.linalg.norm(pose[:, FEET[0]] - pose[:, FEET[1]], axis=-1)
-    return np.minimum.reduce([hip - r["hip_low"], head - hip - r["head_above_hip_low"], r["feet_wide"] - feet])
+    torso = pose[:, CHEST] - pose[:, 0]
+    sideways = np.linalg.norm(torso[:, [0, 2]], axis=-1)
+    allowed = np.linalg.norm(torso, axis=-1) * np.sin(r["angle_high"][-1])
+    return np.minimum.reduce([hip - r["hip_low"], head - hip - r["head_above_hip_low"], r["feet_wide"] - feet,
+                              allowed - sideways])
 
 
 class UprightGuard:
