@@ -38,7 +38,8 @@ manifest, onnx, leader = find_models(args.models)
 rec = {}
 if G.option_error(args):
     ap.error(G.option_error(args))
-follower = G.wrap(load_onnx(onnx["ours"]), manifest["plausibility"], args.guard, args.guard_margin, args.follower_temperature)
+follower = G.wrap(load_onnx(onnx["ours"]), manifest["plausibility"], args.guard, args.guard_margin,
+                  args.follower_temperature, manifest["skeleton"]["offsets"]["follower"])
 soak_one(manifest, load_onnx(leader), follower, args.seed, int(args.seconds * FPS), manifest["defaultTemperature"], rec)
 L, F = rec["leader_shown"], rec["follower_shown"]
 flags = P.frame_flags(F, manifest["plausibility"])

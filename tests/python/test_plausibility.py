@@ -186,6 +186,18 @@ def test_the_upright_guard_takes_the_most_upright_of_the_networks_own_samples():
     # Hips and head high, the torso tipped: the chest 0.3 m out over 0.1 m up leans past 0.6 rad.
     tipped = np.hypot(0.3, 0.1) * np.sin(lean) - 0.3
     assert tipped < 0 and np.allclose(upright_margin(output(1.0, 0.3), r), [tipped], atol=1e-6)
+    # With bone offsets the guard judges the body the rollout draws: the decoded rotations through
+    # the bones. Upright rotations stand; the same joint positions with every joint turned 90°
+    # about x (up becomes forward) draw a body lying flat, and the guard sees it.
+    offsets = np.zeros((feat.N_JOINTS, 3))
+    offsets[1:, 1] = 0.2                  # every bone 20 cm long, pointing up: a straight column
+    standing, lying = output(1.0), output(1.0)
+    for out, (fwd, up) in ((standing, ((0, 0, 1), (0, 1, 0))), (lying, ((0, -1, 0), (0, 0, 1)))):
+        pose = out[POSE].reshape(feat.N_JOINTS, 12)
+        pose[:, 6:9], pose[:, 9:12] = fwd, up
+        out[POSE] = pose.reshape(-1)
+    assert upright_margin(standing, r, offsets)[0] > 0
+    assert upright_margin(lying, r, offsets)[0] < -0.5 and upright_margin(lying, r)[0] > 0
     guard = UprightGuard(policy, r, samples=3, temperature=1.0)
     x = np.zeros(feat.INPUT_SIZE, np.float32)
     rng = np.random.default_rng(0)

@@ -2,9 +2,10 @@
 
 A follower whose decoder is kept reading its code (train.py's `follower_state_dropout`) is as
 varied as the recording again, but now and then it sinks to the floor (docs/plausibility.md). The
-guard asks whether a sample the network already offers would have stayed up: when the decoded
-pose of a step leaves the recording's range (hips low, head low over the hips, feet too wide:
-plausibility.BODY_FLAGS, or the torso leaning further than the recording's steepest), the same input is run again with `samples` fresh Gumbel draws and the
+guard asks whether a sample the network already offers would have stayed up: when the body a
+step draws (the decoded hip and joint rotations through the dancer's bones) leaves the recording's
+range (hips low, head low over the hips, feet too wide: plausibility.BODY_FLAGS, or the torso
+leaning further than the recording's steepest), the same input is run again with `samples` fresh Gumbel draws and the
 most upright of them is taken. Every candidate is one step on from the current pose, decoded by
 the network from the same state, so the body never jumps; the guard only chooses among the
 network's own reactions, and it counts every step it chose (reported beside the flags).
@@ -25,25 +26,34 @@ import argparse
 import numpy as np
 
 from ..mirror import features as feat
-from ..mirror.skeleton import FEET, HEAD
+from ..mirror.rollout import rotations_from_vectors
+from ..mirror.skeleton import FEET, HEAD, forward_kinematics_reduced
 from .plausibility import CHEST
 
 POSE = feat.block_slices(feat.OUTPUT_LAYOUT)["pose"]
 
 
-def upright_margin(outputs: np.ndarray, r: dict) -> np.ndarray:
+def upright_margin(outputs: np.ndarray, r: dict, offsets: np.ndarray | None = None) -> np.ndarray:
     """[B, 323] raw outputs -> [B] metres by which the decoded pose stays inside the recording's
     range on hips, head over hips, feet apart and the torso's lean (negative: that far outside).
     The pose is in the next root's space, whose y is the height above the floor.
 
+    With the dancer's bone `offsets`, the body judged is the one the rollout draws: the decoded hip
+    and the decoded joint rotations through the bones (mirror/rollout.apply_output). Without them,
+    the decoded joint positions, which the drawn body does not use: the soak's falls of seeds 3
+    and 13 happened with those positions upright throughout (docs/plausibility.md).
+
     The lean is measured in metres too: how far the chest may still move sideways over the hips
-    before the torso leans more than the recording's steepest (plausibility's last angle). A
-    dancer can tip over backwards with the hips still high (docs/worst-seed-guard-3.png), so
-    heights alone see that fall only once the head is already down."""
-    pose = np.atleast_2d(outputs)[:, POSE].reshape(-1, feat.N_JOINTS, 12)[..., :3]
-    hip, head = pose[:, 0, 1], pose[:, HEAD, 1]
-    feet = np.linalg.norm(pose[:, FEET[0]] - pose[:, FEET[1]], axis=-1)
-    torso = pose[:, CHEST] - pose[:, 0]
+    before the torso leans more than the recording's steepest (plausibility's last angle)."""
+    pose = np.atleast_2d(outputs)[:, POSE].reshape(-1, feat.N_JOINTS, 12)
+    if offsets is None:
+        joints = pose[..., :3]
+    else:
+        joints = forward_kinematics_reduced(np.asarray(offsets, float), pose[:, 0, :3],
+                                            rotations_from_vectors(pose[..., 6:9], pose[..., 9:12]))
+    hip, head = joints[:, 0, 1], joints[:, HEAD, 1]
+    feet = np.linalg.norm(joints[:, FEET[0]] - joints[:, FEET[1]], axis=-1)
+    torso = joints[:, CHEST] - joints[:, 0]
     sideways = np.linalg.norm(torso[:, [0, 2]], axis=-1)
     allowed = np.linalg.norm(torso, axis=-1) * np.sin(r["angle_high"][-1])
     return np.minimum.reduce([hip - r["hip_low"], head - hip - r["head_above_hip_low"], r["feet_wide"] - feet,
@@ -55,21 +65,21 @@ class UprightGuard:
     in which it picked another sample (reset it per duet)."""
 
     def __init__(self, policy, ranges: dict, samples: int = 8, temperature: float | None = None,
-                 margin: float = 0.0):
+                 margin: float = 0.0, offsets: np.ndarray | None = None):
         if samples < 2:
             raise ValueError("the guard needs at least 2 samples to choose from")
         self.policy, self.ranges, self.samples, self.temperature = policy, ranges, samples, temperature
-        self.margin = margin
+        self.margin, self.offsets = margin, offsets
         self.guarded = 0
 
     def __call__(self, x: np.ndarray, temperature: float, rng: np.random.Generator) -> dict:
         t = temperature if self.temperature is None else self.temperature
         out = self.policy(x, t, rng)
-        if upright_margin(out["output"], self.ranges)[0] >= self.margin:
+        if upright_margin(out["output"], self.ranges, self.offsets)[0] >= self.margin:
             return out
         self.guarded += 1
         many = self.policy(np.repeat(np.atleast_2d(x), self.samples, 0), t, rng)
-        best = int(np.argmax(upright_margin(many["output"], self.ranges)))
+        best = int(np.argmax(upright_margin(many["output"], self.ranges, self.offsets)))
         return {k: v[best:best + 1] for k, v in many.items()}
 
 
@@ -100,12 +110,14 @@ def option_error(args) -> str | None:
     return None
 
 
-def wrap(policy, ranges: dict | None, guard: int = 0, margin: float = 0.0, temperature: float | None = None):
-    """The follower's policy as the options ask: guarded, at its own variety, or as it is."""
+def wrap(policy, ranges: dict | None, guard: int = 0, margin: float = 0.0, temperature: float | None = None,
+         offsets=None):
+    """The follower's policy as the options ask: guarded (judging the body its bone `offsets` draw),
+    at its own variety, or as it is."""
     if guard:
         if not ranges:
             raise ValueError("the upright guard needs the manifest's plausibility range")
-        return UprightGuard(policy, ranges, guard, temperature, margin)
+        return UprightGuard(policy, ranges, guard, temperature, margin, offsets)
     return policy if temperature is None else Variety(policy, temperature)
 
 

@@ -64,7 +64,8 @@ def _init(models: str, method: str, data: str, test: list[str], r: dict, guard: 
     manifest, onnx, leader = find_models(models)
     follower = (build(load_tracks(training_takes(data, exclude=test)), "follower")
                 if method == "motion_matching" else load_onnx(onnx[method]))
-    follower = G.wrap(follower, r, guard, guard_margin, follower_temperature)   # an experiment: guard.py
+    follower = G.wrap(follower, r, guard, guard_margin, follower_temperature,
+                      manifest["skeleton"]["offsets"]["follower"])   # an experiment: guard.py
     _WORKER.update(manifest=manifest, leader=load_onnx(leader), follower=follower, ranges=r)
 
 

@@ -185,7 +185,8 @@ def main(argv=None) -> int:
     if error:
         print(f"error: {error}", file=sys.stderr)
         return 2
-    follower = G.wrap(follower, ranges, args.guard, args.guard_margin, args.follower_temperature)
+    follower = G.wrap(follower, ranges, args.guard, args.guard_margin, args.follower_temperature,
+                      manifest["skeleton"]["offsets"]["follower"])
     t0 = time.time()
     results = []
     print(f"{args.rollouts} rollouts x {frames} frames ({args.minutes:g} min at {FPS} Hz), "
