@@ -26,7 +26,7 @@ import argparse
 import numpy as np
 
 from ..mirror import features as feat
-from ..mirror.rollout import rotations_from_vectors
+from ..mirror.rollout import MIN_ANKLE_HEIGHT, rotations_from_vectors
 from ..mirror.skeleton import FEET, HEAD, forward_kinematics_reduced
 from .plausibility import CHEST
 
@@ -39,7 +39,7 @@ def upright_margin(outputs: np.ndarray, r: dict, offsets: np.ndarray | None = No
     The pose is in the next root's space, whose y is the height above the floor.
 
     With the dancer's bone `offsets`, the body judged is the one the rollout draws: the decoded hip
-    and the decoded joint rotations through the bones (mirror/rollout.apply_output). Without them,
+    and the decoded joint rotations through the bones, lifted as mirror/rollout.apply_output lifts. Without them,
     the decoded joint positions, which the drawn body does not use: the soak's falls of seeds 3
     and 13 happened with those positions upright throughout (docs/plausibility.md).
 
@@ -51,6 +51,8 @@ def upright_margin(outputs: np.ndarray, r: dict, offsets: np.ndarray | None = No
     else:
         joints = forward_kinematics_reduced(np.asarray(offsets, float), pose[:, 0, :3],
                                             rotations_from_vectors(pose[..., 6:9], pose[..., 9:12]))
+        # apply_output's lift: a body whose ankles would go below the floor is raised whole.
+        joints[..., 1] += np.maximum(MIN_ANKLE_HEIGHT - joints[:, FEET, 1].min(-1), 0)[:, None]
     hip, head = joints[:, 0, 1], joints[:, HEAD, 1]
     feet = np.linalg.norm(joints[:, FEET[0]] - joints[:, FEET[1]], axis=-1)
     torso = joints[:, CHEST] - joints[:, 0]
