@@ -1,5 +1,5 @@
 // web/mirror/footik.ts: the two-bone IK keeps bone lengths and reaches what it can; the lock keeps a
-// planted foot still, re-plants a stale lock, and holds ankles above the floor.
+// planted foot still, slides a lock that trails too far, and holds ankles above the floor.
 
 import { describe, expect, it } from 'vitest';
 import { ANKLE_FLOOR, FootLock, MAX_LOCK_DISTANCE, twoBoneIk } from '../../web/mirror/footik';
@@ -54,14 +54,34 @@ describe('FootLock', () => {
     expect(Array.from(moved.subarray(42, 51))).toEqual(right);
   });
 
-  it('re-plants a lock that fell too far behind (reset, glitch)', () => {
+  it('slides a lock that fell too far behind along, MAX_LOCK_DISTANCE behind the foot', () => {
     const lock = new FootLock();
     lock.apply(leg(), [1, 1], 0);
     const far = leg();
     for (let i = 0; i < 51; i += 3) far[i] += MAX_LOCK_DISTANCE + 0.1;
-    const before = Array.from(far);
     lock.apply(far, [1, 1], 0);
-    before.forEach((v, i) => expect(far[i]).toBeCloseTo(v, 9));
+    // Both ankles drawn back toward where they were planted (the lock now 0.25 m behind the model's
+    // ankle, reached as far as the knee's least bend lets), not snapped onto the model's ankle.
+    const model = [0.1 + MAX_LOCK_DISTANCE + 0.1, -0.1 + MAX_LOCK_DISTANCE + 0.1];
+    [far[39], far[48]].forEach((x, i) => {
+      expect(x).toBeGreaterThan(model[i] - MAX_LOCK_DISTANCE - 1e-9);
+      expect(x).toBeLessThan(model[i] - 0.2);
+    });
+  });
+
+  it('locks from its own threshold (the follower is unsure of its feet)', () => {
+    const follower = new FootLock(0.3);
+    const leader = new FootLock();
+    const a = leg();
+    const b = leg();
+    follower.apply(a, [0.4, 0.2], 0);
+    leader.apply(b, [0.4, 0.2], 0);
+    for (const p of [a, b]) for (let i = 0; i < 51; i += 3) p[i + 2] += 0.03;
+    follower.apply(a, [0.4, 0.2], 0);
+    leader.apply(b, [0.4, 0.2], 0);
+    expect(a[41]).toBeCloseTo(0, 9); // locked at 0.4 > 0.3
+    expect(b[41]).toBeCloseTo(0.03, 9); // free at 0.4 < 0.5
+    expect(a[50]).toBeCloseTo(0.03, 9); // 0.2: free for both
   });
 
   it('never draws an ankle below the floor', () => {

@@ -10,7 +10,7 @@
 //    HAND_FULL and closer, with a weight that rises and falls smoothly;
 // 3. planted feet stay planted: FootLock on both dancers, last, so a body moved by 1. keeps its feet.
 
-import { FootLock, twoBoneIk } from './footik';
+import { CONTACT_THRESHOLD, FootLock, twoBoneIk } from './footik';
 import { HANDS, PARENTS, SPINE } from './skeleton';
 
 /** About half a torso's depth at the chest: spines closer than twice this pass through each other
@@ -37,6 +37,9 @@ export const RELEASE_RATE = 0.7;
 export const ELBOW_POLE = [0, -1, 0];
 /** Radians: the recorded elbows bend at least 0.6-0.7 in 99.5 % of frames. */
 export const MIN_ELBOW_BEND = 0.6;
+/** The follower's feet lock from a lower contact than the leader's: its network, at its own
+ *  variety, is unsure of its feet, which slid while low (training/mirror/contact.py: measured). */
+export const FOLLOWER_CONTACT = 0.3;
 
 type Positions = Float32Array | Float64Array;
 
@@ -157,8 +160,8 @@ const pair = new Float64Array(3);
 
 /** State kept between steps: both dancers' foot locks and the hand hold. */
 export class ContactLayer {
-  readonly leaderFeet = new FootLock();
-  readonly followerFeet = new FootLock();
+  readonly leaderFeet = new FootLock(CONTACT_THRESHOLD);
+  readonly followerFeet = new FootLock(FOLLOWER_CONTACT);
   /** 0..1: how far the closest hands are drawn together. */
   hold = 0;
   /** The pair held: indices into HANDS of the leader's and the follower's hand. */

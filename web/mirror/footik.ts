@@ -1,5 +1,5 @@
 // Mirror of training/mirror/footik.py. Foot locking for drawing: while the model says a foot is planted
-// (contact > 0.5), keep it where the contact began, with a two-bone IK on thigh - shin - foot, and never below the floor.
+// (its contact above the lock's threshold), keep it where the contact began, with a two-bone IK on thigh - shin - foot, and never below the floor.
 //
 // This touches only the DRAWN positions (DancerView.positions). The Track the features read stays
 // exactly what the model produced, so the page's features remain identical to Python's.
@@ -9,15 +9,18 @@ import { FEET, PARENTS } from './skeleton';
 /** Lowest height of the ankle joint: a flat foot's ankle sits 7-11 cm up in the data, so 6 cm
  *  keeps the sole above the floor without ever lifting a real flat foot. */
 export const ANKLE_FLOOR = 0.06;
-/** A lock further than this from the model's foot is stale (a reset, a glitch, a step the model
- *  took without lifting the foot): let it go. Further, the legs stretch out of the recorded range
- *  (training/mirror/footik.py: measured). */
+/** A lock never trails the model's foot by more than this: when the model slides a planted foot on,
+ *  the lock slides along behind it (re-planting it at the foot was a jump that counted as skate).
+ *  Further, the legs stretch out of the recorded range (training/mirror/footik.py: measured). */
 export const MAX_LOCK_DISTANCE = 0.25;
 /** Radians: a knee never straightens further than this to reach a lock (the recorded knees bend at
  *  least 0.19-0.30 in 99.5 % of frames; a leg pulled fully straight read as out of that range). */
 export const MIN_KNEE_BEND = 0.2;
 /** After a contact ends, the lock's pull decays by this factor per step (no pop on release). */
 export const RELEASE_DECAY = 0.5;
+/** A foot locks while the model's contact for it is above this (the follower's layer locks from a
+ *  lower one: contact.ts FOLLOWER_CONTACT). */
+export const CONTACT_THRESHOLD = 0.5;
 
 /**
  * Two-bone IK in place on `positions` (17 × 3): joints a (thigh) -> b (knee) -> c (foot) keep
@@ -83,6 +86,8 @@ export function twoBoneIk(
 
 /** The lock state of one dancer's two feet, kept between steps. */
 export class FootLock {
+  constructor(readonly threshold: number = CONTACT_THRESHOLD) {}
+
   private readonly locked = [false, false];
   private readonly target = new Float64Array(6);
   private readonly weight = new Float64Array(2);
@@ -105,13 +110,21 @@ export class FootLock {
       const fx = positions[3 * foot], fy = positions[3 * foot + 1], fz = positions[3 * foot + 2];
       const t = this.target;
       const o = 3 * i;
-      if (contacts[i] > 0.5) {
-        const stale = this.locked[i] && Math.hypot(t[o] - fx, t[o + 1] - fy, t[o + 2] - fz) > MAX_LOCK_DISTANCE;
-        if (!this.locked[i] || stale) {
+      if (contacts[i] > this.threshold) {
+        if (!this.locked[i]) {
           t[o] = fx;
           t[o + 1] = Math.max(fy, ANKLE_FLOOR);
           t[o + 2] = fz;
           this.locked[i] = true;
+        } else {
+          const behind = Math.hypot(t[o] - fx, t[o + 1] - fy, t[o + 2] - fz);
+          if (behind > MAX_LOCK_DISTANCE) {
+            // Slide along, MAX_LOCK_DISTANCE behind the foot.
+            const k = MAX_LOCK_DISTANCE / behind;
+            t[o] = fx + (t[o] - fx) * k;
+            t[o + 1] = Math.max(fy + (t[o + 1] - fy) * k, ANKLE_FLOOR);
+            t[o + 2] = fz + (t[o + 2] - fz) * k;
+          }
         }
         this.weight[i] = 1;
       } else {
