@@ -3,10 +3,10 @@ training.evaluation.seeds, with the contact layer): the 6 s with most follower f
 that the worst seed of a seeds table can be looked at, not only counted.
 
     PYTHONPATH=. .venv/bin/python scripts/worst_seed.py SEED OUT.png [--models DIR] [--flag angles_out|body]
-        [--seconds 60] [--guard K --guard-margin M --follower-temperature T]
+        [--seconds 60] [--temperature T --follower-temperature T --guard K --guard-margin M]
 
-The guard options are training.evaluation.guard's (an experiment); with --seconds 600 a seed is
-the soak's rollout of that seed.
+The variety and guard options are training.evaluation.options' (default: the manifest's, as the
+page dances); with --seconds 600 a seed is the soak's rollout of that seed.
 
 --flag angles_out (default): joint angles out of the recorded range; body: hips low, head low or
 feet wide (plausibility.BODY_FLAGS, what a bad second counts).
@@ -19,7 +19,7 @@ import numpy as np
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
-from training.evaluation import guard as G
+from training.evaluation import options as O
 from training.evaluation import plausibility as P
 from training.evaluation.evaluate_inputs import find_models, load_onnx
 from training.evaluation.soak import soak_one
@@ -31,16 +31,16 @@ ap.add_argument("out")
 ap.add_argument("--models", default="public/models")
 ap.add_argument("--flag", choices=["angles_out", "body"], default="angles_out")
 ap.add_argument("--seconds", type=float, default=60.0)
-G.add_options(ap)
+O.add_options(ap)
 args = ap.parse_args()
 
 manifest, onnx, leader = find_models(args.models)
 rec = {}
-if G.option_error(args):
-    ap.error(G.option_error(args))
-follower = G.wrap(load_onnx(onnx["ours"]), manifest["plausibility"], args.guard, args.guard_margin,
-                  args.follower_temperature, manifest["skeleton"]["offsets"]["follower"])
-soak_one(manifest, load_onnx(leader), follower, args.seed, int(args.seconds * FPS), manifest["defaultTemperature"], rec)
+error = O.resolve(args, manifest)
+if error:
+    ap.error(error)
+follower = O.follower_policy(load_onnx(onnx["ours"]), manifest, args, args.temperature)
+soak_one(manifest, load_onnx(leader), follower, args.seed, int(args.seconds * FPS), args.temperature, rec)
 L, F = rec["leader_shown"], rec["follower_shown"]
 flags = P.frame_flags(F, manifest["plausibility"])
 bad = (P.body_flagged(flags) if args.flag == "body" else flags[args.flag]).astype(float)

@@ -25,6 +25,7 @@ if str(REPO) not in sys.path:      # run as a script from anywhere
     sys.path.insert(0, str(REPO))
 
 from training.mirror import features as feat  # noqa: E402
+from training.mirror import guard as G  # noqa: E402
 from training.mirror import rollout as ro  # noqa: E402
 from training.mirror.contact import ContactLayer  # noqa: E402
 from training.mirror.bvh import BvhError, forward_kinematics, local_transforms, parse_bvh  # noqa: E402
@@ -436,8 +437,25 @@ def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_o
     leashed = ro.keep_close(apart.follower, apart.leader)
     guards = {"shift": exact(shift), "anchor": exact(apart.steering.anchor), "leashed": leashed,
               "leader": dancer_state(apart.leader), "follower": dancer_state(apart.follower)}
+    # The upright guard (training/mirror/guard.py): plausible follower outputs, one tipped over by its
+    # rotations alone (positions standing), one sunk by its hip (its ankles below the floor, so the
+    # drawn body is lifted part of the way back); margins judged on the drawn body.
+    pose = feat.block_slices(feat.OUTPUT_LAYOUT)["pose"]
+    upright = [plausible(follow, 30), plausible(follow, 31)]
+    tipped = upright[0].copy()
+    vectors = tipped[pose].reshape(feat.N_JOINTS, 12)
+    vectors[:, 6:12] = np.stack([vectors[:, 6], -vectors[:, 8], vectors[:, 7],
+                                 vectors[:, 9], -vectors[:, 11], vectors[:, 10]], -1)   # 90 degrees about x
+    tipped[pose] = vectors.ravel()
+    sunk = upright[1].copy()
+    sunk[pose.start + 1] -= 0.5
+    outputs = np.stack(upright + [tipped, sunk])
+    ranges = {"hip_low": 0.95, "head_above_hip_low": 0.5, "feet_wide": 1.07, "angle_high": [2.5, 0.59]}  # this body's
+    uprightness = {"outputs": exact(outputs), "ranges": ranges,
+                   "margins": out7(G.upright_margin(outputs, ranges, follow_offsets)),
+                   "best": int(np.argmax(G.upright_margin(outputs, ranges, follow_offsets)))}
     return {
-        "NOW": ro.NOW, "TRACK_FRAMES": ro.TRACK_FRAMES, "guards": guards,
+        "NOW": ro.NOW, "TRACK_FRAMES": ro.TRACK_FRAMES, "guards": guards, "upright": uprightness,
         "rotationsFromVectors": {"forward": exact(vectors_f), "up": exact(vectors_u),
                                  "expected": out7(ro.rotations_from_vectors(vectors_f, vectors_u))},
         "offsets": {"leader": exact(lead_offsets), "follower": exact(follow_offsets)},

@@ -156,9 +156,9 @@ def test_seeds_refuses_a_manifest_without_the_range(exported, data3, tmp_path, c
 
 
 def test_the_upright_guard_takes_the_most_upright_of_the_networks_own_samples():
-    """guard.py (an evaluation experiment): an upright first sample passes untouched; a low one
+    """mirror/guard.py (the page's upright guard): an upright first sample passes untouched; a low one
     is replaced by the most upright of K fresh samples, and the step is counted."""
-    from training.evaluation.guard import POSE, UprightGuard, upright_margin
+    from training.mirror.guard import POSE, UprightGuard, upright_margin
     from training.evaluation.plausibility import CHEST
     from training.mirror.skeleton import HEAD
 
@@ -207,7 +207,7 @@ def test_the_upright_guard_takes_the_most_upright_of_the_networks_own_samples():
     assert guard.guarded == 1 and calls == [(1, 1.0), (1, 1.0), (3, 1.0)]
 
 
-def test_seeds_runs_the_guard_experiment_and_refuses_a_guard_of_one(exported, data3, tmp_path, capsys):
+def test_seeds_runs_the_guard_and_refuses_a_guard_of_one(exported, data3, tmp_path, capsys):
     import json
 
     from conftest import SMALL_TAKES
@@ -220,6 +220,6 @@ def test_seeds_runs_the_guard_experiment_and_refuses_a_guard_of_one(exported, da
     assert res["config"]["guard"] == 4 and res["config"]["follower_temperature"] == 1.0
     row = res["methods"]["ours"]
     assert row["guarded"] == row["per_seed"][0]["guarded"] >= 0
-    assert "upright guard with 4 samples" in (tmp_path / "g" / "seeds.md").read_text()
+    assert "upright guard (training/mirror/guard.py): 4 samples" in (tmp_path / "g" / "seeds.md").read_text()
     assert seeds.main(base + ["--guard", "1", "--out", str(tmp_path / "o")]) == 2
     assert "--guard 1" in capsys.readouterr().err

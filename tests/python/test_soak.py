@@ -60,14 +60,14 @@ def test_soak_runs_on_freshly_exported_models(exported, tmp_path, capsys):
     assert "summary:" in capsys.readouterr().out
 
 
-def test_soak_runs_the_guard_experiment_and_refuses_a_guard_of_one(tmp_path, capsys):
-    """--guard K (evaluation/guard.py) on the shipped models: the count of chosen steps is in the
+def test_soak_runs_the_guard_and_refuses_a_guard_of_one(tmp_path, capsys):
+    """--guard K (mirror/guard.py) on the shipped models: the count of chosen steps is in the
     summary and printed; one sample is nothing to choose from."""
     out = tmp_path / "soak.json"
     rc = soak.main(["--models", str(MODELS), "--rollouts", "1", "--minutes", "0.2", "--guard", "4",
                     "--follower-temperature", "1", "--out", str(out)])
     assert rc in (0, 1)
     summary = json.loads(out.read_text())["summary"]
-    assert summary["guarded"] >= 0 and "upright guard (experiment)" in capsys.readouterr().out
+    assert summary["guarded"] >= 0 and "upright guard: chose" in capsys.readouterr().out
     assert soak.main(["--models", str(MODELS), "--guard", "1"]) == 2
     assert "--guard 1" in capsys.readouterr().err

@@ -36,6 +36,9 @@ interface FakeOptions {
   /** Per batch sample i: extra sideways step (ghosts differ). */
   spread?: number;
   broken?: boolean;
+  /** Samples (0: run(); i: the i-th of a batch) whose body is tipped over: every joint's rotation
+   *  turned 90 degrees about x, its decoded positions standing. */
+  tipped?: number[];
 }
 
 /** A stand-in for Policy: "keep the current pose, move `step` forward", built from its own input. */
@@ -44,6 +47,8 @@ class FakePolicy implements StepPolicy {
   readonly result = { output: new Float32Array(OUTPUT_SIZE), intention: null as Float32Array | null };
   readonly entry = { intention: false };
   runs = 0;
+  /** The temperature of every run and batch, in order. */
+  readonly temperatures: number[] = [];
   private readonly batches = new Map<number, { input: Float32Array; output: Float32Array }>();
 
   constructor(readonly options: FakeOptions) {
@@ -55,8 +60,9 @@ class FakePolicy implements StepPolicy {
     return this.entry.intention;
   }
 
-  async run(_temperature: number) {
+  async run(temperature: number) {
     this.runs++;
+    this.temperatures.push(temperature);
     this.fill(this.input, 0, this.result.output, 0, 0);
     return this.result;
   }
@@ -66,7 +72,8 @@ class FakePolicy implements StepPolicy {
     return this.batches.get(k)!.input;
   }
 
-  async runBatch(k: number, _temperature: number) {
+  async runBatch(k: number, temperature: number) {
+    this.temperatures.push(temperature);
     const b = this.batches.get(k)!;
     for (let i = 0; i < k; i++) this.fill(b.input, i * INPUT_SIZE, b.output, i * OUTPUT_SIZE, i);
     return { output: b.output, intention: null };
@@ -86,6 +93,16 @@ class FakePolicy implements StepPolicy {
     }
     // The pose in the next root space: the same as now, since the root moved with the body.
     for (let i = 0; i < 204; i++) out[to + OUT.pose.start + i] = input[at + self + i];
+    if (o.tipped?.includes(sample)) {
+      for (let j = 0; j < 17; j++) {
+        for (const v of [6, 9]) {
+          const q = to + OUT.pose.start + 12 * j + v;
+          const [y, z] = [out[q + 1], out[q + 2]];
+          out[q + 1] = -z;
+          out[q + 2] = y;
+        }
+      }
+    }
     const [l, r] = o.contacts ?? [1, 1];
     out[to + OUT.contacts.start] = l;
     out[to + OUT.contacts.start + 1] = r;
@@ -96,16 +113,37 @@ class FakePolicy implements StepPolicy {
 const policy = (o: FakeOptions) => new FakePolicy(o);
 const steer = { x: 0, z: 0, active: false };
 
-function simulation(followers: FakeOptions[] = [{ role: 'follower', intention: true }], leader: FakeOptions = { role: 'leader' }) {
+function simulation(followers: FakeOptions[] = [{ role: 'follower', intention: true }], leader: FakeOptions = { role: 'leader' }, extra: Partial<Manifest> = {}) {
   const lead = new FakePolicy(leader);
   const follow = followers.map((o) => new FakePolicy(o));
-  const sim = createSimulation({ manifest, leader: lead, followers: follow, seed: 1 });
+  const sim = createSimulation({ manifest: { ...manifest, ...extra }, leader: lead, followers: follow, seed: 1 });
   return { sim, lead, follow };
 }
 
 const finite = (a: ArrayLike<number>) => Array.from(a).every(Number.isFinite);
 
 describe('createSimulation', () => {
+  it('runs the leader at its own variety, and the upright guard picks a standing sample of a tipping follower', async () => {
+    const guarded = {
+      leaderTemperature: 0.5,
+      guard: { samples: 4, margin: 0.05 },
+      plausibility: { hip_low: 0.7, head_above_hip_low: 0.4, feet_wide: 1.07, angle_high: [2.5, 0.59] },
+    };
+    const { sim, lead, follow } = simulation([{ role: 'follower', tipped: [0, 1] }], { role: 'leader' }, guarded);
+    await sim.step(steer, 1);
+    expect(lead.temperatures).toEqual([0.5]);
+    expect(follow[0].temperatures).toEqual([1, 1]); // its own run, then the guard's batch of 4
+    expect(sim.guards().upright).toBe(1);
+    const p = sim.followers[0].positions;
+    expect(p[4 * 3 + 1] - p[1]).toBeGreaterThan(0.4); // the head stays above the hips
+    // Without a guard in the manifest, the same follower is drawn tipped over.
+    const bare = simulation([{ role: 'follower', tipped: [0, 1] }]);
+    await bare.sim.step(steer, 1);
+    expect(bare.sim.guards().upright).toBe(0);
+    const q = bare.sim.followers[0].positions;
+    expect(q[4 * 3 + 1] - q[1]).toBeLessThan(0.2);
+  });
+
   it('starts both dancers in world space: leader at the origin, follower 0.8 m ahead facing it', () => {
     const sim = createSimulation({ manifest, leader: policy({ role: 'leader' }), followers: [policy({ role: 'follower' })], seed: 1 });
     expect(sim.leader.root).toEqual([0, 0]);

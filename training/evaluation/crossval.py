@@ -48,7 +48,7 @@ METHODS = {
     "ccm": ("follower_ccm", "follower_ccm_no_proximity", False),
     "ours_tempo": ("follower_tempo", "follower_no_proximity", True),
     "ccm_tempo": ("follower_ccm_tempo", "follower_ccm_no_proximity", True),
-    # The shipped recipes (decoders that read the pose, proximity, state noise).
+    # The shipped recipes (decoders that read the pose, proximity, state noise, state dropout).
     "ours_steady": ("follower_steady", "follower", False),
     "ccm_steady": ("follower_ccm_steady", "follower_ccm", False),
 }

@@ -32,6 +32,7 @@ from tqdm import tqdm
 
 from ..mirror import features as feat
 from . import metrics as M
+from . import options as O
 from . import plausibility as P
 from ..mirror.contact import ContactLayer
 from ..data.dataset import DataError
@@ -167,13 +168,18 @@ def run(args) -> dict:
                         f"(python -m training.learning.export, after training.data.prepare)")
     ranges = manifest["plausibility"]
     leader = load_onnx(leader_onnx)
-    temperature = manifest["defaultTemperature"] if args.temperature is None else args.temperature
+    error = O.resolve(args, manifest)
+    if error:
+        raise EvalError(f"{args.models}/manifest.json: {error}")
+    temperature = args.temperature   # the leader's; each follower runs at its own (options.py)
     frames = int(args.seconds * feat.FPS)
     res = {"takes": names, "recording": recording_row(takes, ranges), "methods": {}}
     bar = tqdm(total=len(methods) * args.seeds, desc="steered duets", unit="duet", file=sys.stderr,
                disable=args.quiet)
     for m, policy in methods.items():
         row = {"teacher_forced": teacher_forced_row(takes, policy, ranges)}
+        if m != "motion_matching":   # no sampling, nothing to guard
+            policy = O.follower_policy(policy, manifest, args, temperature)
         row["free_running"], row["free_running_layer"] = free_running_rows(takes, policy, manifest["startPose"], temperature, ranges)
         row["steered"], row["steered_layer"] = steered_rows(manifest, leader, policy, args.seeds, frames, temperature, bar, ranges)
         row["steering"] = steering_trials(manifest, leader, policy, temperature)
@@ -181,6 +187,7 @@ def run(args) -> dict:
     bar.close()
     res["config"] = {"models": str(args.models), "data": str(args.data), "seeds": args.seeds,
                      "seconds": args.seconds, "temperature": temperature,
+                     "follower_temperature": args.follower_temperature, "guard": args.guard,
                      "wall_seconds": time.time() - t_start}
     return res
 
@@ -220,7 +227,7 @@ def main(argv=None) -> int:
     ap.add_argument("--methods", default=None, help="comma-separated subset (ours, ccm, motion_matching, ...)")
     ap.add_argument("--seeds", type=int, default=4, help="steered duets per method")
     ap.add_argument("--seconds", type=float, default=60.0, help="length of each steered duet")
-    ap.add_argument("--temperature", type=float, default=None, help="default: the manifest's")
+    O.add_options(ap)
     ap.add_argument("--out", default="runs/interaction", help="where interaction.json and .md go")
     ap.add_argument("--quiet", action="store_true")
     args = ap.parse_args(argv)

@@ -26,7 +26,7 @@ from tqdm import tqdm
 from ..data.dataset import DataError, TEST_TAKES
 from ..data.folders import add_folder
 from ..mirror.skeleton import FPS
-from . import guard as G
+from . import options as O
 from . import plausibility as P
 from .evaluate_inputs import EvalError, find_models, load_eval_takes, load_onnx
 from .interaction import contact_labels, measure, weighted as interaction_weighted
@@ -59,13 +59,13 @@ def weighted(rows: list[dict], frames: list[int]) -> dict:
 _WORKER: dict = {}
 
 
-def _init(models: str, method: str, data: str, test: list[str], r: dict, guard: int = 0,
-          follower_temperature: float | None = None, guard_margin: float = 0.0):
+def _init(models: str, method: str, data: str, test: list[str], r: dict, options: dict):
     manifest, onnx, leader = find_models(models)
-    follower = (build(load_tracks(training_takes(data, exclude=test)), "follower")
-                if method == "motion_matching" else load_onnx(onnx[method]))
-    follower = G.wrap(follower, r, guard, guard_margin, follower_temperature,
-                      manifest["skeleton"]["offsets"]["follower"])   # an experiment: guard.py
+    if method == "motion_matching":   # no sampling, nothing to guard
+        follower = build(load_tracks(training_takes(data, exclude=test)), "follower")
+    else:
+        follower = O.follower_policy(load_onnx(onnx[method]), manifest, argparse.Namespace(**options),
+                                     options["temperature"])
     _WORKER.update(manifest=manifest, leader=load_onnx(leader), follower=follower, ranges=r)
 
 
@@ -73,7 +73,7 @@ def _one(job: tuple[int, int, float]) -> dict:
     seed, frames, temperature = job
     w = _WORKER
     rec: dict = {}
-    G.restart_count(w["follower"])
+    O.restart_count(w["follower"])
     soak = soak_one(w["manifest"], w["leader"], w["follower"], seed, frames, temperature, rec)
     out = {"seed": seed, "resets": soak["resets"], "guarded": getattr(w["follower"], "guarded", 0)}
     for kind, suffix in (("alone", ""), ("layer", "_shown")):
@@ -86,8 +86,8 @@ def _one(job: tuple[int, int, float]) -> dict:
 def run_method(args, method: str, r: dict, test: list[str], bar) -> dict:
     frames = int(args.seconds * FPS)
     jobs = [(seed, frames, args.temperature) for seed in range(args.first_seed, args.first_seed + args.seeds)]
-    init = (args.models, method, args.data, test, r, args.guard if method != "motion_matching" else 0,
-            args.follower_temperature if method != "motion_matching" else None, args.guard_margin)
+    options = {k: getattr(args, k) for k in ("temperature", "follower_temperature", "guard", "guard_margin")}
+    init = (args.models, method, args.data, test, r, options)
 
     def counted(results):
         for res in results:
@@ -130,10 +130,9 @@ def run(args) -> dict:
         raise EvalError(f"{args.models}/manifest.json has no plausibility range: re-export it "
                         f"(python -m training.learning.export, after training.data.prepare)")
     r = manifest["plausibility"]   # the training dancers' range, as prepare measured it
-    if G.option_error(args):
-        raise EvalError(G.option_error(args))
-    if args.temperature is None:
-        args.temperature = manifest["defaultTemperature"]
+    error = O.resolve(args, manifest)
+    if error:
+        raise EvalError(f"{args.models}/manifest.json: {error}")
     known = [*onnx, "motion_matching"]
     wanted = [m for m in (args.methods or "").split(",") if m]
     unknown = [m for m in wanted if m not in known]
@@ -166,7 +165,7 @@ def fmt(v, digits=2, pct=False) -> str:
 def write_markdown(path: Path, res: dict) -> None:
     ref, cfg = res["recording"], res["config"]
     lines = [f"# Plausibility over {cfg['seeds']} steered seeds × {cfg['seconds']:g} s "
-             f"(temperature {cfg['temperature']}), against the recording of takes {', '.join(res['takes'])}", "",
+             f"(variety: leader {cfg['temperature']:g}, network followers {cfg.get('follower_temperature') or cfg['temperature']:g}), against the recording of takes {', '.join(res['takes'])}", "",
              "Share of frames flagged (ratio to the recording in brackets); worst = the worst seed's share.", ""]
     for who in ("leader", "follower"):
         lines += [f"## {who}", "",
@@ -193,10 +192,9 @@ def write_markdown(path: Path, res: dict) -> None:
             s, q = row[kind], row["ratio"][kind]
             lines.append(f"| {m} {kind} | {s['path_ratio']:.2f} ({fmt(q['path_ratio'])}×) | " +
                          " | ".join(f"{fmt(s[k], 3)} ({fmt(q[k])}×)" for k in INTERACTION) + f" | {row['resets']} |")
-    if cfg.get("guard") or cfg.get("follower_temperature") is not None:
-        lines += ["", f"Experiment (training/evaluation/guard.py): network followers at temperature "
-                      f"{cfg.get('follower_temperature') or cfg['temperature']}, upright guard with "
-                      f"{cfg.get('guard') or 'no'} samples" +
+    if cfg.get("guard"):
+        lines += ["", f"The network followers' upright guard (training/mirror/guard.py): "
+                      f"{cfg.get('guard')} samples" +
                       (f", acting {cfg['guard_margin']:g} m before the range's edge." if cfg.get("guard_margin") else ".")]
         for m, row in res["methods"].items():
             if m != "motion_matching":
@@ -216,10 +214,9 @@ def main(argv=None) -> int:
     ap.add_argument("--seeds", type=int, default=100)
     ap.add_argument("--first-seed", type=int, default=0)
     ap.add_argument("--seconds", type=float, default=60.0)
-    ap.add_argument("--temperature", type=float, default=None, help="default: the manifest's")
     ap.add_argument("--methods", default=None, help="comma-separated subset (ours, ccm, motion_matching; default all)")
     ap.add_argument("--workers", type=int, default=2)
-    G.add_options(ap)   # the network followers only; Motion Matching dances as it is
+    O.add_options(ap)   # the network followers only; Motion Matching dances as it is
     ap.add_argument("--out", default="runs/seeds")
     ap.add_argument("--quiet", action="store_true")
     args = ap.parse_args(argv)

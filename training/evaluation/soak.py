@@ -26,7 +26,7 @@ from tqdm import tqdm
 
 from ..data.folders import add_folder
 from ..mirror.rollout import NOW, OnnxPolicy, start_duet, step
-from . import guard as G
+from . import options as O
 from . import metrics as M
 from . import plausibility as P
 from ..mirror.skeleton import FEET, FPS, PARENTS
@@ -163,10 +163,9 @@ def main(argv=None) -> int:
     ap.add_argument("--follower", default="follower", help="follower model name in the manifest")
     ap.add_argument("--rollouts", type=int, default=100)
     ap.add_argument("--minutes", type=float, default=10.0)
-    ap.add_argument("--temperature", type=float, default=None, help="default: the manifest's")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--out", default=None, help="write the table as JSON here")
-    G.add_options(ap)
+    O.add_options(ap)
     args = ap.parse_args(argv)
     manifest_path = Path(args.models) / "manifest.json"
     if not manifest_path.exists():
@@ -176,27 +175,25 @@ def main(argv=None) -> int:
     if args.follower not in manifest["models"]:
         print(f"error: no model {args.follower!r} in {manifest_path}", file=sys.stderr)
         return 2
-    temperature = manifest["defaultTemperature"] if args.temperature is None else args.temperature
     leader = OnnxPolicy(Path(args.models) / manifest["models"]["leader"]["file"])
     follower = OnnxPolicy(Path(args.models) / manifest["models"][args.follower]["file"])
     frames = int(args.minutes * 60 * FPS)
-    ranges = manifest.get("plausibility")
-    error = G.option_error(args) or (args.guard and not ranges and f"{manifest_path} has no plausibility range for --guard")
+    error = O.resolve(args, manifest)
     if error:
-        print(f"error: {error}", file=sys.stderr)
+        print(f"error: {manifest_path}: {error}", file=sys.stderr)
         return 2
-    follower = G.wrap(follower, ranges, args.guard, args.guard_margin, args.follower_temperature,
-                      manifest["skeleton"]["offsets"]["follower"])
+    temperature = args.temperature
+    ranges = manifest.get("plausibility")
+    follower = O.follower_policy(follower, manifest, args, temperature)
     t0 = time.time()
     results = []
     print(f"{args.rollouts} rollouts x {frames} frames ({args.minutes:g} min at {FPS} Hz), "
-          f"follower {args.follower}, temperature {temperature}" +
-          (f" (follower {args.follower_temperature})" if args.follower_temperature is not None else "") +
-          (f", upright guard K={args.guard} margin {args.guard_margin:g} m (experiment)" if args.guard else ""))
+          f"follower {args.follower}, variety: leader {temperature:g}, follower {args.follower_temperature:g}, " +
+          (f"upright guard of {args.guard} samples, margin {args.guard_margin:g} m" if args.guard else "no upright guard"))
     print(" seed  nonfinite  max dist m  bone err mm  min foot cm  frozen L  frozen F  resets  result")
     for i in tqdm(range(args.rollouts), desc="soak", unit="rollout", leave=False):
         rec = {}
-        G.restart_count(follower)
+        O.restart_count(follower)
         r = soak_one(manifest, leader, follower, args.seed + i, frames, temperature, rec)
         r["guarded"] = getattr(follower, "guarded", 0)
         r["interaction"] = M.interaction(rec["leader"], rec["follower"], rec["leader_contacts"], rec["follower_contacts"])
@@ -233,7 +230,7 @@ def main(argv=None) -> int:
           f"bone error {summary['bone_error_mm']:.4f} mm; lowest foot {summary['min_foot_cm']:.1f} cm; "
           f"most frozen {summary['frozen_max']:.3f}; resets {summary['resets']}; {summary['seconds']:.0f} s")
     if args.guard:
-        print(f"upright guard (experiment): chose another sample in {summary['guarded']} steps "
+        print(f"upright guard: chose another sample in {summary['guarded']} steps "
               f"({summary['guarded'] / (frames * len(results)):.2%} of frames)")
     for key, title in (("interaction", "networks alone"), ("interaction_layer", "with the contact layer")):
         m = summary[key]

@@ -34,11 +34,16 @@ from ..data.prepared import TrainError
 from .runs import fingerprint, load_run
 from .stamp import eval_file, write_stamp
 from ..mirror.skeleton import FPS, JOINT_NAMES, KEY_JOINTS, PARENTS
+from ..mirror.guard import MARGIN as GUARD_MARGIN, SAMPLES as GUARD_SAMPLES
 from .train import SHIPPED
 
 MANIFEST_VERSION = 1
 OPSET = 18
-DEFAULT_TEMPERATURE = 0.5
+# Each dancer's variety (Gumbel temperature). The follower's is the page's slider: the
+# state-dropout follower is as varied as the recording at 1 (FID 116; 259 with wide swings at 0.5),
+# the leader dances steadiest at 0.5 (docs/plausibility.md).
+DEFAULT_TEMPERATURE = 1.0
+LEADER_TEMPERATURE = 0.5
 # int8 weights snapped to every 4th level (coarsen): 1.0 MB less for a first visit to download,
 # and the steered tables and the FID stay those of the 8-bit models (docs/measurements.md).
 WEIGHT_STEP = 4
@@ -145,6 +150,9 @@ def write_manifest(out: Path, models: dict[str, StepModel], data: str, prepared:
         "startPose": {role: start_pose(stats[f"{role}_output_mean"]) for role in ("leader", "follower")},
         "models": {},
         "defaultTemperature": DEFAULT_TEMPERATURE,
+        "leaderTemperature": LEADER_TEMPERATURE,
+        # The follower's upright guard (training/mirror/guard.py, web/mirror/guard.ts).
+        "guard": {"samples": GUARD_SAMPLES, "margin": GUARD_MARGIN},
         # The training dancers' range (evaluation.plausibility): soak counts a collapse against it
         # and training.evaluation.seeds judges every steered frame against it.
         "plausibility": plausibility_ranges(prepared),

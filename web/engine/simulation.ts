@@ -1,12 +1,16 @@
 // The page's Simulation: policies in, DancerViews out. One step runs the duet loop of rollout.ts
 // (the mirror of training/mirror/rollout.py) with the page's policies, then refreshes what the page draws
-// (the contact layer's poses: web/mirror/contact.ts; planned paths, intentions). Also here: sampled ghosts and leader playback
-// from a recording. Nothing in this file changes a number the models see.
+// (the contact layer's poses: web/mirror/contact.ts; planned paths, intentions). Also here: the
+// follower's upright guard (web/mirror/guard.ts: a batch of fresh samples on the rare step whose body
+// would leave the recording's range), sampled ghosts and leader playback from a recording. Nothing
+// else in this file changes a number the models see.
 
 import { FUTURE_OFFSETS, INPUT_SIZE, INTENTION_SIZE, KEYS, OUTPUT_SIZE, followerInput } from '../mirror/features';
 import { KEY_JOINTS, type Motion, POSITIONS_SIZE, ROTATIONS_SIZE } from '../mirror/skeleton';
 import { ContactLayer } from '../mirror/contact';
+import { FOLLOWER_CONTACT } from '../mirror/contact';
 import { FootLock } from '../mirror/footik';
+import { type GuardSettings, type Ranges, mostUpright, uprightMargin } from '../mirror/guard';
 import { LeaderPlayback } from './playback';
 import { StepTimer } from './timing';
 import {
@@ -26,7 +30,7 @@ class View implements DancerView {
   /** Per hand (left, right): how far the contact layer draws it to the partner's, 0..1. */
   readonly hands = new Float32Array(2);
   /** Foot locks of a follower beyond the first (compare mode): the contact layer has the others. */
-  readonly feet = new FootLock();
+  readonly feet = new FootLock(FOLLOWER_CONTACT);
   resets = -1;
 
   constructor(withIntention: boolean) {
@@ -62,7 +66,12 @@ export class DuetSimulation implements Simulation {
   private readonly followerInputs: Float32Array[];
   // Own copies of each model's result: two roles may never share a policy's result arrays.
   private readonly leaderOutput = new Float32Array(OUTPUT_SIZE);
-  private readonly guardCounts = { resets: 0, leashed: 0 };
+  private readonly guardCounts = { resets: 0, leashed: 0, upright: 0 };
+  /** Steps in which the upright guard took another of the follower's samples. */
+  private upright = 0;
+  private readonly uprightGuard: { settings: GuardSettings; ranges: Ranges } | null;
+  /** The leader model's own variety (the manifest's); the slider sets the followers'. */
+  private readonly leaderTemperature: number | null;
   private readonly followerOutputs: Float32Array[];
   private readonly followerIntentions: (Float32Array | null)[];
   private readonly timer = new StepTimer(300);
@@ -79,6 +88,9 @@ export class DuetSimulation implements Simulation {
     this.followerPolicies = followers;
     this.followerInputs = followers.map((p) => p.input);
     this.temperature = manifest.defaultTemperature ?? 0.5;
+    this.leaderTemperature = manifest.leaderTemperature ?? null;
+    const g = manifest.guard;
+    this.uprightGuard = g && g.samples >= 2 && manifest.plausibility ? { settings: g, ranges: manifest.plausibility } : null;
     this.duet = startDuet(manifest, followers.length);
     this.leaderView = new View(false);
     this.followerViews = followers.map((p) => new View(p.hasIntention));
@@ -92,6 +104,7 @@ export class DuetSimulation implements Simulation {
 
   reset(): void {
     this.duet = startDuet(this.options.manifest, this.followerPolicies.length);
+    this.upright = 0;
     this.playback?.start(this.duet.leader.track);
     this.timer.clear();
     this.updateViews(true);
@@ -109,18 +122,40 @@ export class DuetSimulation implements Simulation {
     }
     stepInputs(duet, playing ? null : this.leaderPolicy.input, this.followerInputs);
     if (!playing) {
-      const result = await this.leaderPolicy.run(temperature);
+      const result = await this.leaderPolicy.run(this.leaderTemperature ?? temperature);
       this.leaderOutput.set(result.output);
     }
     for (let i = 0; i < this.followerPolicies.length; i++) {
       const result = await this.followerPolicies[i].run(temperature);
       this.followerOutputs[i].set(result.output);
       if (result.intention) this.followerIntentions[i]?.set(result.intention);
+      await this.keepUpright(i, temperature);
     }
     if (this.playback) this.playback.advance(duet.leader.track, duet.leader.contacts);
     finishStep(duet, playing ? null : this.leaderOutput, this.followerOutputs, this.followerIntentions);
     this.updateViews(false);
     this.timer.add(performance.now() - started);
+  }
+
+  /**
+   * The upright guard (web/mirror/guard.ts) on follower i's output of this step: when the body it
+   * would draw comes within the margin of the recording's range, run the same input with fresh
+   * samples and keep the most upright (each one step on from the same state: no jump).
+   */
+  private async keepUpright(i: number, temperature: number): Promise<void> {
+    const guard = this.uprightGuard;
+    if (!guard) return;
+    const offsets = this.duet.followers[i].offsets;
+    if (uprightMargin(this.followerOutputs[i], 0, guard.ranges, offsets) >= guard.settings.margin) return;
+    const k = guard.settings.samples;
+    const policy = this.followerPolicies[i];
+    const input = policy.batchInput(k);
+    for (let n = 0; n < k; n++) input.set(policy.input, n * INPUT_SIZE);
+    const { output, intention } = await policy.runBatch(k, temperature);
+    const best = mostUpright(output, k, OUTPUT_SIZE, guard.ranges, offsets);
+    this.followerOutputs[i].set(output.subarray(best * OUTPUT_SIZE, (best + 1) * OUTPUT_SIZE));
+    if (intention) this.followerIntentions[i]?.set(intention.subarray(best * INTENTION_SIZE, (best + 1) * INTENTION_SIZE));
+    this.upright++;
   }
 
   /**
@@ -146,8 +181,9 @@ export class DuetSimulation implements Simulation {
   }
 
   /** Called every animation frame by the HUD: sums into one reused object, allocates nothing. */
-  guards(): { resets: number; leashed: number } {
+  guards(): { resets: number; leashed: number; upright: number } {
     const g = this.guardCounts;
+    g.upright = this.upright;
     g.resets = this.duet.leader.resets;
     g.leashed = this.duet.leader.leashed;
     for (const f of this.duet.followers) {

@@ -2,6 +2,7 @@
 // The shell only ever talks to a `Simulation`; what happens inside one step (features, both
 // models, pose) is the simulation's business.
 
+import type { GuardSettings, Ranges } from '../mirror/guard';
 import type { Motion } from '../mirror/skeleton';
 import type { RecordableDuet } from '../ui/record';
 
@@ -48,9 +49,10 @@ export interface Simulation {
   ghosts(k: number): Promise<Float32Array[]>;
   /** Wall time of step() over the last 300 steps, milliseconds. */
   stepMs(): { median: number; p95: number };
-  /** Guard counts since the start: dancers reset after absurd model output, and frames the
-   *  leash drew a follower toward the leader (see rollout.ts). */
-  guards(): { resets: number; leashed: number };
+  /** Guard counts since the start: dancers reset after absurd model output, frames the leash
+   *  drew a follower toward the leader (see rollout.ts), and steps the upright guard took another
+   *  of a follower's samples (web/mirror/guard.ts). */
+  guards(): { resets: number; leashed: number; upright: number };
   /**
    * Drive the leader from a recorded motion (30 fps) instead of the leader model, or go back to
    * the model with null. Throws, changing nothing, on a motion it cannot play.
@@ -127,7 +129,14 @@ export interface Manifest {
   /** Opaque to the shell; read by rollout.ts (startDuet). */
   startPose: unknown;
   models: Record<string, ModelEntry>;
+  /** The followers' variety (Gumbel temperature): the slider's default. */
   defaultTemperature: number;
+  /** The leader model's own variety; absent in older exports (then the slider's, as the followers). */
+  leaderTemperature?: number;
+  /** The followers' upright guard (web/mirror/guard.ts); absent: no guard. */
+  guard?: GuardSettings;
+  /** The recording's range (training/evaluation/plausibility.py); the guard judges against it. */
+  plausibility?: Ranges;
   credit: string;
 }
 

@@ -11,8 +11,9 @@ export interface HudStats {
   fps: number;
   threads: number;
   modelBytes: number;
-  /** Guard counts (resets after absurd output, leashed frames); shown only once one acted. */
-  guards: { resets: number; leashed: number };
+  /** Guard counts (resets after absurd output, leashed frames, steps the upright guard chose
+   *  another sample); shown only once one acted. */
+  guards: { resets: number; leashed: number; upright: number };
 }
 
 /** Legend entries per follower choice: [colour class, words]. */
@@ -69,8 +70,9 @@ export class Hud {
     this.details.textContent =
       `step ${median.toFixed(1)} ms (p95 ${p95.toFixed(1)})  ·  ${Math.round(stats.fps)} fps  ·  ` +
       `${stats.threads} WASM thread${stats.threads === 1 ? '' : 's'}  ·  models ${formatBytes(stats.modelBytes)}` +
-      (stats.guards.resets || stats.guards.leashed
-        ? `  ·  guards: ${stats.guards.resets} reset${stats.guards.resets === 1 ? '' : 's'}, ${stats.guards.leashed} leashed frames`
+      (stats.guards.resets || stats.guards.leashed || stats.guards.upright
+        ? `  ·  guards: ${stats.guards.resets} reset${stats.guards.resets === 1 ? '' : 's'}, ${stats.guards.leashed} leashed frames, ` +
+          `${stats.guards.upright} upright choice${stats.guards.upright === 1 ? '' : 's'}`
         : '');
   }
 }

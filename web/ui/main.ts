@@ -36,7 +36,7 @@ import { bootMark, bootSpan, bootTimings } from '../engine/boot';
 bootMark('main');
 
 const DT = 1 / FPS;
-const NO_GUARDS = { resets: 0, leashed: 0 };
+const NO_GUARDS = { resets: 0, leashed: 0, upright: 0 };
 /** A long stall counts as at most this much time, so the dance never jumps ahead. */
 const MAX_FRAME_SECONDS = 0.5;
 /** Simulation time the loop may fall behind before it gives up on catching up (slow motion). */

@@ -1,0 +1,56 @@
+"""evaluation/options.py: the evaluation commands dance as the page does unless told otherwise."""
+import argparse
+
+import numpy as np
+import pytest
+
+from training.evaluation import options as O
+from training.mirror.guard import UprightGuard, Variety
+
+RANGES = {"hip_low": 0.7, "head_above_hip_low": 0.6, "feet_wide": 1.0, "angle_high": [3.0, 0.6]}
+OFFSETS = np.zeros((17, 3)).tolist()
+
+
+def parse(*argv):
+    ap = argparse.ArgumentParser()
+    O.add_options(ap)
+    return ap.parse_args(list(argv))
+
+
+def manifest(**extra):
+    return {"defaultTemperature": 1.0, "plausibility": RANGES,
+            "skeleton": {"offsets": {"follower": OFFSETS}}, **extra}
+
+
+def policy(x, temperature, rng):
+    return {"output": np.zeros((len(np.atleast_2d(x)), 323))}
+
+
+def test_defaults_come_from_the_manifest():
+    m = manifest(leaderTemperature=0.5, guard={"samples": 8, "margin": 0.05})
+    args = parse()
+    assert O.resolve(args, m) is None
+    assert (args.temperature, args.follower_temperature, args.guard, args.guard_margin) == (0.5, 1.0, 8, 0.05)
+    f = O.follower_policy(policy, m, args, args.temperature)
+    assert isinstance(f, UprightGuard) and f.samples == 8 and f.temperature == 1.0 and f.margin == 0.05
+
+
+def test_options_override_the_manifest_and_an_old_manifest_has_no_guard():
+    m = manifest(leaderTemperature=0.5, guard={"samples": 8, "margin": 0.05})
+    args = parse("--guard", "0", "--follower-temperature", "0.7")
+    assert O.resolve(args, m) is None
+    f = O.follower_policy(policy, m, args, args.temperature)
+    assert isinstance(f, Variety) and f.temperature == 0.7
+    old = parse()
+    assert O.resolve(old, manifest()) is None   # no leaderTemperature, no guard: both at the default
+    assert (old.temperature, old.follower_temperature, old.guard) == (1.0, 1.0, 0)
+    assert O.follower_policy(policy, manifest(), old, old.temperature) is policy
+
+
+@pytest.mark.parametrize("argv,m,words", [
+    (("--guard", "1"), manifest(), "at least 2 samples"),
+    (("--temperature", "-1"), manifest(), "negative"),
+    (("--guard", "8"), {"defaultTemperature": 1.0}, "plausibility range"),
+])
+def test_bad_options_are_refused_in_plain_words(argv, m, words):
+    assert words in O.resolve(parse(*argv), m)

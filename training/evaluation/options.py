@@ -1,0 +1,66 @@
+"""How the evaluation commands run the two dancers: by default as the page does, from the manifest.
+
+The manifest says each dancer's variety (temperature: `leaderTemperature` for the leader model,
+`defaultTemperature` for the follower, the page's "variety" slider) and the follower's upright guard
+("guard": samples and margin, training/mirror/guard.py). soak, seeds, interaction and
+scripts/worst_seed.py take these options, fill what is not given from the manifest (`resolve`) and
+wrap their follower with `follower_policy`. A manifest without those fields (older exports) runs
+both dancers at `defaultTemperature` with no guard, as the page then does.
+
+    python -m training.evaluation.seeds --guard 0                       # the follower without its guard
+    python -m training.evaluation.soak --temperature 0.5 --follower-temperature 1 --guard 8 --guard-margin 0.05
+"""
+from __future__ import annotations
+
+import argparse
+
+from ..mirror.guard import UprightGuard, Variety
+
+
+def add_options(ap: argparse.ArgumentParser) -> None:
+    ap.add_argument("--temperature", type=float, default=None,
+                    help="the leader's variety (default: the manifest's leaderTemperature, else defaultTemperature)")
+    ap.add_argument("--follower-temperature", type=float, default=None,
+                    help="the follower's variety (default: the manifest's defaultTemperature, the page's slider)")
+    ap.add_argument("--guard", type=int, default=None, metavar="K",
+                    help="the follower's upright guard with K samples (training/mirror/guard.py; 0: off; "
+                         "default: the manifest's)")
+    ap.add_argument("--guard-margin", type=float, default=None, metavar="M",
+                    help="the guard acts once the drawn pose is within M metres of the range's edge "
+                         "(default: the manifest's)")
+
+
+def resolve(args, manifest: dict) -> str | None:
+    """Fill the options not given from the manifest; what is wrong with them, in one line (None: nothing)."""
+    guard = manifest.get("guard") or {}
+    if args.temperature is None:
+        args.temperature = manifest.get("leaderTemperature", manifest["defaultTemperature"])
+    if args.follower_temperature is None:
+        args.follower_temperature = manifest["defaultTemperature"]
+    if args.guard is None:
+        args.guard = int(guard.get("samples", 0))
+    if args.guard_margin is None:
+        args.guard_margin = float(guard.get("margin", 0.0))
+    if args.guard < 0 or args.guard == 1:
+        return f"--guard {args.guard}: 0 (off) or at least 2 samples to choose from"
+    if min(args.temperature, args.follower_temperature) < 0:
+        return "a temperature (variety) cannot be negative"
+    if args.guard and not manifest.get("plausibility"):
+        return "the upright guard needs the manifest's plausibility range: re-export the models"
+    return None
+
+
+def follower_policy(policy, manifest: dict, args, leader_temperature: float):
+    """The follower's policy as the (resolved) options ask: guarded (judging the body the follower's
+    bones draw), at its own variety, or as it is."""
+    temperature = None if args.follower_temperature == leader_temperature else args.follower_temperature
+    if args.guard:
+        return UprightGuard(policy, manifest["plausibility"], args.guard, temperature, args.guard_margin,
+                            manifest["skeleton"]["offsets"]["follower"])
+    return policy if temperature is None else Variety(policy, temperature)
+
+
+def restart_count(policy) -> None:
+    """Zero the guard's count before a duet (a plain policy has none)."""
+    if hasattr(policy, "guarded"):
+        policy.guarded = 0

@@ -1,0 +1,84 @@
+// Mirror of training/mirror/guard.py: the follower's upright guard.
+//
+// When the body a follower's step would draw (the decoded hip and joint rotations through its
+// bones, lifted as applyOutput lifts it) comes within the manifest's margin of the recording's
+// range (hips low, head low over the hips, feet too wide, the torso leaning further than the
+// recording's steepest), the page runs the same input again with fresh Gumbel draws and takes the
+// most upright sample (simulation.ts). Every candidate is one step on from the same state, so the
+// body never jumps; the guard only chooses among the network's own reactions. Measured in Python:
+// it chooses in about 1 step in 10 000 (docs/plausibility.md).
+
+import { N_JOINTS, OUTPUT_LAYOUT, blockSlices } from './features';
+import { MIN_ANKLE_HEIGHT, rotationsFromVectors } from './rollout';
+import { FEET, HEAD, forwardKinematicsReduced } from './skeleton';
+
+/** The chest joint, whose offset over the hips is the torso's lean (evaluation/plausibility.py CHEST). */
+export const CHEST = 2;
+
+/** The recording's range as the manifest carries it ("plausibility", evaluation/plausibility.py). */
+export interface Ranges {
+  hip_low: number;
+  head_above_hip_low: number;
+  feet_wide: number;
+  /** Highest bend of each measured angle; the last is the torso's lean. */
+  angle_high: number[];
+}
+
+/** The manifest's "guard": fresh samples to choose among, and metres before the range's edge it acts. */
+export interface GuardSettings {
+  samples: number;
+  margin: number;
+}
+
+const POSE = blockSlices(OUTPUT_LAYOUT).pose;
+const forward = new Float64Array(3 * N_JOINTS);
+const up = new Float64Array(3 * N_JOINTS);
+const rotations = new Float64Array(9 * N_JOINTS);
+const joints = new Float64Array(3 * N_JOINTS);
+
+/**
+ * Metres by which the body that output[at..] (raw, 323) draws stays inside the recording's range on
+ * hips, head over hips, feet apart and the torso's lean (negative: that far outside). The pose is
+ * in the next root's space, whose y is the height above the floor; the lean is how far the chest
+ * may still move sideways over the hips before the torso leans more than the recording's steepest.
+ */
+export function uprightMargin(output: ArrayLike<number>, at: number, r: Ranges, offsets: ArrayLike<number>): number {
+  const pose = at + POSE.start;
+  for (let j = 0; j < N_JOINTS; j++) {
+    for (let k = 0; k < 3; k++) {
+      forward[3 * j + k] = output[pose + 12 * j + 6 + k];
+      up[3 * j + k] = output[pose + 12 * j + 9 + k];
+    }
+  }
+  rotationsFromVectors(forward, up, N_JOINTS, rotations, 0);
+  forwardKinematicsReduced(offsets, output, pose, rotations, 0, joints, 0);
+  // applyOutput's lift: a body whose ankles would go below the floor is raised whole.
+  const lift = Math.max(MIN_ANKLE_HEIGHT - Math.min(joints[3 * FEET[0] + 1], joints[3 * FEET[1] + 1]), 0);
+  const hip = joints[1] + lift;
+  const head = joints[3 * HEAD + 1] + lift;
+  const feet = Math.hypot(
+    joints[3 * FEET[0]] - joints[3 * FEET[1]],
+    joints[3 * FEET[0] + 1] - joints[3 * FEET[1] + 1],
+    joints[3 * FEET[0] + 2] - joints[3 * FEET[1] + 2],
+  );
+  const tx = joints[3 * CHEST] - joints[0];
+  const ty = joints[3 * CHEST + 1] - joints[1];
+  const tz = joints[3 * CHEST + 2] - joints[2];
+  const sideways = Math.hypot(tx, tz);
+  const allowed = Math.hypot(tx, ty, tz) * Math.sin(r.angle_high[r.angle_high.length - 1]);
+  return Math.min(hip - r.hip_low, head - hip - r.head_above_hip_low, r.feet_wide - feet, allowed - sideways);
+}
+
+/** The index of the most upright of `count` outputs laid one after another from output[0..]. */
+export function mostUpright(output: ArrayLike<number>, count: number, size: number, r: Ranges, offsets: ArrayLike<number>): number {
+  let best = 0;
+  let bestMargin = -Infinity;
+  for (let i = 0; i < count; i++) {
+    const m = uprightMargin(output, i * size, r, offsets);
+    if (m > bestMargin) {
+      best = i;
+      bestMargin = m;
+    }
+  }
+  return best;
+}
