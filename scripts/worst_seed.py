@@ -9,7 +9,8 @@ The variety and guard options are training.evaluation.options' (default: the man
 page dances); with --seconds 600 a seed is the soak's rollout of that seed.
 
 --flag angles_out (default): joint angles out of the recorded range; body: hips low, head low or
-feet wide (plausibility.BODY_FLAGS, what a bad second counts).
+feet wide (plausibility.BODY_FLAGS, what a bad second counts); guarded: the steps in which the
+upright guard took another sample (what it caught, to look at).
 """
 import argparse
 
@@ -29,7 +30,7 @@ ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDe
 ap.add_argument("seed", type=int)
 ap.add_argument("out")
 ap.add_argument("--models", default="public/models")
-ap.add_argument("--flag", choices=["angles_out", "body"], default="angles_out")
+ap.add_argument("--flag", choices=["angles_out", "body", "guarded"], default="angles_out")
 ap.add_argument("--seconds", type=float, default=60.0)
 O.add_options(ap)
 args = ap.parse_args()
@@ -40,11 +41,25 @@ error = O.resolve(args, manifest)
 if error:
     ap.error(error)
 follower = O.follower_policy(load_onnx(onnx["ours"]), manifest, args, args.temperature)
-soak_one(manifest, load_onnx(leader), follower, args.seed, int(args.seconds * FPS), args.temperature, rec)
+chosen = []   # the frames in which the guard took another sample
+
+
+def noted(x, temperature, rng):
+    before = getattr(follower, "guarded", 0)
+    out = follower(x, temperature, rng)
+    if getattr(follower, "guarded", 0) > before:
+        chosen.append(noted.frame)
+    noted.frame += 1
+    return out
+
+
+noted.frame = 0
+soak_one(manifest, load_onnx(leader), noted, args.seed, int(args.seconds * FPS), args.temperature, rec)
 L, F = rec["leader_shown"], rec["follower_shown"]
 flags = P.frame_flags(F, manifest["plausibility"])
+flags["guarded"] = np.isin(np.arange(len(F)), chosen)
 bad = (P.body_flagged(flags) if args.flag == "body" else flags[args.flag]).astype(float)
-label = "body low, folded or split" if args.flag == "body" else "angle out"
+label = {"body": "body low, folded or split", "guarded": "guard chose"}.get(args.flag, "angle out")
 start = int(np.argmax(np.convolve(bad, np.ones(6 * FPS), "valid")))   # the 6 s with most flagged frames
 fig, axes = plt.subplots(2, 6, figsize=(18, 6.5))
 for k, ax in enumerate(axes.flat):
@@ -55,7 +70,8 @@ for k, ax in enumerate(axes.flat):
             if p >= 0:
                 ax.plot([pos[j, 0] - c[0], pos[p, 0] - c[0]], [pos[j, 1], pos[p, 1]], color=col, lw=2)
     ax.set_xlim(-1.2, 1.2); ax.set_ylim(0, 1.9); ax.set_aspect("equal"); ax.set_xticks([]); ax.set_yticks([])
-    ax.set_title(f"t={t / FPS:.1f} s{'  ' + label if bad[t] else ''}", fontsize=9)
+    # Flagged within the half second this frame stands for (a guard's choice is a single step).
+    ax.set_title(f"t={t / FPS:.1f} s{'  ' + label if bad[t:t + FPS // 2].any() else ''}", fontsize=9)
 fig.suptitle(f"{args.models}, steered seed {args.seed}" + (f" (guard K={args.guard}, {args.guard_margin:g} m)" if args.guard else "") + ": the 6 s with most follower frames flagged "
              f"({label}), side view (x, height), a frame every 0.5 s")
 fig.tight_layout()
