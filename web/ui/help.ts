@@ -21,8 +21,10 @@ const METHOD = [
 const RESEARCH =
   'Research names: "reads your intention" is this project\'s follower (ours), which predicts the leader\'s ' +
   'future key joints and conditions its pose on them; "baseline, no intention" is CCM, the same network ' +
-  'without that step; "variety" is the sampling temperature; "possible reactions" are ghost samples ' +
-  '(the follower run again with fresh noise).';
+  'without that step; "variety" is the partner\'s sampling temperature (the leader model keeps 0.5); ' +
+  '"possible reactions" are ghost samples (the follower run again with fresh noise); an "upright choice" ' +
+  'is a step in which the partner\'s sampled pose would have left the recorded dancers\' range (hips low, ' +
+  'torso tipping) and the page took the most upright of 8 fresh samples instead.';
 
 function element<K extends keyof HTMLElementTagNameMap>(tag: K, className = '', text = ''): HTMLElementTagNameMap[K] {
   const e = document.createElement(tag);
