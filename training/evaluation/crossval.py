@@ -9,7 +9,7 @@ the first take of the next group validates (per-epoch numbers only) and the rest
 method is trained in every fold with every seed, by the same recipe as the shipped model but
 with --epochs / --intention-epochs (shorter, to fit this CPU), exported to int8 ONNX like the
 page's models and measured by training.evaluation.evaluate on the fold's test takes: teacher-forced MPJPE
-and codebook error, free-running FID (temperature 0.5, evaluation seeds 0-2; the evaluation
+and codebook error, free-running FID (temperature 0.5 or --temperature, evaluation seeds 0-2; the evaluation
 encoder is trained on the fold's training takes). Each take is tested exactly once and never
 trained on in its fold.
 
@@ -131,7 +131,8 @@ def train_job(recipe: str, run: str, tempo: bool, prepared: str, runs: str, seed
     return run
 
 
-def evaluate_job(data: str, where: str, fold: dict, runs: list[str], eval_seeds: str, smoke: bool = False) -> str:
+def evaluate_job(data: str, where: str, fold: dict, runs: list[str], eval_seeds: str, smoke: bool = False,
+                 temperature: float = 0.5) -> str:
     """Export each run of one fold and seed (WHERE/models_RUN) and evaluate it on the fold's test
     takes (WHERE/eval_RUN/metrics.json); what exists is kept. Methods are evaluated one by one:
     a method's numbers do not depend on the others (same seeds, same reference)."""
@@ -151,7 +152,7 @@ def evaluate_job(data: str, where: str, fold: dict, runs: list[str], eval_seeds:
         code = _quietly(where / "evaluate.log", evaluate.main, [
             "--data", data, "--takes", ",".join(fold["test"]), "--models", str(models),
             "--train-takes", ",".join(fold["train"]), "--conditions", "", "--seeds", eval_seeds,
-            "--temperatures", "0.5", "--encoder-cache", str(where.parent / "eval_encoder"),
+            "--temperatures", f"{temperature:g}", "--encoder-cache", str(where.parent / "eval_encoder"),
             "--out", str(where / f"eval_{run}"), "--quiet", "--methods", NAMES.get(run, run)]
             + (["--encoder-epochs", "2"] if smoke else []))
         if code:
@@ -177,7 +178,7 @@ def run_crossval(args) -> dict:
     if args.smoke:
         args.epochs, args.intention_epochs = 2, 1
     plan = {"folds": folds, "methods": methods, "seeds": seeds, "epochs": args.epochs,
-            "intention_epochs": args.intention_epochs, "smoke": args.smoke,
+            "intention_epochs": args.intention_epochs, "smoke": args.smoke, "temperature": args.temperature,
             "tempos": TEMPOS if any(METHODS[m][2] for m in methods) else []}
     t0 = time.time()
     if not args.report_only:
@@ -209,7 +210,7 @@ def run_crossval(args) -> dict:
                 fdir = out / f"fold{f['fold']}"
                 evals += [pool.apply_async(evaluate_job, (args.data, str(fdir / f"seed{s}"), f,
                                                           [METHODS[m][0] for m in methods],
-                                                          args.eval_seeds, args.smoke)) for s in seeds]
+                                                          args.eval_seeds, args.smoke, args.temperature)) for s in seeds]
             for e in evals:
                 e.get()
                 bar.update(1)
@@ -259,7 +260,8 @@ def markdown(res: dict) -> str:
     plan = res["plan"]
     digits = {"mpjpe_cm": 2, "fid": 1, "codebook_error": 4, "implausible": 3, "worst_second": 2}
     lines = [f"Folds {len(res['complete_folds'])} of {len(plan['folds'])} complete, seeds "
-             f"{','.join(map(str, plan['seeds']))}, {plan['intention_epochs']} + {plan['epochs']} epochs"
+             f"{','.join(map(str, plan['seeds']))}, {plan['intention_epochs']} + {plan['epochs']} epochs, "
+             f"free runs at variety {plan.get('temperature', 0.5):g}"
              + (f", tempo copies {plan['tempos']}" if plan["tempos"] else "") + ".", "",
              "| fold | test takes | " + " | ".join(f"{m} {METRICS[k]}" for k in METRICS for m in plan["methods"]) + " |",
              "|---|---|" + "---|" * (len(METRICS) * len(plan["methods"]))]
@@ -302,6 +304,8 @@ def main(argv=None) -> int:
     ap.add_argument("--epochs", type=int, default=20, help="matching epochs (shipped recipe: 40)")
     ap.add_argument("--intention-epochs", type=int, default=10, help="(shipped recipe: 20)")
     ap.add_argument("--eval-seeds", default="0,1,2", help="free-running seeds per evaluation")
+    ap.add_argument("--temperature", type=float, default=0.5,
+                    help="the followers' variety in the free runs (the page runs the shipped followers at 1)")
     ap.add_argument("--jobs", type=int, default=2, help="processes side by side, one thread each")
     ap.add_argument("--report-only", action="store_true", help="only rebuild the table from OUT")
     ap.add_argument("--report", default="crossval", help="name of the report files in OUT")

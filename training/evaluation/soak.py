@@ -12,6 +12,10 @@ split), both against the range the manifest carries (evaluation.plausibility); i
 rollout breaks a limit. The summary gives every plausibility share with its worst rollout, and how
 the duet reads as a couple (metrics.interaction), for the networks alone and with the run-time
 contact layer (training/mirror/contact.py).
+
+The dancers run as the page runs them, from the manifest: each at its own variety, the follower
+with its upright guard (training/mirror/guard.py), whose chosen steps are counted and reported
+(training/evaluation/options.py for the options that change this).
 """
 from __future__ import annotations
 
