@@ -153,6 +153,7 @@ class Page {
     this.leader.capture(this.still.leader, true);
     this.followers[0].capture(this.still.followers[0], true);
     this.snapCamera();
+    bootMark('ui:start'); // HUD, controls, panel, recorder: the loading scene waits for these too
     this.hud = new Hud(document.getElementById('overlay')!);
     this.hud.setStatus('loading models…');
     const credit = document.getElementById('credit');
@@ -183,6 +184,7 @@ class Page {
       onOpenLeaderFile: () => this.leaderFileInput.open(),
       onLeaderModel: () => this.leaderBackToModel(),
     });
+    bootMark('ui:end');
   }
 
   private createPanel(): Panel {
