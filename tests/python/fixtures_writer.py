@@ -453,7 +453,7 @@ def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_o
     ranges = {"hip_low": 0.95, "head_above_hip_low": 0.5, "feet_wide": 1.07, "angle_high": [2.5, 0.59]}  # this body's
     uprightness = {"outputs": exact(outputs), "ranges": ranges,
                    "margins": out7(G.upright_margin(outputs, ranges, follow_offsets)),
-                   "best": int(np.argmax(G.upright_margin(outputs, ranges, follow_offsets)))}
+                   "best": G.most_upright(outputs, ranges, follow_offsets)}
     return {
         "NOW": ro.NOW, "TRACK_FRAMES": ro.TRACK_FRAMES, "guards": guards, "upright": uprightness,
         "rotationsFromVectors": {"forward": exact(vectors_f), "up": exact(vectors_u),

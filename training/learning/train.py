@@ -153,10 +153,11 @@ MODELS = {
     # size of that gap keeps the encoders from trusting its training-set accuracy, which buys
     # FID and Diversity on the test takes (docs/results.md, w/o intention noise).
     # The decoder kept reading its code: the state hidden from it in half the samples
-    # (TrainConfig.state_dropout). As varied as the recording against the recorded leader (FID 116
-    # at variety 1, against 271 without), and the page's upright guard (training/mirror/guard.py)
-    # catches its rare falls: 0 of 100 steered seeds with a bad second, none in the soak
-    # (docs/plausibility.md). CCM by the same recipe, so the comparison stays fair.
+    # (TrainConfig.state_dropout). As varied as the recording against the recorded leader (the
+    # shipped 64-level file: FID 111.9 at variety 1, seeds 108.5-115.9), and the page's upright
+    # guard (training/mirror/guard.py) catches its rare falls: 0 of 100 steered seeds with a bad
+    # second, no fall in the 100 x 10 min soak (docs/plausibility.md). CCM by the same recipe, so
+    # the comparison stays fair.
     "follower": replace(steady(OURS), state_dropout=0.5),
     "follower_ccm": replace(steady(CCM), state_dropout=0.5),
     # The leader's partner is the follower: it gets the same terms (its own weights, above).

@@ -62,6 +62,11 @@ def upright_margin(outputs: np.ndarray, r: dict, offsets: np.ndarray | None = No
                               allowed - sideways])
 
 
+def most_upright(outputs: np.ndarray, r: dict, offsets: np.ndarray | None = None) -> int:
+    """The index of the most upright of the outputs [B, 323]."""
+    return int(np.argmax(upright_margin(outputs, r, offsets)))
+
+
 class UprightGuard:
     """Wraps a policy (x, temperature, rng) -> {output, intention, ...}; `guarded` counts the steps
     in which it picked another sample (reset it per duet). `temperature` overrides the one the
@@ -82,7 +87,7 @@ class UprightGuard:
             return out
         self.guarded += 1
         many = self.policy(np.repeat(np.atleast_2d(x), self.samples, 0), t, rng)
-        best = int(np.argmax(upright_margin(many["output"], self.ranges, self.offsets)))
+        best = most_upright(many["output"], self.ranges, self.offsets)
         return {k: v[best:best + 1] for k, v in many.items()}
 
 
