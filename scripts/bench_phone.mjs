@@ -3,8 +3,10 @@
 // throttling web performance audits use for phones: 4× slower CPU (Emulation.setCPUThrottlingRate),
 // 9 Mbit/s down and 40 ms round trips (Network.emulateNetworkConditions), a 412 × 823 touch screen.
 //
-// Prints, for a cold first visit: first paint, the drawn loading scene (floor + standing pair +
-// loading bar: window.duet.sceneMs), the first dancing frame (window.duet.firstFrameMs); the same
+// Prints, for a cold first visit: first paint, the loading scene on screen (floor + standing pair
+// + loading bar: window.duet.sceneMs), the first dancing frame on screen (window.duet.firstFrameMs),
+// both once the rendering update that paints them has run, not when their draw calls were issued
+// (the software GPU of a headless browser spends 0.3-0.6 s on a first frame after that); the same
 // for a repeat visit with the service worker warm; the model step median at 4× CPU; and frames per
 // second drawing both dancers as skinned bodies and as ?bodies=sticks (skipped when the page has
 // no window.duet.bodies). Then, for each visit, where the time went: the page's boot stages
@@ -216,12 +218,17 @@ function printResult(result, { json, breakdown }) {
   console.log('\nphone profile: CPU 4× slower, 9 Mbit/s down, 40 ms RTT, 412×823 @1.75, scripts/serve.mjs (br/gzip, COOP/COEP)');
   console.log(`first visit (${(cold.transferredBytes / 1e6).toFixed(2)} MB over the wire, ${cold.threads} threads)`);
   console.log(`  first paint              ${s(cold.firstPaintMs)}  (first contentful ${s(cold.firstContentfulPaintMs)})`);
-  console.log(`  loading scene drawn      ${s(cold.sceneMs)}  target ≤ ${s(TARGETS.sceneMs)}  ${mark(cold.sceneMs, TARGETS.sceneMs)}`);
-  console.log(`  first dancing frame      ${s(cold.firstFrameMs)}  target ≤ ${s(TARGETS.firstFrameMs)}  ${mark(cold.firstFrameMs, TARGETS.firstFrameMs)}`);
+  // On screen: once the rendering update that paints the frame has run (web/engine/boot.ts,
+  // afterPaint). Drawn: when the page issued the frame's draw calls (the software GPU still
+  // compiles and rasterizes it after that); step: the first dancing pose computed.
+  const drawn = (visit) => `(drawn ${s(visit.boot.scene)})`;
+  const danced = (visit) => `(step ${s(visit.boot['first-step'])}, drawn ${s(visit.boot['first-drawn'])})`;
+  console.log(`  loading scene on screen  ${s(cold.sceneMs)}  target ≤ ${s(TARGETS.sceneMs)}  ${mark(cold.sceneMs, TARGETS.sceneMs)}  ${drawn(cold)}`);
+  console.log(`  first dancing frame      ${s(cold.firstFrameMs)}  target ≤ ${s(TARGETS.firstFrameMs)}  ${mark(cold.firstFrameMs, TARGETS.firstFrameMs)}  ${danced(cold)}`);
   console.log(`repeat visit (service worker ${repeat.controlled ? 'in control' : 'NOT in control'}, ${result.cached} files cached, ${(repeat.transferredBytes / 1e6).toFixed(2)} MB over the wire)`);
   console.log(`  first paint              ${s(repeat.firstPaintMs)}`);
-  console.log(`  loading scene drawn      ${s(repeat.sceneMs)}`);
-  console.log(`  first dancing frame      ${s(repeat.firstFrameMs)}  target ≤ ${s(TARGETS.repeatMs)}  ${mark(repeat.firstFrameMs, TARGETS.repeatMs)}`);
+  console.log(`  loading scene on screen  ${s(repeat.sceneMs)}  ${drawn(repeat)}`);
+  console.log(`  first dancing frame      ${s(repeat.firstFrameMs)}  target ≤ ${s(TARGETS.repeatMs)}  ${mark(repeat.firstFrameMs, TARGETS.repeatMs)}  ${danced(repeat)}`);
   if (!result.stepMs) {
     printBreakdowns(result, breakdown);
     return result;

@@ -313,13 +313,28 @@ export class Stage {
   }
 
   /**
-   * Compile the shaders of everything the scene can show, hidden things included (the paths,
-   * intentions, ghosts, contact marks and the compare pair are hidden while the models load), so
-   * that the first dancing frame does not stall on shader compilation. With
-   * KHR_parallel_shader_compile the compiling happens off this thread.
+   * Draw everything the scene can show once, hidden things included (the paths, intentions,
+   * ghosts, contact marks, the skeleton and the compare pair are hidden while the models load),
+   * then the scene as it is. Why a real draw and not only compiling the shaders: GPU drivers
+   * finish a pipeline only when it first draws (the phone bench's software GPU compiles each
+   * one then), and the first dancing frame waited 0.4-0.5 s for that. Done while the models
+   * download, this costs nothing anyone waits for; the second draw leaves the picture unchanged.
    */
-  precompile(): Promise<void> {
-    return this.renderer.compileAsync(this.scene, this.camera).then(() => undefined);
+  warmUp(): void {
+    const restore: (() => void)[] = [];
+    this.scene.traverse((object) => {
+      if (!object.visible) {
+        object.visible = true;
+        restore.push(() => (object.visible = false));
+      }
+      if (object instanceof THREE.InstancedMesh && object.count === 0) {
+        object.count = 1;
+        restore.push(() => (object.count = 0));
+      }
+    });
+    this.renderer.render(this.scene, this.camera);
+    for (const undo of restore) undo();
+    this.renderer.render(this.scene, this.camera);
   }
 
   render(): void {

@@ -164,9 +164,10 @@ export interface DuetHook {
   threads: number;
   /** Bytes of the ONNX files loaded so far. */
   modelBytes: number;
-  /** performance.now() when the first step finished (cold load to a reacting page). */
+  /** performance.now() once the first dancing frame (the first step's pose) is painted: the
+   *  rendering update that shows it has run (boot.ts, afterPaint). Cold load to a dancing page. */
   firstFrameMs: number | null;
-  /** performance.now() when the floor and the standing pair were first drawn (loading scene). */
+  /** performance.now() once the floor and the standing pair are first painted (loading scene). */
   sceneMs?: number | null;
   /** Bytes of the first dance's downloads (wasm + models), so far and in all. */
   download?: { loaded: number; total: number };
