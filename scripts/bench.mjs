@@ -1,7 +1,7 @@
 // Browser benchmark of the shipped page: builds dist/, serves it with `vite preview` (COOP/COEP
 // on, so two WASM threads are possible) and loads it cold in headless Chromium, once per thread
 // count. Prints, per run: simulation step time (median/p95 over the last 300 steps: features +
-// both models + pose), cold load to the first simulated frame, and the page weight (raw and
+// both models + pose), cold load to the first dancing frame on screen, and the page weight (raw and
 // gzip) of everything the page downloaded to get there.
 //
 //   npm run bench                 # threads 1 and 2
@@ -108,7 +108,7 @@ if (json) {
   for (const r of results) {
     console.log(`\nthreads ${r.threads} (asked ${r.requestedThreads}, cross-origin isolated: ${r.crossOriginIsolated})`);
     console.log(`  step            median ${r.stepMs.median.toFixed(2)} ms   p95 ${r.stepMs.p95.toFixed(2)} ms`);
-    console.log(`  cold load       ${(r.coldLoadMs / 1000).toFixed(2)} s to the first simulated frame`);
+    console.log(`  cold load       ${(r.coldLoadMs / 1000).toFixed(2)} s to the first dancing frame on screen`);
     console.log(`  models          ${mb(r.modelBytes)}`);
     console.log(`  page weight     ${mb(r.pageBytes)} raw, ${mb(r.pageGzipBytes)} gzip (${mb(r.transferredBytes)} sent by vite preview)`);
     console.log(`  display         ${r.fps.toFixed(1)} fps (software WebGL in headless Chromium)`);

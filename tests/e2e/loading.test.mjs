@@ -73,6 +73,13 @@ test('before the models arrive: floor, standing pair and a loading bar; then it 
     release();
     await waitReady(page, 60_000);
     assert.equal(await page.locator('#loading').isVisible(), false, 'loading bar gone once dancing');
+    // The bench's times are for frames on screen: each comes after its frame was drawn, and the
+    // first dancing frame is drawn right after the first step (web/ui/main.ts, web/engine/boot.ts).
+    await page.waitForFunction(() => window.duet?.firstFrameMs, null, { timeout: 30_000, polling: 50 });
+    const { sceneMs, firstFrameMs, bootTimings: t } = await duet(page);
+    assert.ok(sceneMs >= t.scene && t['scene-painted'] === sceneMs, `loading scene on screen ${sceneMs} after its draw ${t.scene}`);
+    assert.ok(t['first-drawn'] >= t['first-step'] && firstFrameMs >= t['first-drawn'], `first step ${t['first-step']}, drawn ${t['first-drawn']}, on screen ${firstFrameMs}`);
+    assert.ok(firstFrameMs > sceneMs, 'dancing after the loading scene');
     assert.deepEqual(browser.consoleErrors, []);
   } finally {
     release();
