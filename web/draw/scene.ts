@@ -317,7 +317,7 @@ export class Stage {
    * ghosts, contact marks, the skeleton and the compare pair are hidden while the models load),
    * then the scene as it is. Why a real draw and not only compiling the shaders: GPU drivers
    * finish a pipeline only when it first draws (the phone bench's software GPU compiles each
-   * one then), and the first dancing frame waited 0.4-0.5 s for that. Done while the models
+   * one then), and the first dancing frame waited about 0.2 s longer for that. Done while the models
    * download, this costs nothing anyone waits for; the second draw leaves the picture unchanged.
    */
   warmUp(): void {

@@ -38,19 +38,24 @@ export function bootSpan<T>(stage: string, start: () => Promise<T>): Promise<T> 
   return task;
 }
 
+/** Chromium's prioritized task scheduler (window.scheduler), where the browser has it. */
+interface Scheduler {
+  postTask(task: () => void, options: { priority: 'user-blocking' }): Promise<void>;
+}
+
 /**
  * Call `painted` with the time at which a frame drawn now is on screen, as far as this thread
  * can tell: after the rendering update that paints it (style, layout and paint of the page's
  * DOM, the canvas composited) has run. Drawn outside an animation-frame callback, that update is
  * the next one; drawn inside one, it is the current one, which runs once the callbacks and the
- * microtasks they queued are done. A timeout task queued from there runs after it.
+ * microtasks they queued are done. A task queued from there runs after it.
  */
 export function afterPaint(painted: (at: number) => void, insideFrame: boolean): void {
   // A task of the highest priority where the browser has them (Chromium's scheduler.postTask):
   // a plain timeout would run after timeouts queued before it, such as the page's steps.
   const now = () => painted(performance.now());
-  const post = (globalThis as { scheduler?: { postTask?: (task: () => void, options: { priority: string }) => unknown } }).scheduler?.postTask;
-  const later = () => (post ? post.call((globalThis as { scheduler?: unknown }).scheduler, now, { priority: 'user-blocking' }) : setTimeout(now, 0));
+  const scheduler = (globalThis as { scheduler?: Scheduler }).scheduler;
+  const later = () => (scheduler ? scheduler.postTask(now, { priority: 'user-blocking' }) : setTimeout(now, 0));
   if (insideFrame) later();
   else requestAnimationFrame(later);
 }

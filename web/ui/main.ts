@@ -388,8 +388,8 @@ class Page {
       this.stepping = true;
       // The steps run in a task of their own, after this frame is on screen. Started from here
       // they would be microtasks of this callback (onnxruntime's run resolves at once), and the
-      // browser paints the frame drawn below only after them: on the phone bench the first
-      // dancing frame waited 0.4-0.6 s for its paint.
+      // browser would paint the frame drawn below only after them: a frame's worth of steps
+      // (at least MIN_STEP_BUDGET_MS) later than it could.
       setTimeout(() =>
         this.exclusive(() => this.advance())
           .catch(this.fail)
