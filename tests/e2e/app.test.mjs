@@ -260,25 +260,26 @@ describe('phone', () => {
     await page.locator('.help-overlay').waitFor({ state: 'hidden', timeout: 5000 });
   });
 
+  const boxes = async () =>
+    page.evaluate(() => {
+      const box = (selector) => {
+        const r = document.querySelector(selector).getBoundingClientRect();
+        return { x: r.left, y: r.top, w: r.width, h: r.height };
+      };
+      const canvas = box('canvas.stage');
+      // The middle 40 % of the canvas, where the camera keeps the dancers.
+      const centre = { x: canvas.x + 0.3 * canvas.w, y: canvas.y + 0.3 * canvas.h, w: 0.4 * canvas.w, h: 0.4 * canvas.h };
+      return { title: box('.title-row'), hud: box('.hud'), panel: box('.duet-panel'), centre, hudLines: Math.round(box('.hud').h / 16) };
+    });
+  const overlap = (a, b) => a.x < b.x + b.w && b.x < a.x + a.w && a.y < b.y + b.h && b.y < a.y + a.h;
+  const check = (b, state) => {
+    for (const [n1, n2] of [['title', 'hud'], ['title', 'panel'], ['hud', 'panel'], ['title', 'centre'], ['hud', 'centre'], ['panel', 'centre']]) {
+      assert.ok(!overlap(b[n1], b[n2]), `${state}: ${n1} ${JSON.stringify(b[n1])} overlaps ${n2} ${JSON.stringify(b[n2])}`);
+    }
+    assert.equal(b.hudLines, 1, `${state}: the legend is one line`);
+  };
+
   test('phone layout: title, legend and panel clear of each other and of the dancers (docs/screenshot-phone-panel.png)', async () => {
-    const boxes = async () =>
-      page.evaluate(() => {
-        const box = (selector) => {
-          const r = document.querySelector(selector).getBoundingClientRect();
-          return { x: r.left, y: r.top, w: r.width, h: r.height };
-        };
-        const canvas = box('canvas.stage');
-        // The middle 40 % of the canvas, where the camera keeps the dancers.
-        const centre = { x: canvas.x + 0.3 * canvas.w, y: canvas.y + 0.3 * canvas.h, w: 0.4 * canvas.w, h: 0.4 * canvas.h };
-        return { title: box('.title-row'), hud: box('.hud'), panel: box('.duet-panel'), centre, hudLines: Math.round(box('.hud').h / 16) };
-      });
-    const overlap = (a, b) => a.x < b.x + b.w && b.x < a.x + a.w && a.y < b.y + b.h && b.y < a.y + a.h;
-    const check = (b, state) => {
-      for (const [n1, n2] of [['title', 'hud'], ['title', 'panel'], ['hud', 'panel'], ['title', 'centre'], ['hud', 'centre'], ['panel', 'centre']]) {
-        assert.ok(!overlap(b[n1], b[n2]), `${state}: ${n1} ${JSON.stringify(b[n1])} overlaps ${n2} ${JSON.stringify(b[n2])}`);
-      }
-      assert.equal(b.hudLines, 1, `${state}: the legend is one line`);
-    };
     check(await boxes(), 'panel folded');
     await page.locator('.duet-panel > .lil-title').click();
     await sleep(500); // lil-gui's open animation
@@ -287,6 +288,26 @@ describe('phone', () => {
     writeFileSync(join(ROOT, 'docs', 'screenshot-phone-panel.png'), await page.screenshot());
     await page.locator('.duet-panel > .lil-title').click();
     await sleep(500);
+  });
+
+  test('phone layout at 360-430 px, portrait and landscape: nothing overlaps, panel folded or open', async () => {
+    const sizes = [[360, 740], [430, 932], [740, 360], [844, 390], [932, 430]];
+    try {
+      for (const [width, height] of sizes) {
+        await page.setViewportSize({ width, height });
+        await sleep(400); // resize observers, the camera's aspect
+        const folded = await page.evaluate(() => document.querySelector('.duet-panel').classList.contains('lil-closed'));
+        check(await boxes(), `${width}x${height}, panel ${folded ? 'folded' : 'open'}`);
+        await page.locator('.duet-panel > .lil-title').click();
+        await sleep(500); // lil-gui's open and close animation
+        check(await boxes(), `${width}x${height}, panel ${folded ? 'open' : 'folded'}`);
+        await page.locator('.duet-panel > .lil-title').click();
+        await sleep(500);
+      }
+    } finally {
+      await page.setViewportSize({ width: 390, height: 844 });
+      await sleep(400);
+    }
   });
 
   test('phone screenshot is not blank', async () => {
