@@ -169,11 +169,10 @@ MODELS = {
     # Only the noise on the own state, the decoder reading the code alone.
     "follower_state_noise": replace(OURS, state_noise=STATE_NOISE),
     "follower_ccm_state_noise": replace(CCM, state_noise=STATE_NOISE),
-    # Dials on the steady follower's lost variety (docs/plausibility.md, "Why the follower is less
-    # varied"): the decoder kept from ignoring the code (TrainConfig.state_dropout) brings the FID
-    # back at variety 1 (116) but the steered follower falls in 3-11 % of seeds; half the
-    # state noise hardly moves it (206 against 219). Measured, not shipped.
-    # The followers shipped before the state dropout: steady, but less varied (FID 219 at 0.5).
+    # The followers shipped before the state dropout: steady, but less varied (FID 219 at 0.5,
+    # docs/plausibility.md, "Why the follower is less varied"). Without the upright guard, the
+    # state-dropout follower falls in 3-11 % of steered seeds; half the state noise hardly moves
+    # the FID (206 against 219). Measured, not shipped.
     "follower_steady": steady(OURS),
     "follower_ccm_steady": steady(CCM),
     "follower_state_dropout_20": replace(steady(OURS), state_dropout=0.2),

@@ -39,7 +39,7 @@ MIN_ELBOW_BEND = 0.6   # radians: the recorded elbows bend at least 0.6-0.7 in 9
 # The follower's feet lock from a lower contact than the leader's (footik.CONTACT_THRESHOLD): its
 # skate while low fell from 2.08x the recording's to 1.31x (4 steered seeds x 60 s), its legs staying
 # in the recorded range. The leader's feet locked from 0.3 bent its knees and hips out of the range
-# in 12-25 % of its frames (against 4-6 % at 0.5; the recording 7.1 %), so the leader keeps 0.5.
+# in 12-13 % of its frames (against 4-6 % at 0.5; the recording 7.1 %), so the leader keeps 0.5.
 FOLLOWER_CONTACT = 0.3
 
 

@@ -1,9 +1,10 @@
 """Foot locking for what is shown (web/mirror/footik.ts mirrors it name for name).
 
 While the model says a foot is planted (its contact above the lock's threshold), the foot stays
-where the contact began, with a two-bone IK on thigh - shin - foot, and never below the floor. This touches only the SHOWN
-positions (contact.py's layer); the Track the features read stays what the model produced, so
-the page's features remain identical to Python's and the networks' own metrics stay measurable.
+where the contact began, with a two-bone IK on thigh - shin - foot, and never below the floor.
+This touches only the SHOWN positions (contact.py's layer); the Track the features read stays what
+the model produced, so the page's features remain identical to Python's and the networks' own
+metrics stay measurable.
 """
 from __future__ import annotations
 
@@ -17,12 +18,12 @@ ANKLE_FLOOR = 0.06
 # A lock never trails the model's foot by more than this: when the model slides a planted foot on
 # (a step it took without lifting it), the lock slides along behind it. Re-planting it at the
 # model's foot instead was a jump of a quarter metre that counted as skate: the follower's skate in
-# contact was 1.16x the recording's with the slide against 2.11x with the jump (4 steered seeds x 60 s,
-# docs/plausibility.md). Holding to half a
-# metre hid most of that skate but stretched the legs out of the recorded range: steered duets of
-# the decoder-reads-pose models, 10 x 30 s, follower with the layer, knee/hip angles out of range
-# and foot skate in contact (ratios to the recording): 0.5 m 4.7x / 1.85x, 0.25 m 1.3x / 2.5x,
-# 0.15 m 0.8x / 3.1x (docs/plausibility.md). A quarter metre keeps the legs plausible.
+# contact was 1.16x the recording's with the slide against 2.11x with the jump (4 steered seeds x
+# 60 s, docs/plausibility.md). Holding to half a metre hid most of that skate but stretched the
+# legs out of the recorded range: steered duets of the decoder-reads-pose models, 10 x 30 s,
+# follower with the layer, knee/hip angles out of range and foot skate in contact (ratios to the
+# recording): 0.5 m 4.7x / 1.85x, 0.25 m 1.3x / 2.5x, 0.15 m 0.8x / 3.1x (docs/plausibility.md).
+# A quarter metre keeps the legs plausible.
 MAX_LOCK_DISTANCE = 0.25
 # A knee never straightens further than this (radians between thigh and shin) to reach a lock:
 # the recorded dancers' knees bend at least 0.19-0.30 rad in 99.5 % of frames, and a leg pulled

@@ -7,8 +7,7 @@
 
 import { FUTURE_OFFSETS, INPUT_SIZE, INTENTION_SIZE, KEYS, OUTPUT_SIZE, followerInput } from '../mirror/features';
 import { KEY_JOINTS, type Motion, POSITIONS_SIZE, ROTATIONS_SIZE } from '../mirror/skeleton';
-import { ContactLayer } from '../mirror/contact';
-import { FOLLOWER_CONTACT } from '../mirror/contact';
+import { ContactLayer, FOLLOWER_CONTACT } from '../mirror/contact';
 import { FootLock } from '../mirror/footik';
 import { type GuardSettings, type Ranges, mostUpright, uprightMargin } from '../mirror/guard';
 import { LeaderPlayback } from './playback';

@@ -1,5 +1,6 @@
-// Mirror of training/mirror/footik.py. Foot locking for drawing: while the model says a foot is planted
-// (its contact above the lock's threshold), keep it where the contact began, with a two-bone IK on thigh - shin - foot, and never below the floor.
+// Mirror of training/mirror/footik.py. Foot locking for drawing: while the model says a foot is
+// planted (its contact above the lock's threshold), keep it where the contact began, with a
+// two-bone IK on thigh - shin - foot, and never below the floor.
 //
 // This touches only the DRAWN positions (DancerView.positions). The Track the features read stays
 // exactly what the model produced, so the page's features remain identical to Python's.
