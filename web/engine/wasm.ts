@@ -5,10 +5,15 @@
 // after its last byte), and counts its bytes for the progress bar. ort.ts hands the compiled
 // module to onnxruntime.
 //
-// `onnxruntime-web/wasm` ships only the SIMD + threads build, and it is the smallest of the four
-// (14.2 MB; the JSPI one is 16.8 MB, asyncify 26.8 MB, JSEP 28.3 MB): the one to keep.
+// `onnxruntime-web/wasm` ships only the SIMD + threads build (11.2 MB; the JSEP one is 21.7 MB).
+// onnxruntime-web is held at 1.22: its wasm is 1.80 MB brotli against 2.30 MB for 1.30's (14.2 MB),
+// which on the phone profile's 9 Mbit/s link brought the first dancing frame about 0.9 s sooner
+// at the same step time (docs/measurements.md, "onnxruntime-web 1.22"). Its JavaScript loads the
+// Emscripten loader (GLUE_URL) as a file of its own; 1.30's carries it inside. Both files are
+// imported by path (vite.config.ts: onnxruntime-web-dist): the package's export map lists neither.
 
-import wasmUrl from 'onnxruntime-web/ort-wasm-simd-threaded.wasm?url';
+import wasmUrl from 'onnxruntime-web-dist/ort-wasm-simd-threaded.wasm?url';
+import glueUrl from 'onnxruntime-web-dist/ort-wasm-simd-threaded.mjs?url';
 import { type DownloadProgress, VERSION_HEADER, countBody, readBody } from './download';
 import { DuetError } from '../ui/errors';
 import type { DownloadSlots } from './slots';
@@ -18,6 +23,9 @@ declare const __ORT_WASM_BYTES__: number | undefined;
 export const WASM_BYTES = typeof __ORT_WASM_BYTES__ === 'number' ? __ORT_WASM_BYTES__ : 0;
 /** Where the build put the wasm (its name carries a content hash). */
 export const WASM_URL: string = wasmUrl;
+/** Where the build put onnxruntime's Emscripten loader (ort.ts hands it to onnxruntime; its worker
+ *  threads start from it too). */
+export const GLUE_URL: string = glueUrl;
 
 /** The wasm on its way: `received` once its last byte is in, `module` once it is compiled. */
 export interface WasmDownload {
