@@ -1,9 +1,13 @@
 """Fixtures that pin web/mirror/*.ts to the Python reference: `.venv/bin/python tests/python/fixtures_writer.py`.
 
-Writes tests/fixtures/{bvh,features,rollout}.json: inputs, and what training/mirror/bvh.py,
-skeleton.py, features.py and rollout.py compute from them. tests/web/*.test.ts run the TypeScript
-mirror on the same inputs and compare every number (1e-5, relative for large values);
+Writes tests/fixtures/{bvh,features,rollout,contact}.json: inputs, and what training/mirror/bvh.py,
+skeleton.py, features.py, rollout.py and contact.py compute from them. tests/web/*.test.ts run the
+TypeScript mirror on the same inputs and compare every number (1e-5, relative for large values);
 tests/python/test_fixtures.py checks that the files still match this code.
+
+And tests/fixtures/runtime.json: inputs for each shipped model (public/models) and what Python's
+onnxruntime computes from them, which tests/e2e/runtime.test.mjs asks of the page's onnxruntime-web
+(another version, compiled to WebAssembly). Re-export the models, then rerun this script.
 
 All motion here is procedural (sinusoidal joint rotations, seeded random rotations, two dancers
 circling each other) and every BVH is generated text: no recorded motion is ever written out.
@@ -502,6 +506,41 @@ def contact_fixture(rng: np.random.Generator, leader: Motion, follower: Motion) 
             "hands": [int(v) for v in np.ravel(hands)], "pushed": out7(pushed)}
 
 
+# ---------------------------------------------------------------- the models' runtime
+
+MODELS = REPO / "public" / "models"
+RUNTIME_BATCH = 2      # samples per model: every output channel and code of two steps
+
+
+def runtime_fixture(rng) -> dict:
+    """Per shipped model: a batch of inputs near the model's own input statistics (features of
+    no recording: its normalization mean plus 0.7 of a standard deviation of seeded noise, so
+    every layer works in its usual range), Gumbel noise and a temperature, and the outputs that
+    onnxruntime computes from them, with the manifest's fingerprint of the files they came from."""
+    import onnx
+    import onnxruntime as ort
+    from onnx import numpy_helper
+
+    manifest = json.loads((MODELS / "manifest.json").read_text())
+    out = {"temperature": 1.0, "models": {}}
+    for name, entry in sorted(manifest["models"].items()):
+        path = MODELS / entry["file"]
+        inits = {i.name: numpy_helper.to_array(i) for i in onnx.load(str(path)).graph.initializer}
+        mean, std = inits["input_mean"].astype(np.float64), inits["input_std"].astype(np.float64)
+        x = np.round(mean + 0.7 * std * rng.standard_normal((RUNTIME_BATCH, mean.size)), 5).astype(np.float32)
+        width = entry["channels"] * entry["classes"]
+        noise = np.round(rng.uniform(0.001, 0.999, (RUNTIME_BATCH, width)), 6).astype(np.float32)
+        session = ort.InferenceSession(str(path), providers=["CPUExecutionProvider"])
+        names = [o.name for o in session.get_outputs()]
+        results = session.run(None, {"input": x, "temperature": np.array([out["temperature"]], np.float32), "noise": noise})
+        out["models"][name] = {
+            "fingerprint": entry["fingerprint"], "batch": RUNTIME_BATCH,
+            "input": exact(x), "noise": exact(noise),
+            "outputs": {n: ([int(v) for v in np.ravel(r)] if n == "code" else out7(r)) for n, r in zip(names, results)},
+        }
+    return out
+
+
 def build() -> dict[str, dict]:
     rng = np.random.default_rng(SEED)
     bvh = bvh_fixture(rng)
@@ -512,6 +551,7 @@ def build() -> dict[str, dict]:
         "features": features_fixture(rng, lead, follow),
         "rollout": rollout_fixture(rng, lead, follow, leader.offsets, follower.offsets),
         "contact": contact_fixture(np.random.default_rng(SEED + 1), leader, follower),
+        "runtime": runtime_fixture(np.random.default_rng(SEED + 2)),
     }
 
 

@@ -34,7 +34,7 @@ def same(a, b, path="") -> None:
         assert a == b, f"{path}: {a!r} != {b!r}"
 
 
-@pytest.mark.parametrize("name", ["bvh", "features", "rollout"])
+@pytest.mark.parametrize("name", ["bvh", "features", "rollout", "runtime"])
 def test_fixture_file_matches_python(built, name):
     path = fixtures.OUT_DIR / f"{name}.json"
     assert path.exists(), f"{path} missing: run .venv/bin/python tests/python/fixtures_writer.py"

@@ -112,16 +112,16 @@ function copyOut(tensor: Tensor | undefined, into: Float32Array): void {
   tensor.dispose();
 }
 
+/** How every model's session is made (tests/e2e/runtime.test.mjs makes its sessions the same way). */
+export const SESSION_OPTIONS = { executionProviders: ['wasm'], graphOptimizationLevel: 'all' as const };
+
 /** Create the session for one model from its bytes (see fetchModelBytes in manifest.ts). */
 export async function createPolicy(manifest: Manifest, name: string, bytes: Uint8Array, seed: number): Promise<Policy> {
   const entry = manifest.models[name];
   if (!entry) throw new DuetError('Model not found', `"${name}" is not in manifest.json`);
   let session: Session;
   try {
-    session = await ort.InferenceSession.create(bytes, {
-      executionProviders: ['wasm'],
-      graphOptimizationLevel: 'all',
-    });
+    session = await ort.InferenceSession.create(bytes, SESSION_OPTIONS);
   } catch (error) {
     // onnxruntime's own message can be empty ("ERROR_MESSAGE: "): say what it means in any case.
     const detail = String((error as Error)?.message ?? error).trim();
