@@ -1,10 +1,12 @@
 // onnxruntime-web, loaded on its own.
 //
-// Why a dynamic import in a separate module: the WASM build starts its worker threads from the
-// script it lives in (import.meta.url). If ORT were bundled into the app's entry chunk, every
-// worker would re-run the whole app after `vite build`, and session creation hangs with
-// numThreads > 1. A dynamic import gives ORT a chunk of its own. `onnxruntime-web/wasm` is the
-// CPU-only build (11.2 MB of wasm, 1.80 MB brotli) instead of the 21.7 MB JSEP one.
+// Why a dynamic import in a separate module: the loading scene does not need onnxruntime's
+// JavaScript, so it comes in a chunk of its own while the floor is drawn. Its WASM threads start
+// from the script the Emscripten loader lives in (import.meta.url): in 1.22 that is the loader's
+// own file (wasm.ts, GLUE_URL). When the loader sat inside the app's entry chunk (1.30 bundled
+// into it), every worker re-ran the whole app after `vite build` and session creation hung with
+// numThreads > 1. `onnxruntime-web/wasm` is the CPU-only build (11.2 MB of wasm, 1.80 MB brotli)
+// instead of the 21.7 MB JSEP one.
 
 import { bootMark } from './boot';
 import { GLUE_URL } from './wasm';
