@@ -32,7 +32,7 @@ from ..data.folders import add_folder
 from .models import OutputEncoderStep, StepModel
 from ..data.prepared import TrainError
 from .runs import fingerprint, load_run
-from .stamp import eval_file, write_stamp
+from .stamp import PAGE_MODELS, eval_file, write_stamp
 from ..mirror.skeleton import FPS, JOINT_NAMES, KEY_JOINTS, PARENTS
 from ..mirror.guard import MARGIN as GUARD_MARGIN, SAMPLES as GUARD_SAMPLES
 from .train import SHIPPED
@@ -221,6 +221,9 @@ def main(argv=None) -> int:
         return 2
     total = sum(v["bytes"] for v in m["models"].values())
     print(f"wrote {args.models}/manifest.json; models total {total / 1e6:.2f} MB")
+    if Path(args.models).resolve() == PAGE_MODELS.resolve():
+        # tests/fixtures/runtime.json pins the page's models (tests/e2e/runtime.test.mjs).
+        print("the page's models changed: rewrite the test fixtures with .venv/bin/python tests/python/fixtures_writer.py")
     return 0
 
 
