@@ -9,7 +9,7 @@
 // instead of the 21.7 MB JSEP one.
 
 import { bootMark } from './boot';
-import { GLUE_URL } from './wasm';
+import { GLUE_URL, WASM_URL } from './wasm';
 
 bootMark('ort:import');
 export const ort = await import('onnxruntime-web/wasm');
@@ -57,8 +57,9 @@ export function configureThreads(requested: number | null, module?: WebAssembly.
   // The page fetched and compiled the wasm itself (wasm.ts), with a progress bar.
   if (module) useCompiledModule(module);
   // onnxruntime 1.22 imports its Emscripten loader from a file of its own, by default from beside
-  // its own chunk under the package's file name; the build hashed that name (wasm.ts).
-  ort.env.wasm.wasmPaths = { mjs: new URL(GLUE_URL, location.href).href };
+  // its own chunk under the package's file name; the build hashed that name (wasm.ts). The wasm's
+  // address too, for a page that did not hand over a compiled module.
+  ort.env.wasm.wasmPaths = { mjs: new URL(GLUE_URL, location.href).href, wasm: new URL(WASM_URL, location.href).href };
   const most = globalThis.crossOriginIsolated ? 2 : 1;
   const threads = requested === null ? most : Math.max(1, Math.min(most, Math.round(requested)));
   ort.env.wasm.numThreads = threads;
