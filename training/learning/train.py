@@ -26,7 +26,8 @@ import torch.nn.functional as F
 from tqdm import tqdm
 
 from ..mirror import features as feat
-from .distributed import average_gradients, broadcast_parameters, pick_device, setup_distributed, stop_distributed
+from .distributed import (average_gradients, broadcast_parameters, pick_device, setup_distributed, stop_distributed,
+                          wait_for_all)
 from ..data.folders import add_folder
 from ..evaluation.loss_plot import plot_history
 from .models import CodebookMatching, Discriminator, IntentionPredictor, ModelConfig, code_logits, sample_codes
@@ -600,6 +601,7 @@ def main(argv=None) -> int:
             if rank == 0:
                 mse = "" if r["val_mse"] is None else f", val mse {r['val_mse']:.4f}"
                 print(f"{name}: done in {r['seconds']:.0f} s{mse}")
+        wait_for_all(world)   # not on an error: the other process may never arrive
     except TrainError as e:
         print(f"error: {e}", file=sys.stderr)
         return 2
