@@ -35,6 +35,7 @@ from training.mirror.contact import ContactLayer  # noqa: E402
 from training.mirror.bvh import BvhError, forward_kinematics, local_transforms, parse_bvh  # noqa: E402
 from training.mirror.features import Track  # noqa: E402
 from training.data.synthetic import OFFSETS, procedural_dancer  # noqa: E402
+from training.learning.stamp import PAGE_MODELS  # noqa: E402
 from training.mirror.skeleton import (FPS, JOINT_NAMES, MIRROR, PARENTS, Motion, facing_direction,  # noqa: E402
                                forward_kinematics_reduced, gaussian_smooth, mirror_motion, reduce_bvh,
                                resample, root_from_motion)
@@ -508,7 +509,6 @@ def contact_fixture(rng: np.random.Generator, leader: Motion, follower: Motion) 
 
 # ---------------------------------------------------------------- the models' runtime
 
-MODELS = REPO / "public" / "models"
 RUNTIME_BATCH = 2      # samples per model: every output channel and code of two steps
 
 
@@ -521,10 +521,10 @@ def runtime_fixture(rng) -> dict:
     import onnxruntime as ort
     from onnx import numpy_helper
 
-    manifest = json.loads((MODELS / "manifest.json").read_text())
+    manifest = json.loads((PAGE_MODELS / "manifest.json").read_text())
     out = {"temperature": 1.0, "models": {}}
     for name, entry in sorted(manifest["models"].items()):
-        path = MODELS / entry["file"]
+        path = PAGE_MODELS / entry["file"]
         inits = {i.name: numpy_helper.to_array(i) for i in onnx.load(str(path)).graph.initializer}
         mean, std = inits["input_mean"].astype(np.float64), inits["input_std"].astype(np.float64)
         x = np.round(mean + 0.7 * std * rng.standard_normal((RUNTIME_BATCH, mean.size)), 5).astype(np.float32)

@@ -6,7 +6,7 @@
 // own file (wasm.ts, GLUE_URL). When the loader sat inside the app's entry chunk (1.30 bundled
 // into it), every worker re-ran the whole app after `vite build` and session creation hung with
 // numThreads > 1. `onnxruntime-web/wasm` is the CPU-only build (11.2 MB of wasm, 1.80 MB brotli)
-// instead of the 21.7 MB JSEP one.
+// instead of the 21.9 MB JSEP one.
 
 import { bootMark } from './boot';
 import { GLUE_URL, WASM_URL } from './wasm';

@@ -5,10 +5,10 @@
 // after its last byte), and counts its bytes for the progress bar. ort.ts hands the compiled
 // module to onnxruntime.
 //
-// `onnxruntime-web/wasm` ships only the SIMD + threads build (11.2 MB; the JSEP one is 21.7 MB).
+// `onnxruntime-web/wasm` ships only the SIMD + threads build (11.2 MB; the JSEP one is 21.9 MB).
 // onnxruntime-web is held at 1.22: its wasm is 1.80 MB brotli against 2.30 MB for 1.30's (14.2 MB),
-// which on the phone profile's 9 Mbit/s link brought the first dancing frame about 0.9 s sooner
-// at the same step time (docs/measurements.md, "onnxruntime-web 1.22"). Its JavaScript loads the
+// which on the phone profile's 9 Mbit/s link brought the first dancing frame 0.6-1.4 s sooner in
+// six alternating pairs, at the same step time (docs/measurements.md, "onnxruntime-web 1.22"). Its JavaScript loads the
 // Emscripten loader (GLUE_URL) as a file of its own; 1.30's carries it inside. Both files are
 // imported by path (vite.config.ts: onnxruntime-web-dist): the package's export map lists neither.
 

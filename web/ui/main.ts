@@ -373,6 +373,13 @@ class Page {
     });
   }
 
+  /** The steps real time asks for, as a task of their own (frame() queues it, one at a time). */
+  private readonly runSteps = (): void => {
+    this.exclusive(() => this.advance())
+      .catch(this.fail)
+      .finally(() => (this.stepping = false));
+  };
+
   private readonly frame = (now: number): void => {
     requestAnimationFrame(this.frame);
     const elapsed = Math.min(Math.max(0, now - this.last) / 1000, MAX_FRAME_SECONDS);
@@ -390,10 +397,7 @@ class Page {
       // they would be microtasks of this callback (onnxruntime's run resolves at once), and the
       // browser would paint the frame drawn below only after them: a frame's worth of steps
       // (at least MIN_STEP_BUDGET_MS) later than it could.
-      setTimeout(() =>
-        this.exclusive(() => this.advance())
-          .catch(this.fail)
-          .finally(() => (this.stepping = false)), 0);
+      setTimeout(this.runSteps, 0);
     }
 
     // While the models load (or after an error) nothing moves but the camera: redraw only when
