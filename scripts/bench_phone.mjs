@@ -4,7 +4,8 @@
 // 9 Mbit/s down and 40 ms round trips (Network.emulateNetworkConditions), a 412 × 823 touch screen.
 //
 // Prints, for a cold first visit: first paint, the loading scene on screen (floor + standing pair
-// + loading bar: window.duet.sceneMs), the first dancing frame on screen (window.duet.firstFrameMs),
+// + loading bar: first as index.html's picture of it, element timing "poster", then live,
+// window.duet.sceneMs), the first dancing frame on screen (window.duet.firstFrameMs),
 // both once the rendering update that paints them has run, not when their draw calls were issued
 // (the software GPU of a headless browser spends 0.3-0.6 s on a first frame after that); the same
 // for a repeat visit with the service worker warm; the model step median at 4× CPU; and frames per
@@ -43,7 +44,16 @@ async function throttle(page) {
 async function visit(page, url, timeoutMs = 90_000) {
   await page.goto(url, { waitUntil: 'commit' });
   await page.waitForFunction(() => window.duet && (window.duet.firstFrameMs || window.duet.error), null, { timeout: timeoutMs, polling: 50 });
-  return page.evaluate(() => {
+  return page.evaluate(async () => {
+    // index.html's picture of the loading scene (elementtiming="poster"): when it was painted.
+    const posterMs = await new Promise((resolve) => {
+      const observer = new PerformanceObserver((list) => {
+        const entry = list.getEntries().find((e) => e.identifier === 'poster');
+        if (entry) resolve(entry.renderTime || entry.loadTime);
+      });
+      observer.observe({ type: 'element', buffered: true });
+      setTimeout(() => resolve(null), 200); // never painted: the live scene came first
+    });
     const paint = Object.fromEntries(performance.getEntriesByType('paint').map((e) => [e.name, e.startTime]));
     // The runtime worker's downloads (wasm, models) are in its own resource timing, not the page's.
     const workerFiles = window.duet.workerFiles ?? [];
@@ -54,6 +64,7 @@ async function visit(page, url, timeoutMs = 90_000) {
       error: window.duet.error,
       firstPaintMs: paint['first-paint'] ?? null,
       firstContentfulPaintMs: paint['first-contentful-paint'] ?? null,
+      posterMs,
       sceneMs: window.duet.sceneMs ?? null,
       firstFrameMs: window.duet.firstFrameMs,
       download: window.duet.download ?? null,
@@ -221,13 +232,16 @@ function printResult(result, { json, breakdown }) {
   // On screen: once the rendering update that paints the frame has run (web/engine/boot.ts,
   // afterPaint). Drawn: when the page issued the frame's draw calls (the software GPU still
   // compiles and rasterizes it after that); step: the first dancing pose computed.
-  const drawn = (visit) => `(drawn ${s(visit.boot.scene)})`;
+  // The loading scene is on screen first as index.html's picture of it (scripts/poster.mjs), then
+  // live: a visitor sees whichever came first; both are printed.
+  const shown = (visit) => [visit.posterMs, visit.sceneMs].filter((ms) => ms !== null && ms !== undefined).sort((a, b) => a - b)[0] ?? null;
+  const drawn = (visit) => `(picture ${s(visit.posterMs)}, live scene ${s(visit.sceneMs)}, drawn ${s(visit.boot.scene)})`;
   const danced = (visit) => `(step ${s(visit.boot['first-step'])}, drawn ${s(visit.boot['first-drawn'])})`;
-  console.log(`  loading scene on screen  ${s(cold.sceneMs)}  target ≤ ${s(TARGETS.sceneMs)}  ${mark(cold.sceneMs, TARGETS.sceneMs)}  ${drawn(cold)}`);
+  console.log(`  loading scene on screen  ${s(shown(cold))}  target ≤ ${s(TARGETS.sceneMs)}  ${mark(shown(cold), TARGETS.sceneMs)}  ${drawn(cold)}`);
   console.log(`  first dancing frame      ${s(cold.firstFrameMs)}  target ≤ ${s(TARGETS.firstFrameMs)}  ${mark(cold.firstFrameMs, TARGETS.firstFrameMs)}  ${danced(cold)}`);
   console.log(`repeat visit (service worker ${repeat.controlled ? 'in control' : 'NOT in control'}, ${result.cached} files cached, ${(repeat.transferredBytes / 1e6).toFixed(2)} MB over the wire)`);
   console.log(`  first paint              ${s(repeat.firstPaintMs)}`);
-  console.log(`  loading scene on screen  ${s(repeat.sceneMs)}  ${drawn(repeat)}`);
+  console.log(`  loading scene on screen  ${s(shown(repeat))}  ${drawn(repeat)}`);
   console.log(`  first dancing frame      ${s(repeat.firstFrameMs)}  target ≤ ${s(TARGETS.repeatMs)}  ${mark(repeat.firstFrameMs, TARGETS.repeatMs)}  ${danced(repeat)}`);
   if (!result.stepMs) {
     printBreakdowns(result, breakdown);

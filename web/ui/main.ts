@@ -357,6 +357,10 @@ class Page {
     afterPaint((at) => {
       hook.sceneMs = at;
       bootMark('scene-painted', at);
+      // index.html's picture of this scene covered the canvas until now: the live one is on
+      // screen under it, so taking it away changes nothing a visitor sees (same pixels, or the
+      // view of a shared link's camera).
+      document.getElementById('poster')?.remove();
     }, false);
     // While the models are still coming (a moment after the loading scene is on screen): when
     // they are in already (a repeat visit), starting them and the first step come first.
