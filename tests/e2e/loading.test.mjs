@@ -115,3 +115,33 @@ test('the picture comparison sees a picture out of place', async () => {
   const { difference } = await posterAndScene(`${server.url}?seed=1`, SCREENS[0][1], shifted);
   assert.ok(difference.mean > 10 && difference.off > 0.05, JSON.stringify(difference));
 });
+
+test('while loading on a phone, the loading bar is clear of the title, the credit, the settings bar and the dancers', async () => {
+  const phone = await launch({ viewport: { width: 390, height: 844 }, ...PHONE });
+  try {
+    const { page } = phone;
+    await page.route('**/models/*.onnx', () => undefined); // stays loading
+    await page.goto(`${server.url}?seed=1`);
+    await page.waitForFunction(() => window.duet?.sceneMs, null, { timeout: 60_000, polling: 50 });
+    const overlap = (a, b) => a.x < b.x + b.w && b.x < a.x + a.w && a.y < b.y + b.h && b.y < a.y + a.h;
+    for (const [width, height] of [[360, 740], [390, 844], [430, 932], [740, 360], [844, 390]]) {
+      await page.setViewportSize({ width, height });
+      await page.waitForTimeout(300);
+      const b = await page.evaluate(() => {
+        const box = (selector) => {
+          const r = document.querySelector(selector).getBoundingClientRect();
+          return { x: r.left, y: r.top, w: r.width, h: r.height };
+        };
+        const canvas = box('canvas.stage');
+        const centre = { x: canvas.x + 0.3 * canvas.w, y: canvas.y + 0.3 * canvas.h, w: 0.4 * canvas.w, h: 0.4 * canvas.h };
+        return { loading: box('#loading'), title: box('#overlay'), credit: box('#credit'), panel: box('.duet-panel'), centre };
+      });
+      assert.ok(b.loading.h > 0 && b.credit.h > 0, `${width}x${height}: ${JSON.stringify(b)}`);
+      for (const other of ['title', 'credit', 'panel', 'centre']) {
+        assert.ok(!overlap(b.loading, b[other]), `${width}x${height}: loading bar ${JSON.stringify(b.loading)} overlaps ${other} ${JSON.stringify(b[other])}`);
+      }
+    }
+  } finally {
+    await phone.close();
+  }
+});
