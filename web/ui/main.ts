@@ -14,6 +14,7 @@ import { Fetcher } from '../engine/fetcher';
 import { FOLLOWER_MODELS } from '../engine/firstdance';
 import { standingViews } from '../engine/standing';
 import { assetVersion, keepForOffline, registerOffline } from '../engine/offline';
+import { GLUE_URL } from '../engine/wasm';
 import { LoadingBar } from './loading';
 import { Stage } from '../draw/scene';
 import { readBodies } from '../draw/body';
@@ -81,6 +82,12 @@ function publish(target: DuetHook['leader'], view: DancerView): void {
  * models, not with the page (ORT alone is 3.7 MB gzipped).
  */
 function loadRuntime() {
+  // onnxruntime imports its Emscripten loader when the first session is made, which on a first
+  // visit is while the last model still downloads: fetch and parse it now, while the link is free.
+  const loader = document.createElement('link');
+  loader.rel = 'modulepreload';
+  loader.href = GLUE_URL;
+  document.head.append(loader);
   const runtime = bootSpan('runtime', () => Promise.all([import('../engine/ort'), import('../engine/policy'), import('../engine/simulation')]));
   runtime.catch(() => undefined); // reported where it is awaited
   return runtime;
