@@ -40,6 +40,8 @@ async function run(url, threads) {
   try {
     await page.goto(`${url}?seed=1&threads=${threads}`);
     await waitReady(page, 60_000);
+    // Ready comes when the models are; the first dancing frame is on screen a paint later.
+    await page.waitForFunction(() => window.duet.firstFrameMs, null, { timeout: 30_000, polling: 20 });
     const ready = await duet(page);
     // Snapshot what the page needed to react, before any lazily loaded extras.
     await sleep(200);
