@@ -1,5 +1,5 @@
 // Heads-up display: one line that says who is who (a colour legend, which also explains compare
-// mode), a status line ("loading models…", "paused"), and the engine's figures (step time, frame
+// mode), a status line ("loading the dancers…", "paused"), and the engine's figures (step time, frame
 // rate, WASM threads, model bytes, guard counts) in an element the help overlay shows inside its
 // "about / details" fold. Updated a few times a second with textContent (cheap, and never
 // interprets markup).
@@ -57,7 +57,7 @@ export class Hud {
     );
   }
 
-  /** A line under the legend: "loading models…", "paused", or nothing. */
+  /** A line under the legend: "loading the dancers…", "paused", or nothing. */
   setStatus(text: string): void {
     this.status.textContent = text;
     this.status.hidden = text === '';

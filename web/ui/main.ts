@@ -162,7 +162,7 @@ class Page {
     this.snapCamera();
     bootMark('ui:start'); // HUD, controls, panel, recorder: the loading scene waits for these too
     this.hud = new Hud(document.getElementById('overlay')!);
-    this.hud.setStatus('loading models…');
+    this.hud.setStatus('loading the dancers…');
     const credit = document.getElementById('credit');
     if (credit) credit.textContent = manifest.credit ?? '';
 
@@ -276,7 +276,7 @@ class Page {
   /** (Re)build the simulation for a follower choice; a new simulation starts from the start pose. */
   private useModel(choice: FollowerChoice): Promise<void> {
     return this.exclusive(async () => {
-      this.hud.setStatus('loading models…');
+      this.hud.setStatus('loading the dancers…');
       const [leaderPolicy, ...followerPolicies] = await Promise.all([this.policy('leader'), ...FOLLOWER_MODELS[choice].map((n) => this.policy(n))]);
       this.simulation = this.createSimulation!({ manifest: this.manifest, leader: leaderPolicy, followers: followerPolicies, seed: this.settings.seed });
       this.applyLeaderFile(); // a new simulation keeps the leader's file
