@@ -96,7 +96,7 @@ export default defineConfig({
   // first visit and reloading the page (which doubles the first load and confuses the e2e tests).
   optimizeDeps: {
     exclude: ['onnxruntime-web', 'onnxruntime-web-dist'],
-    include: ['three', 'three/addons/controls/OrbitControls.js', 'lil-gui'],
+    include: ['three', 'three/addons/controls/OrbitControls.js', 'three/examples/jsm/loaders/GLTFLoader.js', 'lil-gui', '@pixiv/three-vrm'],
   },
   // The loading bar's total before the first byte of the wasm arrives (web/engine/wasm.ts).
   define: { __ORT_WASM_BYTES__: JSON.stringify(statSync(ORT_WASM).size) },

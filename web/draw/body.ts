@@ -14,6 +14,7 @@
 // (the sampled ghosts) it is derived from the positions: facing from the hips and the shoulders,
 // hands along the forearm. Nothing here allocates per frame.
 
+import type { Avatar } from './avatar';
 import * as THREE from 'three';
 import { HEAD, JOINT_NAMES, N_JOINTS } from '../mirror/skeleton';
 import { type FigureStyle, bindPositions, buildFigure, poseBones } from './figure';
@@ -354,6 +355,36 @@ export class SkinnedDancer implements DancerBody {
     this.overlay.setPose(0, positions, rotations, contacts);
     poseBones(this.bind, positions, rotations ?? null, this.matrices);
     for (let j = 0; j < N_JOINTS; j++) this.bones[j].matrixWorld.fromArray(this.matrices, 16 * j);
+    if (this.avatar) {
+      // An avatar needs the joints' rotations; a pose without them shows the dancer's own body.
+      const posable = !!rotations && rotations.length >= 9 * N_JOINTS;
+      this.avatar.group.visible = posable;
+      this.mesh.visible = !posable;
+      const now = performance.now();
+      const dt = this.posedAt > 0 ? Math.min(0.1, (now - this.posedAt) / 1000) : 0;
+      this.posedAt = now;
+      if (posable) this.avatar.setPose(positions, rotations!, dt);
+    }
+  }
+
+  /**
+   * Wear `avatar` (avatar.ts) in place of this body, or the body again (null; the avatar worn
+   * before is disposed). The skeleton overlay and the contact marks stay the dancer's.
+   */
+  dress(avatar: Avatar | null): void {
+    this.avatar?.dispose();
+    this.avatar = avatar;
+    this.mesh.visible = avatar === null;
+    if (avatar) {
+      avatar.fit(this.bind);
+      this.group.add(avatar.group);
+    }
+  }
+  private avatar: Avatar | null = null;
+  private posedAt = 0;
+
+  get wearing(): Avatar | null {
+    return this.avatar;
   }
 
   /** Bone j's world matrix as last posed (for tests). */

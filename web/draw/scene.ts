@@ -5,6 +5,7 @@
 
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+import type { Avatar } from './avatar';
 import { type Bodies, ContactMarks, type DancerBody, DancerMeshes, SkinnedDancer } from './body';
 
 export { DancerMeshes } from './body';
@@ -300,6 +301,42 @@ export class Stage {
     const length = Math.hypot(_offset.x, _offset.z) || 1;
     out.x = _offset.x / length;
     out.z = _offset.z / length;
+  }
+
+  /**
+   * The dancer ('leader' or the first 'follower') drawn nearest to a point of the page (client
+   * pixels): the one a file dropped there is for. Measured from each dancer's hips.
+   */
+  nearestDancer(clientX: number, clientY: number): 'leader' | 'follower' {
+    const distance = (dancer: 'leader' | 'follower') => {
+      const at = this.screenPoint(dancer);
+      return at ? Math.hypot(at[0] - clientX, at[1] - clientY) : Infinity;
+    };
+    return distance('follower') < distance('leader') ? 'follower' : 'leader';
+  }
+
+  /** Where a dancer's hips were last drawn, in client pixels (null for capsule figures). */
+  screenPoint(dancer: 'leader' | 'follower'): [number, number] | null {
+    const body = dancer === 'leader' ? this.leader : this.followers[0];
+    if (!(body instanceof SkinnedDancer)) return null;
+    const rect = this.canvas.getBoundingClientRect();
+    _offset.setFromMatrixPosition(body.boneMatrix(0)).project(this.camera);
+    return [rect.left + ((_offset.x + 1) / 2) * rect.width, rect.top + ((1 - _offset.y) / 2) * rect.height];
+  }
+
+  /** Dress a dancer in `avatar` (null: its own body again); false when the bodies are sticks. */
+  dress(dancer: 'leader' | 'follower', avatar: Avatar | null): boolean {
+    const body = dancer === 'leader' ? this.leader : this.followers[0];
+    if (!(body instanceof SkinnedDancer)) return false;
+    body.dress(avatar);
+    this.rendered.stale = true;
+    return true;
+  }
+
+  /** The avatar a dancer wears, if any. */
+  wearing(dancer: 'leader' | 'follower'): Avatar | null {
+    const body = dancer === 'leader' ? this.leader : this.followers[0];
+    return body instanceof SkinnedDancer ? body.wearing : null;
   }
 
   /**

@@ -149,9 +149,10 @@ export interface DuetHook {
   error: string | null;
   /** Simulation steps taken since the page loaded (not reset by R). */
   frame: number;
-  /** `hip`: the drawn hip joint's height above the floor, metres. */
-  leader: { root: [number, number]; heading: number; hip?: number };
-  follower: { root: [number, number]; heading: number; hip?: number };
+  /** `hip`: the drawn hip joint's height above the floor, metres; `screen`: where the hips are
+   *  drawn, client pixels (read when asked, for tests that drop files on a dancer). */
+  leader: { root: [number, number]; heading: number; hip?: number; screen?: [number, number] | null };
+  follower: { root: [number, number]; heading: number; hip?: number; screen?: [number, number] | null };
   /** step() wall time over the last 300 steps: features + both models + pose. */
   stepMs: { median: number; p95: number };
   /** Follower model in use: 'ours', 'ccm' or 'compare'. */
@@ -180,6 +181,10 @@ export interface DuetHook {
   /** What the fetcher worker downloaded (this page's resource timing does not list it): sizes,
    *  and times in ms since navigation. */
   workerFiles?: { url: string; transferSize: number; encodedBodySize: number; start: number; firstByte: number; end: number }[];
+  /** The avatar each dancer wears (a dropped .vrm): its name; in the last pose, the worst angle,
+   *  degrees, between its bones as drawn and the dancer's, and how far, cm, its ankles are from the
+   *  dancer's, scaled to its size (web/draw/avatar.ts). */
+  avatars?: Partial<Record<'leader' | 'follower', { name: string; fitDeg: number; feetCm: number }>>;
 }
 
 declare global {

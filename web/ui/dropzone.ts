@@ -12,6 +12,8 @@ import { type ToastKind, showToast } from './toast';
 
 /** Bigger files are refused before reading (a 10-minute 120 fps take is ~30 MB). */
 export const MAX_BVH_BYTES = 64 * 1024 * 1024;
+/** The same for avatars (web/draw/avatar.ts): those made with VRoid Studio are 5-30 MB. */
+export const MAX_AVATAR_BYTES = 100 * 1024 * 1024;
 /** Plausible standing height of a dancer, metres (foot to head along the bones). */
 const HEIGHT_RANGE: [number, number] = [0.5, 4];
 const NAME_LENGTH = 60;
@@ -90,6 +92,8 @@ export async function readLeaderFile(file: File): Promise<Motion> {
 export interface LeaderFileOptions {
   /** Put the motion on the leader; may throw (then the message is shown). */
   onMotion(motion: Motion, name: string): void | Promise<void>;
+  /** A .vrm avatar dropped at a point of the page (client pixels); shows its own messages. */
+  onAvatar?(file: File, clientX: number, clientY: number): void;
   notify?: (title: string, detail: string, kind: ToastKind) => void;
 }
 
@@ -116,7 +120,7 @@ export class LeaderFileInput {
     this.hint = document.createElement('div');
     this.hint.className = 'drop-hint';
     this.hint.hidden = true;
-    this.hint.textContent = 'Drop a .bvh file: the leader will dance it';
+    this.hint.textContent = 'Drop a .bvh file: the leader will dance it · a .vrm avatar on a dancer: it wears it';
     document.body.appendChild(this.hint);
 
     const carriesFiles = (event: DragEvent) => !!event.dataTransfer && Array.from(event.dataTransfer.types).includes('Files');
@@ -148,7 +152,8 @@ export class LeaderFileInput {
         return;
       }
       const file = files.find((f) => /\.bvh$/i.test(f.name)) ?? files[0];
-      void this.load(file);
+      if (/\.(vrm|glb)$/i.test(file.name) && this.options.onAvatar) this.options.onAvatar(file, event.clientX, event.clientY);
+      else void this.load(file);
     });
   }
 

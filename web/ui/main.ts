@@ -8,7 +8,7 @@
 import './style.css';
 import type { CreateSimulation, DancerView, DuetHook, FollowerChoice, Manifest, Simulation } from '../engine/types';
 import type { Policy } from '../engine/policy';
-import { checkBrowserSupport, installGlobalErrorHandlers, showError } from './errors';
+import { DuetError, checkBrowserSupport, installGlobalErrorHandlers, showError } from './errors';
 import { loadManifest } from '../engine/manifest';
 import { Fetcher } from '../engine/fetcher';
 import { FOLLOWER_MODELS } from '../engine/firstdance';
@@ -29,7 +29,7 @@ import { KEYS, N_KEY_JOINTS } from '../mirror/features';
 import { DancerTrack } from '../draw/interpolation';
 import { MAX_RECORD_FRAMES, Recorder, formatDuration } from './record';
 import { RecordPanel } from './recordpanel';
-import { LeaderFileInput } from './dropzone';
+import { LeaderFileInput, MAX_AVATAR_BYTES, displayName } from './dropzone';
 import { showToast } from './toast';
 import { afterPaint, bootMark, bootSpan, bootTimings } from '../engine/boot';
 
@@ -155,6 +155,10 @@ class Page {
     this.stage = new Stage(document.getElementById('app')!, manifest.skeleton.parents, MAX_GHOSTS, { ...look, offsets: manifest.skeleton.offsets });
     bootMark('stage:end'); // the renderer and the dancers' bodies: most of the loading scene's own work
     hook.bodies = this.stage.bodies;
+    for (const dancer of ['leader', 'follower'] as const) {
+      const stage = this.stage;
+      Object.defineProperty(hook[dancer], 'screen', { enumerable: true, get: () => stage.screenPoint(dancer) });
+    }
     if (this.settings.camera) this.stage.setOrbit(this.settings.camera);
     this.still = standingViews(manifest);
     this.leader.capture(this.still.leader, true);
@@ -180,6 +184,7 @@ class Page {
     this.leaderFileInput = new LeaderFileInput({
       notify: showToast,
       onMotion: (motion, name) => this.playLeaderFile(motion, name),
+      onAvatar: (file, x, y) => void this.wearAvatar(file, x, y),
     });
     this.recordPanel = new RecordPanel({
       gui: panel.gui,
@@ -190,6 +195,7 @@ class Page {
       notify: showToast,
       onOpenLeaderFile: () => this.leaderFileInput.open(),
       onLeaderModel: () => this.leaderBackToModel(),
+      onPlainBodies: () => this.plainBodies(),
     });
     bootMark('ui:end');
   }
@@ -319,6 +325,34 @@ class Page {
       this.leaderFile = { motion, name };
       this.recordPanel.setLeaderFile(name);
     });
+  }
+
+  /** A .vrm avatar dropped at a point of the page: the dancer drawn nearest to it wears it. */
+  private async wearAvatar(file: File, clientX: number, clientY: number): Promise<void> {
+    const name = displayName(file.name);
+    try {
+      if (this.stage.bodies !== 'skinned') throw new DuetError(`Cannot wear ${name}`, 'Avatars replace the shaded bodies: open the page without ?bodies=sticks.');
+      if (file.size > MAX_AVATAR_BYTES) throw new DuetError(`Cannot wear ${name}`, `The file is ${(file.size / 2 ** 20).toFixed(0)} MB; the page reads avatars up to ${MAX_AVATAR_BYTES / 2 ** 20} MB.`);
+      const { Avatar, AvatarError } = await import('../draw/avatar');
+      const avatar = await Avatar.load(await file.arrayBuffer(), name).catch((error: unknown) => {
+        throw error instanceof AvatarError ? new DuetError(`Cannot wear ${name}`, error.message) : error;
+      });
+      const dancer = this.stage.nearestDancer(clientX, clientY);
+      this.stage.dress(dancer, avatar);
+      hook.avatars = { ...hook.avatars, [dancer]: { name, get fitDeg() { return avatar.fitDeg; }, get feetCm() { return avatar.feetCm; } } };
+      this.recordPanel.setDressed(true);
+      showToast(dancer === 'leader' ? `You dance as ${name}` : `Your partner wears ${name}`, '“plain bodies again” in the panel takes it off.', 'info');
+    } catch (error) {
+      if (error instanceof DuetError) showToast(error.title, error.detail, 'error');
+      else showToast(`Cannot wear ${name}`, error instanceof Error ? error.message : String(error), 'error');
+    }
+  }
+
+  private plainBodies(): void {
+    this.stage.dress('leader', null);
+    this.stage.dress('follower', null);
+    hook.avatars = {};
+    this.recordPanel.setDressed(false);
   }
 
   private leaderBackToModel(): void {

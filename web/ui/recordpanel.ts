@@ -21,12 +21,15 @@ export interface RecordPanelOptions {
   notify(title: string, detail: string, kind: 'info' | 'error'): HTMLElement | void;
   onOpenLeaderFile(): void;
   onLeaderModel(): void;
+  /** Take off the dropped avatars (avatar.ts). */
+  onPlainBodies(): void;
 }
 
 export class RecordPanel {
   private readonly folder: GUI;
   private readonly recordButton: Controller;
   private readonly modelButton: Controller;
+  private readonly plainButton: Controller;
   private readonly indicator: HTMLElement;
   private leaderFile: string | null = null;
   private lastText = '';
@@ -42,16 +45,23 @@ export class RecordPanel {
       download: () => this.download(),
       open: () => options.onOpenLeaderFile(),
       model: () => options.onLeaderModel(),
+      plain: () => options.onPlainBodies(),
     };
     this.recordButton = this.folder.add(actions, 'record');
     this.folder.add(actions, 'download').name(`${CONTROLS.download[0]} (both dancers)`);
     this.folder.add(actions, 'open').name(CONTROLS.open[0]);
     this.modelButton = this.folder.add(actions, 'model').name(CONTROLS.leaderModel[0]).disable();
+    this.plainButton = this.folder.add(actions, 'plain').name(CONTROLS.plainBodies[0]).disable();
     this.indicator = document.createElement('div');
     this.indicator.className = 'record-status';
     this.indicator.hidden = true;
     options.overlay.appendChild(this.indicator);
     this.update();
+  }
+
+  /** Whether a dancer wears a dropped avatar ("plain bodies again" can take it off). */
+  setDressed(dressed: boolean): void {
+    this.plainButton.enable(dressed);
   }
 
   /** The leader dances a file (its name) or the model (null). */

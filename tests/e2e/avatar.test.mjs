@@ -1,0 +1,91 @@
+// End-to-end: a VRM avatar dropped on a dancer dresses that dancer (web/draw/avatar.ts): its bones
+// follow the dancer's while they dance and its feet stay on the floor, "plain bodies again" takes
+// it off, and a file that is not an avatar gives a message while the page dances on. The avatar
+// is the tests' own (tests/e2e/vrm.mjs); tests/web/avatar.test.ts checks the retargeting itself.
+// Run: node --test tests/e2e/avatar.test.mjs
+
+import { after, before, test } from 'node:test';
+import assert from 'node:assert/strict';
+import { writeFileSync } from 'node:fs';
+import { join } from 'node:path';
+import { ROOT, duet, launch, startServer, waitReady, waitSteps } from './harness.mjs';
+import { makeVrm } from './vrm.mjs';
+
+let server;
+let browser;
+
+before(async () => {
+  server = await startServer();
+  browser = await launch();
+  await browser.page.goto(`${server.url}?seed=2&camera=90,75,4`); // from the side: both dancers in view
+  await waitReady(browser.page, 60_000);
+});
+
+after(async () => {
+  await browser?.close();
+  await server?.stop();
+});
+
+/** Drop a file at a point of the page (client pixels), as a browser does when one is dragged there. */
+async function dropAt(page, name, bytes, [x, y]) {
+  await page.evaluate(
+    ({ name, base64, x, y }) => {
+      const data = new DataTransfer();
+      data.items.add(new File([Uint8Array.from(atob(base64), (c) => c.charCodeAt(0))], name, { type: 'application/octet-stream' }));
+      const target = document.querySelector('canvas');
+      for (const type of ['dragenter', 'dragover', 'drop']) {
+        target.dispatchEvent(new DragEvent(type, { dataTransfer: data, bubbles: true, cancelable: true, clientX: x, clientY: y }));
+      }
+    },
+    { name, base64: Buffer.from(bytes).toString('base64'), x, y },
+  );
+}
+
+const avatars = async (page) => (await duet(page)).avatars ?? {};
+const button = (page, name) => page.locator('.lil-gui button', { hasText: name });
+
+test('a .vrm dropped on the partner dresses the partner; its bones follow the dance', async () => {
+  const { page } = browser;
+  await dropAt(page, 'test-dancer.vrm', makeVrm('Test Dancer'), (await duet(page)).follower.screen);
+  await page.waitForFunction(() => window.duet.avatars?.follower, null, { timeout: 30_000 });
+  assert.deepEqual(Object.keys(await avatars(page)), ['follower']);
+  assert.equal((await avatars(page)).follower.name, 'test-dancer.vrm');
+  await page.locator('.toast-info', { hasText: 'Your partner wears test-dancer.vrm' }).waitFor({ timeout: 5000 });
+  // While dancing: every bone of the avatar within a few degrees of the dancer's, ankles on the
+  // dancer's (scaled) ankle heights.
+  const samples = [];
+  for (let i = 0; i < 10; i++) {
+    await waitSteps(page, 6);
+    samples.push((await avatars(page)).follower);
+  }
+  const worst = (key) => Math.max(...samples.map((s) => s[key]));
+  assert.ok(worst('fitDeg') < 5, `worst bone angle per sample (degrees): ${samples.map((s) => s.fitDeg.toFixed(2)).join(' ')}`);
+  assert.ok(worst('feetCm') < 5, `ankles off (cm): ${samples.map((s) => s.feetCm.toFixed(2)).join(' ')}`);
+  writeFileSync(join(ROOT, 'docs', 'screenshot-avatar.png'), await page.screenshot());
+});
+
+test('a .vrm dropped on the leader dresses the leader; "plain bodies again" takes both off', async () => {
+  const { page } = browser;
+  await dropAt(page, 'older.vrm', makeVrm('Older', '0.0'), (await duet(page)).leader.screen);
+  await page.waitForFunction(() => window.duet.avatars?.leader, null, { timeout: 30_000 });
+  assert.deepEqual(Object.keys(await avatars(page)).sort(), ['follower', 'leader']);
+  await waitSteps(page, 10);
+  const { leader } = await avatars(page);
+  assert.ok(leader.fitDeg < 5 && leader.feetCm < 5, JSON.stringify(leader));
+  await button(page, 'plain bodies again').click();
+  await page.waitForFunction(() => Object.keys(window.duet.avatars ?? {}).length === 0, null, { timeout: 5000 });
+  assert.equal(await button(page, 'plain bodies again').isDisabled(), true);
+});
+
+test('a file that is not an avatar gives a message, and the dance goes on', async () => {
+  const { page } = browser;
+  const before = (await duet(page)).frame;
+  await dropAt(page, 'not-an-avatar.vrm', Buffer.from('HIERARCHY\nROOT hip'), (await duet(page)).follower.screen);
+  const toast = page.locator('.toast-error', { hasText: 'Cannot wear not-an-avatar.vrm' });
+  await toast.waitFor({ timeout: 10_000 });
+  assert.match(await toast.textContent(), /not a VRM avatar/);
+  await waitSteps(page, 10);
+  assert.ok((await duet(page)).frame > before, 'still dancing');
+  assert.deepEqual(await avatars(page), {});
+  assert.deepEqual(browser.consoleErrors, []);
+});

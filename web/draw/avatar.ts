@@ -1,0 +1,222 @@
+// A VRM avatar worn by a dancer: a .vrm file dropped on the page (web/ui/main.ts) replaces that
+// dancer's drawn body; the simulation, the contact marks and the skeleton overlay stay the
+// dancer's own. Loaded only when a file is dropped (this module and @pixiv/three-vrm are a chunk
+// of their own), so the first visit downloads none of it.
+//
+// Retargeting. Both rigs rest in a T-pose facing +z with y up: the dancers' skeleton (the BVH
+// rest pose, every joint rotation the identity; its left side at +x) and a VRM's normalized
+// humanoid (three-vrm's rig in which every bone rests at the identity, for VRM 0.x and 1.0
+// alike). A dancer's world rotation G_j therefore carries over to the avatar's bone almost as it
+// is: H_j = G_j · A_j, where A_j turns the avatar's rest bone direction onto the skeleton's (a
+// few degrees: the two T-poses differ a little). Then, as the skinned body does (figure.ts), the
+// bone is swung onto the direction the dancer's joint positions actually take (the contact layer
+// and the foot fixes move positions, not rotations). Each normalized bone gets its local rotation
+// from its nearest posed ancestor; bones the skeleton lacks (shoulders, upper chest, toes,
+// fingers) stay at rest. The avatar keeps its own size: its hips go where the dancer's are, at
+// the height scaled by the ratio of the two leg lengths, so its feet meet the floor.
+
+import * as THREE from 'three';
+import { GLTFLoader } from 'three/examples/jsm/loaders/GLTFLoader.js';
+import { type VRM, type VRMHumanBoneName, VRMLoaderPlugin, VRMUtils } from '@pixiv/three-vrm';
+import { N_JOINTS } from '../mirror/skeleton';
+import { PRIMARY_CHILD } from './figure';
+
+/** The VRM humanoid bone each skeleton joint drives, by joint index (hip, abdomen, chest, ...). */
+export const AVATAR_BONES: readonly VRMHumanBoneName[] = [
+  'hips', 'spine', 'chest', 'neck', 'head',
+  'leftUpperArm', 'leftLowerArm', 'leftHand', 'rightUpperArm', 'rightLowerArm', 'rightHand',
+  'leftUpperLeg', 'leftLowerLeg', 'leftFoot', 'rightUpperLeg', 'rightLowerLeg', 'rightFoot',
+];
+const L_THIGH = 11, L_SHIN = 12, L_FOOT = 13, R_THIGH = 14, R_FOOT = 16;
+
+/** Why a file cannot be worn, in words for the page's message. */
+export class AvatarError extends Error {}
+
+const _q = new THREE.Quaternion();
+const _swing = new THREE.Quaternion();
+const _m = new THREE.Matrix4();
+const _x = new THREE.Vector3();
+const _y = new THREE.Vector3();
+const _z = new THREE.Vector3();
+const _u = new THREE.Vector3();
+const _v = new THREE.Vector3();
+const _p = new THREE.Vector3();
+
+export class Avatar {
+  /** What the stage draws in the dancer's place. */
+  readonly group = new THREE.Group();
+  /** The worst angle, degrees, between an avatar bone as drawn and the dancer's bone, last pose. */
+  fitDeg = 0;
+  /** How far, cm, the avatar's ankles are from the dancer's ankle heights (scaled), last pose. */
+  feetCm = 0;
+  private readonly nodes: (THREE.Object3D | null)[];
+  private readonly raw: (THREE.Object3D | null)[];
+  /** Per joint: the joint whose position the bone points at (the nearest one the avatar has too). */
+  private readonly target: number[];
+  /** Per joint: the nearest ancestor joint the avatar has (-1 for the hips). */
+  private readonly parent: number[];
+  /** The avatar's rest bone directions, in the group's frame. */
+  private readonly restDirection: THREE.Vector3[];
+  /** A_j, set by fit(). */
+  private readonly align: THREE.Quaternion[];
+  /** H_j of the last pose. */
+  private readonly world: THREE.Quaternion[];
+  /** The rig root's rotation in the group's frame (a half turn for VRM 0.x after rotateVRM0). */
+  private readonly rigRotation = new THREE.Quaternion();
+  private readonly rigInverse = new THREE.Quaternion();
+  private readonly rigRootInverse = new THREE.Matrix4();
+  private readonly restHips = new THREE.Vector3();
+  private readonly restLegs = new THREE.Vector3();
+  private readonly avatarLeg: number;
+  private scale = 1;
+
+  private constructor(readonly vrm: VRM, readonly name: string) {
+    const { humanoid } = vrm;
+    this.group.add(vrm.scene);
+    this.nodes = AVATAR_BONES.map((b) => humanoid.getNormalizedBoneNode(b));
+    this.raw = AVATAR_BONES.map((b) => humanoid.getRawBoneNode(b));
+    const has = (j: number) => j >= 0 && this.nodes[j] !== null;
+    this.target = AVATAR_BONES.map((_, j) => {
+      let t = PRIMARY_CHILD[j];
+      while (t >= 0 && !has(t)) t = PRIMARY_CHILD[t];
+      return t;
+    });
+    this.parent = AVATAR_BONES.map((_, j) => {
+      const mine = this.nodes[j];
+      for (let node = mine?.parent ?? null; node; node = node.parent) {
+        const k = this.nodes.indexOf(node);
+        if (k >= 0) return k;
+      }
+      return -1;
+    });
+
+    // The rest pose, measured in the group's frame.
+    humanoid.resetNormalizedPose();
+    this.group.updateMatrixWorld(true);
+    const rest = this.nodes.map((n) => (n ? n.getWorldPosition(new THREE.Vector3()) : null));
+    this.restDirection = AVATAR_BONES.map((_, j) => {
+      const t = this.target[j];
+      return rest[j] && t >= 0 && rest[t] ? rest[t]!.clone().sub(rest[j]!).normalize() : new THREE.Vector3();
+    });
+    const rigRoot = humanoid.normalizedHumanBonesRoot;
+    rigRoot.getWorldQuaternion(this.rigRotation);
+    this.rigInverse.copy(this.rigRotation).invert();
+    this.rigRootInverse.copy(rigRoot.matrixWorld).invert();
+    const node = (b: VRMHumanBoneName) => humanoid.getNormalizedBoneNode(b)!.getWorldPosition(new THREE.Vector3());
+    this.restHips.copy(node('hips'));
+    this.restLegs.copy(node('leftUpperLeg')).add(node('rightUpperLeg')).multiplyScalar(0.5);
+    this.avatarLeg = node('leftUpperLeg').distanceTo(node('leftLowerLeg')) + node('leftLowerLeg').distanceTo(node('leftFoot'));
+    this.align = AVATAR_BONES.map(() => new THREE.Quaternion());
+    this.world = AVATAR_BONES.map(() => new THREE.Quaternion());
+  }
+
+  /** Read a .vrm (VRM 0.x or 1.0) file's bytes; an AvatarError says why it cannot be worn. */
+  static async load(bytes: ArrayBuffer, name: string): Promise<Avatar> {
+    const magic = new Uint8Array(bytes, 0, Math.min(4, bytes.byteLength));
+    if (String.fromCharCode(...magic) !== 'glTF') throw new AvatarError('This is not a VRM avatar (a .vrm file is a binary glTF, starting with "glTF").');
+    const loader = new GLTFLoader();
+    loader.register((parser) => new VRMLoaderPlugin(parser));
+    let vrm: VRM | undefined;
+    try {
+      const gltf = await loader.parseAsync(bytes, '');
+      vrm = gltf.userData.vrm as VRM | undefined;
+    } catch (error) {
+      throw new AvatarError(`The file could not be read as a VRM avatar: ${(error as Error)?.message || error}`);
+    }
+    if (!vrm) throw new AvatarError('The file is a 3D model but not a VRM avatar (it has no humanoid bones).');
+    for (const bone of AVATAR_BONES) {
+      // The skeleton's spine joints may be missing from an avatar (VRM requires only some bones).
+      if (!vrm.humanoid.getNormalizedBoneNode(bone) && !['chest', 'neck'].includes(bone)) {
+        throw new AvatarError(`The avatar has no "${bone}" bone; a dancer needs hips, spine, head, arms, hands, legs and feet.`);
+      }
+    }
+    VRMUtils.rotateVRM0(vrm); // VRM 0.x avatars face -z: turn them to face +z as VRM 1.0 ones do
+    VRMUtils.combineSkeletons(vrm.scene); // fewer bone textures to upload per frame
+    vrm.scene.traverse((object) => {
+      object.frustumCulled = false; // the avatar moves anywhere; its rest bounds would cull it
+      if ((object as THREE.Mesh).isMesh) object.castShadow = true;
+    });
+    return new Avatar(vrm, name);
+  }
+
+  /**
+   * Fit to a dancer's rest pose (bind: 17 joint positions, the skeleton's T-pose): the rest
+   * alignment A_j and the height scale.
+   */
+  fit(bind: ArrayLike<number>): void {
+    const at = (j: number, out: THREE.Vector3) => out.set(bind[3 * j], bind[3 * j + 1], bind[3 * j + 2]);
+    for (let j = 0; j < N_JOINTS; j++) {
+      const t = this.target[j];
+      this.align[j].identity();
+      if (t < 0 || this.restDirection[j].lengthSq() === 0) continue;
+      at(t, _u).sub(at(j, _v)).normalize();
+      this.align[j].setFromUnitVectors(this.restDirection[j], _u);
+    }
+    const ourLeg = at(L_SHIN, _u).distanceTo(at(L_THIGH, _v)) + at(L_FOOT, _u).distanceTo(at(L_SHIN, _v));
+    this.scale = ourLeg > 1e-6 ? this.avatarLeg / ourLeg : 1;
+  }
+
+  /**
+   * Pose the avatar from 17 world joint positions and rotations (row-major 3×3, as the simulation
+   * gives them); `dt` advances the avatar's own motion (spring bones: hair, skirts).
+   */
+  setPose(positions: ArrayLike<number>, rotations: ArrayLike<number>, dt: number): void {
+    const at = (j: number, out: THREE.Vector3) => out.set(positions[3 * j], positions[3 * j + 1], positions[3 * j + 2]);
+    for (let j = 0; j < N_JOINTS; j++) {
+      const node = this.nodes[j];
+      if (!node) continue;
+      const o = 9 * j;
+      // Columns of the row-major matrix, made orthonormal (interpolated rotations drift a little).
+      _y.set(rotations[o + 1], rotations[o + 4], rotations[o + 7]).normalize();
+      _z.set(rotations[o + 2], rotations[o + 5], rotations[o + 8]);
+      _z.addScaledVector(_y, -_z.dot(_y)).normalize();
+      _x.crossVectors(_y, _z);
+      const h = this.world[j].setFromRotationMatrix(_m.makeBasis(_x, _y, _z)).multiply(this.align[j]);
+      const t = this.target[j];
+      if (t >= 0) {
+        // Swing the bone onto where the dancer's joints are.
+        _u.copy(this.restDirection[j]).applyQuaternion(h);
+        at(t, _v).sub(at(j, _p));
+        if (_v.lengthSq() > 1e-12) h.premultiply(_swing.setFromUnitVectors(_u, _v.normalize()));
+      }
+      const p = this.parent[j];
+      // local = S⁻¹ · H_parent⁻¹ · H_j · S (S: the rig root's rotation; H of the hips' parent is 1)
+      _q.copy(this.rigInverse);
+      if (p >= 0) _q.multiply(_swing.copy(this.world[p]).invert());
+      node.quaternion.copy(_q.multiply(h).multiply(this.rigRotation));
+    }
+    // The hips: the avatar's hip joints (the legs' tops) where the dancer's are, scaled in height.
+    at(L_THIGH, _u).add(at(R_THIGH, _v)).multiplyScalar(0.5);
+    _u.y *= this.scale;
+    _v.copy(this.restHips).sub(this.restLegs).applyQuaternion(this.world[0]);
+    this.nodes[0]!.position.copy(_u.add(_v).applyMatrix4(this.rigRootInverse));
+    this.vrm.update(dt);
+    this.measureFit(positions);
+  }
+
+  private measureFit(positions: ArrayLike<number>): void {
+    this.group.updateMatrixWorld(true);
+    let worst = 0;
+    for (let j = 0; j < N_JOINTS; j++) {
+      const t = this.target[j];
+      const from = this.raw[j], to = t >= 0 ? this.raw[t] : null;
+      if (!from || !to) continue;
+      to.getWorldPosition(_u).sub(from.getWorldPosition(_v));
+      _p.set(positions[3 * t] - positions[3 * j], positions[3 * t + 1] - positions[3 * j + 1], positions[3 * t + 2] - positions[3 * j + 2]);
+      if (_u.lengthSq() < 1e-12 || _p.lengthSq() < 1e-12) continue;
+      worst = Math.max(worst, THREE.MathUtils.radToDeg(_u.angleTo(_p)));
+    }
+    this.fitDeg = worst;
+    let feet = 0;
+    for (const j of [L_FOOT, R_FOOT]) {
+      const foot = this.raw[j];
+      if (foot) feet = Math.max(feet, Math.abs(foot.getWorldPosition(_u).y - positions[3 * j + 1] * this.scale));
+    }
+    this.feetCm = 100 * feet;
+  }
+
+  dispose(): void {
+    this.group.removeFromParent();
+    VRMUtils.deepDispose(this.vrm.scene);
+  }
+}
