@@ -1,7 +1,8 @@
 // End-to-end: a VRM avatar dropped on a dancer dresses that dancer (web/draw/avatar.ts): its bones
 // follow the dancer's while they dance and its feet stay on the floor, "plain bodies again" takes
-// it off, and a file that is not an avatar gives a message while the page dances on. The avatar
-// is the tests' own (tests/e2e/vrm.mjs); tests/web/avatar.test.ts checks the retargeting itself.
+// it off, the panel's button dresses the partner, and a file that is not an avatar gives a message
+// while the page dances on. The avatar is the tests' own (tests/e2e/vrm.mjs); tests/web/avatar.test.ts
+// checks the retargeting itself.
 // Run: node --test tests/e2e/avatar.test.mjs
 
 import { after, before, test } from 'node:test';
@@ -75,6 +76,16 @@ test('a .vrm dropped on the leader dresses the leader; "plain bodies again" take
   await button(page, 'plain bodies again').click();
   await page.waitForFunction(() => Object.keys(window.duet.avatars ?? {}).length === 0, null, { timeout: 5000 });
   assert.equal(await button(page, 'plain bodies again').isDisabled(), true);
+});
+
+test("the panel's avatar button dresses the partner (phones have no drag and drop)", async () => {
+  const { page } = browser;
+  await page.locator('input[aria-label="avatar file for the partner"]').setInputFiles({ name: 'chosen.vrm', mimeType: 'application/octet-stream', buffer: makeVrm('Chosen') });
+  await page.waitForFunction(() => window.duet.avatars?.follower, null, { timeout: 30_000 });
+  assert.deepEqual(Object.keys(await avatars(page)), ['follower']);
+  assert.equal((await avatars(page)).follower.name, 'chosen.vrm');
+  await button(page, 'plain bodies again').click();
+  await page.waitForFunction(() => Object.keys(window.duet.avatars ?? {}).length === 0, null, { timeout: 5000 });
 });
 
 test('a file that is not an avatar gives a message, and the dance goes on', async () => {

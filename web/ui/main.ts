@@ -105,6 +105,7 @@ class Page {
   private readonly controls: Controls;
   private readonly recorder: Recorder;
   private readonly leaderFileInput: LeaderFileInput;
+  private readonly avatarInput: HTMLInputElement;
   private readonly recordPanel: RecordPanel;
 
   private simulation: Simulation | null = null;
@@ -184,7 +185,7 @@ class Page {
     this.leaderFileInput = new LeaderFileInput({
       notify: showToast,
       onMotion: (motion, name) => this.playLeaderFile(motion, name),
-      onAvatar: (file, x, y) => void this.wearAvatar(file, x, y),
+      onAvatar: (file, x, y) => void this.wearAvatar(file, this.stage.nearestDancer(x, y)),
     });
     this.recordPanel = new RecordPanel({
       gui: panel.gui,
@@ -195,8 +196,21 @@ class Page {
       notify: showToast,
       onOpenLeaderFile: () => this.leaderFileInput.open(),
       onLeaderModel: () => this.leaderBackToModel(),
+      onOpenAvatar: () => this.avatarInput.click(),
       onPlainBodies: () => this.plainBodies(),
     });
+    // The panel's avatar button: a file chooser (phones have no drag and drop).
+    this.avatarInput = document.createElement('input');
+    this.avatarInput.type = 'file';
+    this.avatarInput.accept = '.vrm,.glb';
+    this.avatarInput.className = 'leader-file';
+    this.avatarInput.setAttribute('aria-label', 'avatar file for the partner');
+    this.avatarInput.addEventListener('change', () => {
+      const file = this.avatarInput.files?.[0];
+      this.avatarInput.value = ''; // choosing the same file again fires 'change' again
+      if (file) void this.wearAvatar(file, 'follower');
+    });
+    document.body.appendChild(this.avatarInput);
     bootMark('ui:end');
   }
 
@@ -327,8 +341,8 @@ class Page {
     });
   }
 
-  /** A .vrm avatar dropped at a point of the page: the dancer drawn nearest to it wears it. */
-  private async wearAvatar(file: File, clientX: number, clientY: number): Promise<void> {
+  /** Dress `dancer` in a .vrm avatar file (dropped on it, or chosen with the panel's button). */
+  private async wearAvatar(file: File, dancer: 'leader' | 'follower'): Promise<void> {
     const name = displayName(file.name);
     try {
       if (this.stage.bodies !== 'skinned') throw new DuetError(`Cannot wear ${name}`, 'Avatars replace the shaded bodies: open the page without ?bodies=sticks.');
@@ -337,7 +351,6 @@ class Page {
       const avatar = await Avatar.load(await file.arrayBuffer(), name).catch((error: unknown) => {
         throw error instanceof AvatarError ? new DuetError(`Cannot wear ${name}`, error.message) : error;
       });
-      const dancer = this.stage.nearestDancer(clientX, clientY);
       this.stage.dress(dancer, avatar);
       hook.avatars = { ...hook.avatars, [dancer]: { name, get fitDeg() { return avatar.fitDeg; }, get feetCm() { return avatar.feetCm; } } };
       this.recordPanel.setDressed(true);

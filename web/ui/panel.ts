@@ -52,7 +52,8 @@ export const CONTROLS = {
   download: ['download BVH', 'Saves the recording as one motion file per dancer (for Blender and other animation tools).'],
   open: ['leader from BVH file…', 'Your dancer plays a motion file instead of following your keys (you can also drop the file on the page).'],
   leaderModel: ['leader back to model', 'Gives your dancer back to your keys or thumb.'],
-  plainBodies: ['plain bodies again', 'Takes off the avatars you dressed the dancers in: drop a .vrm avatar file on a dancer to dress it.'],
+  avatar: ['partner avatar (.vrm)…', 'Dresses your partner in a VRM avatar file (on a computer you can also drop one on either dancer).'],
+  plainBodies: ['plain bodies again', 'Takes off the avatars the dancers wear.'],
 } as const satisfies Record<string, readonly [string, string]>;
 
 const [label, help] = [(k: keyof typeof CONTROLS) => CONTROLS[k][0], (k: keyof typeof CONTROLS) => CONTROLS[k][1]];

@@ -21,7 +21,9 @@ export interface RecordPanelOptions {
   notify(title: string, detail: string, kind: 'info' | 'error'): HTMLElement | void;
   onOpenLeaderFile(): void;
   onLeaderModel(): void;
-  /** Take off the dropped avatars (avatar.ts). */
+  /** Choose a .vrm file for the partner to wear (avatar.ts). */
+  onOpenAvatar(): void;
+  /** Take off the avatars. */
   onPlainBodies(): void;
 }
 
@@ -45,12 +47,14 @@ export class RecordPanel {
       download: () => this.download(),
       open: () => options.onOpenLeaderFile(),
       model: () => options.onLeaderModel(),
+      avatar: () => options.onOpenAvatar(),
       plain: () => options.onPlainBodies(),
     };
     this.recordButton = this.folder.add(actions, 'record');
     this.folder.add(actions, 'download').name(`${CONTROLS.download[0]} (both dancers)`);
     this.folder.add(actions, 'open').name(CONTROLS.open[0]);
     this.modelButton = this.folder.add(actions, 'model').name(CONTROLS.leaderModel[0]).disable();
+    this.folder.add(actions, 'avatar').name(CONTROLS.avatar[0]);
     this.plainButton = this.folder.add(actions, 'plain').name(CONTROLS.plainBodies[0]).disable();
     this.indicator = document.createElement('div');
     this.indicator.className = 'record-status';
@@ -59,7 +63,7 @@ export class RecordPanel {
     this.update();
   }
 
-  /** Whether a dancer wears a dropped avatar ("plain bodies again" can take it off). */
+  /** Whether a dancer wears an avatar ("plain bodies again" can take it off). */
   setDressed(dressed: boolean): void {
     this.plainButton.enable(dressed);
   }
