@@ -383,10 +383,6 @@ export class SkinnedDancer implements DancerBody {
   private avatar: Avatar | null = null;
   private posedAt = 0;
 
-  get wearing(): Avatar | null {
-    return this.avatar;
-  }
-
   /** Bone j's world matrix as last posed (for tests). */
   boneMatrix(j: number): THREE.Matrix4 {
     return this.bones[j].matrixWorld;

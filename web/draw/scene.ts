@@ -333,12 +333,6 @@ export class Stage {
     return true;
   }
 
-  /** The avatar a dancer wears, if any. */
-  wearing(dancer: 'leader' | 'follower'): Avatar | null {
-    const body = dancer === 'leader' ? this.leader : this.followers[0];
-    return body instanceof SkinnedDancer ? body.wearing : null;
-  }
-
   /**
    * How much hand `hand` (0 left, 1 right) of dancer `dancer` (0 leader, 1 follower, 2 compare
    * follower) is in contact, 0..1: above 0 a soft glow shows at that hand. Holds until set again;

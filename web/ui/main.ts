@@ -203,7 +203,7 @@ class Page {
     this.avatarInput = document.createElement('input');
     this.avatarInput.type = 'file';
     this.avatarInput.accept = '.vrm,.glb';
-    this.avatarInput.className = 'leader-file';
+    this.avatarInput.hidden = true;
     this.avatarInput.setAttribute('aria-label', 'avatar file for the partner');
     this.avatarInput.addEventListener('change', () => {
       const file = this.avatarInput.files?.[0];
@@ -412,8 +412,8 @@ class Page {
       hook.sceneMs = at;
       bootMark('scene-painted', at);
       // index.html's picture of this scene covered the canvas until now: the live one is on
-      // screen under it, so taking it away changes nothing a visitor sees (same pixels, or the
-      // view of a shared link's camera).
+      // screen under it with the same pixels, so taking it away changes nothing a visitor sees
+      // (except on a shared link whose camera or bodies differ from the picture's).
       document.getElementById('poster')?.remove();
     }, false);
     // While the models are still coming (a moment after the loading scene is on screen): when
