@@ -155,21 +155,32 @@ export async function displacement(page, ms, hold = async () => {}, release = as
 }
 
 /**
- * Fraction-of-pixels check that a screenshot is not blank: decode the PNG in the page (no image
- * library needed) and return the variance of the luminance.
+ * A screenshot (PNG bytes) decoded in the page (no image library needed), on a canvas `scale`
+ * times its size (smoothed): a handle for the caller's own evaluate().
  */
+export function pngCanvas(page, png, scale = 1) {
+  return page.evaluateHandle(
+    async ({ src, scale }) => {
+      const image = new Image();
+      image.src = src;
+      await image.decode();
+      const canvas = document.createElement('canvas');
+      canvas.width = Math.round(image.naturalWidth * scale);
+      canvas.height = Math.round(image.naturalHeight * scale);
+      const context = canvas.getContext('2d');
+      context.imageSmoothingQuality = 'high';
+      context.drawImage(image, 0, 0, canvas.width, canvas.height);
+      return canvas;
+    },
+    { src: `data:image/png;base64,${png.toString('base64')}`, scale },
+  );
+}
+
+/** Check that a screenshot is not blank: the variance of its luminance. */
 export async function pixelVariance(page, png) {
-  const dataUrl = `data:image/png;base64,${png.toString('base64')}`;
-  return page.evaluate(async (src) => {
-    const image = new Image();
-    image.src = src;
-    await image.decode();
-    const canvas = document.createElement('canvas');
-    canvas.width = image.width;
-    canvas.height = image.height;
-    const context = canvas.getContext('2d');
-    context.drawImage(image, 0, 0);
-    const { data } = context.getImageData(0, 0, canvas.width, canvas.height);
+  const canvas = await pngCanvas(page, png);
+  return canvas.evaluate((canvas) => {
+    const { data } = canvas.getContext('2d').getImageData(0, 0, canvas.width, canvas.height);
     let sum = 0;
     let sumSquares = 0;
     const n = data.length / 4;
@@ -180,7 +191,7 @@ export async function pixelVariance(page, png) {
     }
     const mean = sum / n;
     return sumSquares / n - mean * mean;
-  }, dataUrl);
+  });
 }
 
 /** Touch drag through the DevTools protocol (Playwright has no touch-move API). */

@@ -1,7 +1,7 @@
 // The loading scene's picture (index.html's #poster, drawn by scripts/poster.mjs) against the live
 // loading scene, as a visitor's screen shows them: shared by tests/e2e/loading.test.mjs.
 
-import { launch } from './harness.mjs';
+import { launch, pngCanvas } from './harness.mjs';
 
 /** Everything over the canvas hidden except the picture: the two screens show the scene alone. */
 const SCENE_ONLY = 'body > *:not(#app):not(#poster) { visibility: hidden !important; }';
@@ -39,37 +39,24 @@ export async function posterAndScene(url, options, css = '') {
 }
 
 /**
- * How far two screenshots differ, in the page (it decodes PNG): both scaled down 4× (the picture
- * is drawn at another pixel ratio than the screen, which sharpens edges differently), then per
- * pixel the largest channel difference. Returns its mean and the share of pixels off by more than
- * 32 of 255: a picture shifted or scaled against the scene moves the dancers and the grid lines,
- * and that share grows with it.
+ * How far two screenshots differ: both scaled down 4× in the page (the picture is drawn at another
+ * pixel ratio than the screen, which sharpens edges differently), then per pixel the largest
+ * channel difference. Returns its mean and the share of pixels off by more than 32 of 255: a
+ * picture shifted or scaled against the scene moves the dancers and the grid lines, and that share
+ * grows with it.
  */
-function compare(page, a, b) {
-  return page.evaluate(
-    async ([a, b]) => {
-      const pixels = async (base64) => {
-        const image = new Image();
-        image.src = `data:image/png;base64,${base64}`;
-        await image.decode();
-        const canvas = document.createElement('canvas');
-        canvas.width = Math.round(image.naturalWidth / 4);
-        canvas.height = Math.round(image.naturalHeight / 4);
-        const context = canvas.getContext('2d');
-        context.imageSmoothingQuality = 'high';
-        context.drawImage(image, 0, 0, canvas.width, canvas.height);
-        return context.getImageData(0, 0, canvas.width, canvas.height).data;
-      };
-      const [p, q] = [await pixels(a), await pixels(b)];
-      let sum = 0, off = 0;
-      const n = p.length / 4;
-      for (let i = 0; i < p.length; i += 4) {
-        const d = Math.max(Math.abs(p[i] - q[i]), Math.abs(p[i + 1] - q[i + 1]), Math.abs(p[i + 2] - q[i + 2]));
-        sum += d;
-        if (d > 32) off++;
-      }
-      return { mean: sum / n, off: off / n };
-    },
-    [a.toString('base64'), b.toString('base64')],
-  );
+export async function compare(page, a, b) {
+  const [p, q] = [await pngCanvas(page, a, 0.25), await pngCanvas(page, b, 0.25)];
+  return page.evaluate(([p, q]) => {
+    const pixels = (canvas) => canvas.getContext('2d').getImageData(0, 0, canvas.width, canvas.height).data;
+    const [x, y] = [pixels(p), pixels(q)];
+    let sum = 0, off = 0;
+    const n = x.length / 4;
+    for (let i = 0; i < x.length; i += 4) {
+      const d = Math.max(Math.abs(x[i] - y[i]), Math.abs(x[i + 1] - y[i + 1]), Math.abs(x[i + 2] - y[i + 2]));
+      sum += d;
+      if (d > 32) off++;
+    }
+    return { mean: sum / n, off: off / n };
+  }, [p, q]);
 }

@@ -1,8 +1,9 @@
-// A small VRM 1.0 avatar written from scratch for the tests (tests/e2e/avatar.test.mjs): one box
-// per humanoid bone, skinned rigidly to it, in a T-pose facing +z, with proportions unlike the
-// dancers' (shorter legs and arms) and the bones the dancers lack (upper chest, shoulders, toes),
-// so that retargeting has something to get wrong. A .vrm is a binary glTF (GLB) whose VRMC_vrm
-// extension names the humanoid bones (https://github.com/vrm-c/vrm-specification).
+// A small VRM avatar (1.0, or 0.0) written from scratch for the tests (tests/e2e/avatar.test.mjs,
+// tests/web/avatar.test.ts): one box per humanoid bone, skinned rigidly to it, in a T-pose, with
+// proportions unlike the dancers' (shorter legs and arms) and the bones the dancers lack (upper
+// chest, shoulders, toes), so that retargeting has something to get wrong. A .vrm is a binary
+// glTF (GLB) whose VRMC_vrm extension (VRM 0.0: VRM) names the humanoid bones
+// (https://github.com/vrm-c/vrm-specification).
 
 /** [bone, parent, offset from the parent in metres]; the right side mirrors the left. */
 const LEFT = [

@@ -7,8 +7,9 @@
 // rest pose, every joint rotation the identity; its left side at +x) and a VRM's normalized
 // humanoid (three-vrm's rig in which every bone rests at the identity, for VRM 0.x and 1.0
 // alike). A dancer's world rotation G_j therefore carries over to the avatar's bone almost as it
-// is: H_j = G_j · A_j, where A_j turns the avatar's rest bone direction onto the skeleton's (a
-// few degrees: the two T-poses differ a little). Then, as the skinned body does (figure.ts), the
+// is: H_j = G_j · A_j, where A_j turns the avatar's rest bone direction onto the skeleton's (the
+// two T-poses differ: the dancers' forearms, for one, point 17° forward of a straight arm in the
+// manifest's offsets). Then, as the skinned body does (figure.ts), the
 // bone is swung onto the direction the dancer's joint positions actually take (the contact layer
 // and the foot fixes move positions, not rotations). Each normalized bone gets its local rotation
 // from its nearest posed ancestor; bones the skeleton lacks (shoulders, upper chest, toes,
@@ -18,16 +19,26 @@
 import * as THREE from 'three';
 import { GLTFLoader } from 'three/examples/jsm/loaders/GLTFLoader.js';
 import { type VRM, type VRMHumanBoneName, VRMLoaderPlugin, VRMUtils } from '@pixiv/three-vrm';
-import { N_JOINTS } from '../mirror/skeleton';
-import { PRIMARY_CHILD } from './figure';
+import { FEET, JOINT_NAMES, N_JOINTS, POSITIONS_SIZE } from '../mirror/skeleton';
+import { PRIMARY_CHILD, jointRotation } from './figure';
 
-/** The VRM humanoid bone each skeleton joint drives, by joint index (hip, abdomen, chest, ...). */
-export const AVATAR_BONES: readonly VRMHumanBoneName[] = [
-  'hips', 'spine', 'chest', 'neck', 'head',
-  'leftUpperArm', 'leftLowerArm', 'leftHand', 'rightUpperArm', 'rightLowerArm', 'rightHand',
-  'leftUpperLeg', 'leftLowerLeg', 'leftFoot', 'rightUpperLeg', 'rightLowerLeg', 'rightFoot',
-];
-const L_THIGH = 11, L_SHIN = 12, L_FOOT = 13, R_THIGH = 14, R_FOOT = 16;
+/** The VRM humanoid bone each skeleton joint drives. */
+const BONE_OF: Record<(typeof JOINT_NAMES)[number], VRMHumanBoneName> = {
+  hip: 'hips', abdomen: 'spine', chest: 'chest', neck: 'neck', head: 'head',
+  lShldr: 'leftUpperArm', lForeArm: 'leftLowerArm', lHand: 'leftHand',
+  rShldr: 'rightUpperArm', rForeArm: 'rightLowerArm', rHand: 'rightHand',
+  lThigh: 'leftUpperLeg', lShin: 'leftLowerLeg', lFoot: 'leftFoot',
+  rThigh: 'rightUpperLeg', rShin: 'rightLowerLeg', rFoot: 'rightFoot',
+};
+/** The same, by joint index. */
+export const AVATAR_BONES: readonly VRMHumanBoneName[] = JOINT_NAMES.map((name) => BONE_OF[name]);
+const joint = (name: (typeof JOINT_NAMES)[number]) => JOINT_NAMES.indexOf(name);
+const L_THIGH = joint('lThigh'), L_SHIN = joint('lShin'), L_FOOT = joint('lFoot'), R_THIGH = joint('rThigh');
+
+/** Joint j of a 17 × 3 position array into `out`. */
+function jointAt(positions: ArrayLike<number>, j: number, out: THREE.Vector3): THREE.Vector3 {
+  return out.set(positions[3 * j], positions[3 * j + 1], positions[3 * j + 2]);
+}
 
 /** Why a file cannot be worn, in words for the page's message. */
 export class AvatarError extends Error {}
@@ -35,9 +46,7 @@ export class AvatarError extends Error {}
 const _q = new THREE.Quaternion();
 const _swing = new THREE.Quaternion();
 const _m = new THREE.Matrix4();
-const _x = new THREE.Vector3();
-const _y = new THREE.Vector3();
-const _z = new THREE.Vector3();
+const _w = new THREE.Vector3();
 const _u = new THREE.Vector3();
 const _v = new THREE.Vector3();
 const _p = new THREE.Vector3();
@@ -45,10 +54,6 @@ const _p = new THREE.Vector3();
 export class Avatar {
   /** What the stage draws in the dancer's place. */
   readonly group = new THREE.Group();
-  /** The worst angle, degrees, between an avatar bone as drawn and the dancer's bone, last pose. */
-  fitDeg = 0;
-  /** How far, cm, the avatar's ankles are from the dancer's ankle heights (scaled), last pose. */
-  feetCm = 0;
   private readonly nodes: (THREE.Object3D | null)[];
   private readonly raw: (THREE.Object3D | null)[];
   /** Per joint: the joint whose position the bone points at (the nearest one the avatar has too). */
@@ -69,6 +74,8 @@ export class Avatar {
   private readonly restLegs = new THREE.Vector3();
   private readonly avatarLeg: number;
   private scale = 1;
+  /** The dancer's joint positions of the last pose, for measure(). */
+  private readonly posed = new Float32Array(POSITIONS_SIZE);
 
   private constructor(readonly vrm: VRM, readonly name: string) {
     const { humanoid } = vrm;
@@ -144,15 +151,14 @@ export class Avatar {
    * alignment A_j and the height scale.
    */
   fit(bind: ArrayLike<number>): void {
-    const at = (j: number, out: THREE.Vector3) => out.set(bind[3 * j], bind[3 * j + 1], bind[3 * j + 2]);
     for (let j = 0; j < N_JOINTS; j++) {
       const t = this.target[j];
       this.align[j].identity();
       if (t < 0 || this.restDirection[j].lengthSq() === 0) continue;
-      at(t, _u).sub(at(j, _v)).normalize();
+      jointAt(bind, t, _u).sub(jointAt(bind, j, _v)).normalize();
       this.align[j].setFromUnitVectors(this.restDirection[j], _u);
     }
-    const ourLeg = at(L_SHIN, _u).distanceTo(at(L_THIGH, _v)) + at(L_FOOT, _u).distanceTo(at(L_SHIN, _v));
+    const ourLeg = jointAt(bind, L_SHIN, _u).distanceTo(jointAt(bind, L_THIGH, _v)) + jointAt(bind, L_FOOT, _u).distanceTo(jointAt(bind, L_SHIN, _v));
     this.scale = ourLeg > 1e-6 ? this.avatarLeg / ourLeg : 1;
   }
 
@@ -161,22 +167,15 @@ export class Avatar {
    * gives them); `dt` advances the avatar's own motion (spring bones: hair, skirts).
    */
   setPose(positions: ArrayLike<number>, rotations: ArrayLike<number>, dt: number): void {
-    const at = (j: number, out: THREE.Vector3) => out.set(positions[3 * j], positions[3 * j + 1], positions[3 * j + 2]);
     for (let j = 0; j < N_JOINTS; j++) {
       const node = this.nodes[j];
       if (!node) continue;
-      const o = 9 * j;
-      // Columns of the row-major matrix, made orthonormal (interpolated rotations drift a little).
-      _y.set(rotations[o + 1], rotations[o + 4], rotations[o + 7]).normalize();
-      _z.set(rotations[o + 2], rotations[o + 5], rotations[o + 8]);
-      _z.addScaledVector(_y, -_z.dot(_y)).normalize();
-      _x.crossVectors(_y, _z);
-      const h = this.world[j].setFromRotationMatrix(_m.makeBasis(_x, _y, _z)).multiply(this.align[j]);
+      const h = this.world[j].setFromRotationMatrix(jointRotation(rotations, j, _m)).multiply(this.align[j]);
       const t = this.target[j];
       if (t >= 0) {
         // Swing the bone onto where the dancer's joints are.
         _u.copy(this.restDirection[j]).applyQuaternion(h);
-        at(t, _v).sub(at(j, _p));
+        jointAt(positions, t, _v).sub(jointAt(positions, j, _p));
         if (_v.lengthSq() > 1e-12) h.premultiply(_swing.setFromUnitVectors(_u, _v.normalize()));
       }
       const p = this.parent[j];
@@ -186,15 +185,21 @@ export class Avatar {
       node.quaternion.copy(_q.multiply(h).multiply(this.rigRotation));
     }
     // The hips: the avatar's hip joints (the legs' tops) where the dancer's are, scaled in height.
-    at(L_THIGH, _u).add(at(R_THIGH, _v)).multiplyScalar(0.5);
+    jointAt(positions, L_THIGH, _u).add(jointAt(positions, R_THIGH, _v)).multiplyScalar(0.5);
     _u.y *= this.scale;
     _v.copy(this.restHips).sub(this.restLegs).applyQuaternion(this.world[0]);
     this.nodes[0]!.position.copy(_u.add(_v).applyMatrix4(this.rigRootInverse));
     this.vrm.update(dt);
-    this.measureFit(positions);
+    this.posed.set(positions);
   }
 
-  private measureFit(positions: ArrayLike<number>): void {
+  /**
+   * How well the last pose fits the dancer, as drawn: the worst angle, degrees, between an avatar
+   * bone and the dancer's, and how far, cm, its ankles are from the dancer's ankle heights scaled
+   * to its size. For tests (window.duet.avatars): not computed per frame.
+   */
+  measure(): { fitDeg: number; feetCm: number } {
+    const positions = this.posed;
     this.group.updateMatrixWorld(true);
     let worst = 0;
     for (let j = 0; j < N_JOINTS; j++) {
@@ -202,17 +207,16 @@ export class Avatar {
       const from = this.raw[j], to = t >= 0 ? this.raw[t] : null;
       if (!from || !to) continue;
       to.getWorldPosition(_u).sub(from.getWorldPosition(_v));
-      _p.set(positions[3 * t] - positions[3 * j], positions[3 * t + 1] - positions[3 * j + 1], positions[3 * t + 2] - positions[3 * j + 2]);
+      jointAt(positions, t, _p).sub(jointAt(positions, j, _w));
       if (_u.lengthSq() < 1e-12 || _p.lengthSq() < 1e-12) continue;
       worst = Math.max(worst, THREE.MathUtils.radToDeg(_u.angleTo(_p)));
     }
-    this.fitDeg = worst;
     let feet = 0;
-    for (const j of [L_FOOT, R_FOOT]) {
+    for (const j of FEET) {
       const foot = this.raw[j];
       if (foot) feet = Math.max(feet, Math.abs(foot.getWorldPosition(_u).y - positions[3 * j + 1] * this.scale));
     }
-    this.feetCm = 100 * feet;
+    return { fitDeg: worst, feetCm: 100 * feet };
   }
 
   dispose(): void {

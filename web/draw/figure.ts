@@ -393,12 +393,7 @@ export function poseBones(bind: Float32Array, positions: ArrayLike<number>, rota
   for (let j = 0; j < N_JOINTS; j++) {
     const child = PRIMARY_CHILD[j];
     if (rotations && rotations.length >= 9 * (j + 1)) {
-      const o = 9 * j;
-      // Columns of the row-major matrix, Gram-Schmidt: y first (the bone's up), then z, x = y × z.
-      _y.set(rotations[o + 1], rotations[o + 4], rotations[o + 7]);
-      _z.set(rotations[o + 2], rotations[o + 5], rotations[o + 8]);
-      orthonormalFrame(_y, _z);
-      _rotation.makeBasis(_x.crossVectors(_y, _z), _y, _z);
+      jointRotation(rotations, j, _rotation);
     } else if (child >= 0) {
       // Without rotations: the bind bone direction onto the actual one, bind forward (+z) onto the
       // body's facing.
@@ -443,6 +438,19 @@ export function poseBones(bind: Float32Array, positions: ArrayLike<number>, rota
     m.setPosition(positions[3 * j] - _v.x, positions[3 * j + 1] - _v.y, positions[3 * j + 2] - _v.z);
     out.set(m.elements, 16 * j);
   }
+}
+
+/**
+ * Joint j's world rotation from the simulation's row-major 3×3 matrices, made orthonormal
+ * (interpolated rotations are not quite): Gram-Schmidt on the columns, y first (the bone's up),
+ * then z, x = y × z. Shared with the avatars (avatar.ts).
+ */
+export function jointRotation(rotations: ArrayLike<number>, j: number, out: THREE.Matrix4): THREE.Matrix4 {
+  const o = 9 * j;
+  _y.set(rotations[o + 1], rotations[o + 4], rotations[o + 7]);
+  _z.set(rotations[o + 2], rotations[o + 5], rotations[o + 8]);
+  orthonormalFrame(_y, _z);
+  return out.makeBasis(_x.crossVectors(_y, _z), _y, _z);
 }
 
 /** p unit, q unit and perpendicular to p (q becomes any perpendicular when it runs along p). */

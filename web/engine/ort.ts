@@ -15,7 +15,7 @@ import { GLUE_URL, WASM_URL } from './wasm';
 // A static import, so that the page's import() of this module fetches onnxruntime's chunk with it
 // (Vite preloads a dynamic import's dependencies side by side), at main.ts's start, before the
 // wasm and the models fill the link. Imported inside this module (as it was), it was asked for
-// only once this module ran, 1.3-3.6 s into a first visit on the phone profile, behind them.
+// only once this module ran, 1.9-4.3 s into a first visit on the phone profile (four visits), behind them.
 bootMark('ort:imported');
 export { ort };
 

@@ -12,7 +12,7 @@ import { type ToastKind, showToast } from './toast';
 
 /** Bigger files are refused before reading (a 10-minute 120 fps take is ~30 MB). */
 export const MAX_BVH_BYTES = 64 * 1024 * 1024;
-/** The same for avatars (web/draw/avatar.ts): those made with VRoid Studio are 5-30 MB. */
+/** The same for avatars (web/draw/avatar.ts), which the page reads into memory whole. */
 export const MAX_AVATAR_BYTES = 100 * 1024 * 1024;
 /** Plausible standing height of a dancer, metres (foot to head along the bones). */
 const HEIGHT_RANGE: [number, number] = [0.5, 4];

@@ -352,7 +352,7 @@ class Page {
         throw error instanceof AvatarError ? new DuetError(`Cannot wear ${name}`, error.message) : error;
       });
       this.stage.dress(dancer, avatar);
-      hook.avatars = { ...hook.avatars, [dancer]: { name, get fitDeg() { return avatar.fitDeg; }, get feetCm() { return avatar.feetCm; } } };
+      hook.avatars = { ...hook.avatars, [dancer]: { name, get fitDeg() { return avatar.measure().fitDeg; }, get feetCm() { return avatar.measure().feetCm; } } };
       this.recordPanel.setDressed(true);
       showToast(dancer === 'leader' ? `You dance as ${name}` : `Your partner wears ${name}`, '“plain bodies again” in the panel takes it off.', 'info');
     } catch (error) {
