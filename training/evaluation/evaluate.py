@@ -44,7 +44,7 @@ from ..mirror import features as feat
 from . import metrics as M
 from .evaluate_inputs import EvalError, RecordingPolicy, find_models, load_eval_takes, load_onnx
 from .evaluate_report import write_markdown, write_report
-from .evaluate_rollouts import latents, mean_metrics, parse_condition, recorded, rollout, run_metrics
+from .evaluate_rollouts import FIGURE_KEYS, latents, mean_metrics, parse_condition, recorded, rollout, run_metrics
 from .evaluate_teacher_forced import codebook_errors, output_encoders, pose_positions, teacher_forced
 from .motion_matching import build, load_tracks, training_takes
 
@@ -175,12 +175,18 @@ def evaluate(args) -> dict:
                           "jitter": roll["jitter"], "hand_distance": roll["hand_distance"],
                           "rollout_mpjpe_cm": roll["mpjpe_cm"], "root_error_m": roll["root_error_m"],
                           "resets": roll["resets"], "implausible": roll.get("implausible"),
-                          "worst_second": roll.get("worst_second")}
+                          "worst_second": roll.get("worst_second"),
+                          **{k: v for k, v in roll.items() if k in FIGURE_KEYS or k[:-4] in FIGURE_KEYS}}
     if any(v is None for m, v in cb.items() if m != "ground_truth"):
         notes.append(f"codebook error is null where {eval_folder(args.models)} lacks the model's output encoder")
     notes.append("codebook error: the step model's own code at temperature 0 (the exported int8 file) against "
                  "the code its output encoder gives the recorded output (eval/NAME.output_encoder.onnx, fp32); "
                  "both files carry one training's fingerprint")
+    notes.append("figures (evaluation.figures): a turn is a net change of facing (shoulder and hip lines) of "
+                 "300 degrees within 2.5 s; spin frames turn faster than 300 deg/s; body motion is the mean "
+                 "joint speed relative to the hips, travel the hips' speed over the floor (0.5 s average); "
+                 "recall and precision match the follower's turns to the recorded follower's of the same "
+                 "direction within 0.75 s, beside the same played-back leader")
     notes.append("MPJPE: joint positions in the follower's own root space (teacher-forced: the t+1 pose of "
                  "the output; rollout: the generated pose vs the recording at the same frame). Foot skate: "
                  f"horizontal ankle motion per frame while the ankle is below {feat.CONTACT_HEIGHT} m. "

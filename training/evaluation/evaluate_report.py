@@ -39,6 +39,7 @@ def write_markdown(path: Path, res: dict) -> None:
         L.append(f"| {name} | {fmt(m.get('mpjpe_cm'))} | {fmt(m.get('diversity'))} | {fmt(m.get('fid'))} | "
                  f"{fmt(m.get('codebook_error'), 4)} | {fmt(m.get('foot_skate_cm'))} | {fmt(m.get('jitter'), 1)} | "
                  f"{fmt(m.get('hand_distance'))} | {pct(m.get('implausible'))} | {pct(m.get('worst_second'))} |")
+    L += figures_table(res)
     tf = res["protocols"]["teacher_forced"]
     if "motion_matching_oracle" in tf:
         L += ["", f"Motion Matching queried with the recorded follower future (the paper's MM query; "
@@ -72,6 +73,39 @@ def write_markdown(path: Path, res: dict) -> None:
                          f"{m['resets']}+{m['leader_resets']} |")
     L += ["", "## Notes", ""] + [f"- {n}" for n in res["notes"]]
     path.write_text("\n".join(L) + "\n")
+
+
+def figures_table(res: dict) -> list[str]:
+    """The salsa figures of the headline runs against the recording (evaluation.figures): each
+    rate with its ratio to the recorded follower's, and the lowest..highest seed."""
+    ref = res["methods"].get("ground_truth", {})
+    if "turns_per_min" not in ref:
+        return []
+
+    def cell(m, k, digits=2, share=False):
+        v = m.get(k)
+        if v is None:
+            return "n/a"
+        show = (lambda x: pct(x)) if share else (lambda x: fmt(x, digits))
+        text = show(v)
+        if ref.get(k) and k not in ("recall", "precision"):
+            text += f" ({v / ref[k]:.2f}×)"
+        if m.get(f"{k}_min") is not None and m.get(f"{k}_min") != m.get(f"{k}_max"):
+            text += f" [{show(m[f'{k}_min'])}..{show(m[f'{k}_max'])}]"
+        return text
+
+    L = ["", "## Salsa figures (b)", "",
+         "The follower's turns, spins, body motion and travel in the free-running runs beside the "
+         "played-back leader, as a ratio to the recorded follower's, with the lowest..highest seed "
+         "in brackets; recall and precision of its turns against the recorded follower's (same "
+         "direction, within 0.75 s).", "",
+         "| method | turns/min | spin frames % | body motion m/s | travel m/s | turn recall % | turn precision % |",
+         "|---|---|---|---|---|---|---|"]
+    for name, m in res["methods"].items():
+        L.append(f"| {name} | {cell(m, 'turns_per_min', 1)} | {cell(m, 'spin_frames', share=True)} | "
+                 f"{cell(m, 'body_motion')} | {cell(m, 'travel')} | {cell(m, 'recall', share=True)} | "
+                 f"{cell(m, 'precision', share=True)} |")
+    return L
 
 
 def clean(o):

@@ -11,6 +11,7 @@ import numpy as np
 from ..mirror import features as feat
 from ..mirror.features import FUTURE_OFFSETS, HISTORY, Track, follower_input, leader_input
 from ..mirror.rollout import NOW, Dancer, apply_output, output_is_absurd, reset_beside
+from . import figures as Fg
 from . import metrics as M
 from . import plausibility as P
 from .evaluate_inputs import EvalError, EvalTake, RecordingPolicy, window
@@ -145,13 +146,18 @@ def latents(encoder, r: dict) -> np.ndarray:
     return encoder(M.windows(M.motion_features(as_track(r), frames)))
 
 
+# The figure measures (figures.py) every run reports: pooled over the takes, then means over seeds
+# with the worst seed beside them (mean_metrics).
+FIGURE_KEYS = ["turns_per_min", "spin_frames", "body_motion", "travel", "recall", "precision"]
+
+
 def run_metrics(runs: list[dict], refs: list[dict], encoder, ref_latents: np.ndarray,
                 ranges: dict | None = None) -> dict:
     """Metrics of one run over all takes (frame-weighted means; FID and Diversity pooled). With
     the training takes' plausibility range (the manifest's), also the follower's plausibility:
     `implausible`, the share of frames with its body low, folded or split (plausibility.BODY_FLAGS),
     `angles_out`, and the worst second over the takes, since a mean pose error never shows a fall."""
-    per, weights, lat = [], [], []
+    per, weights, lat, figs = [], [], [], []
     for r, g in zip(runs, refs):
         idx = np.arange(HISTORY + 1, HISTORY + r["steps"] + 1)
         local = feat.to_root_space_points(r["positions"][idx], r["root"][idx][:, None], r["heading"][idx][:, None])
@@ -172,6 +178,7 @@ def run_metrics(runs: list[dict], refs: list[dict], encoder, ref_latents: np.nda
                            angles_out=float(flags["angles_out"].mean()), worst_second=P.worst_second(flags))
         weights.append(len(idx))
         lat.append(latents(encoder, r))
+        figs.append({**Fg.dancer(r["positions"][idx]), **Fg.against(r["positions"][idx], g["positions"][idx])})
     w = np.asarray(weights, float) / sum(weights)
     out = {k: float(sum(wi * p[k] for wi, p in zip(w, per))) for k in per[0]}
     if ranges is not None:
@@ -179,12 +186,20 @@ def run_metrics(runs: list[dict], refs: list[dict], encoder, ref_latents: np.nda
     lat = np.concatenate(lat)
     out["fid"] = M.fid(lat, ref_latents)
     out["diversity"] = M.diversity(lat)
+    fig = Fg.summarize(figs)
+    out.update({k: fig[k] for k in FIGURE_KEYS})
     out["resets"] = int(sum(r["resets"] for r in runs))
     out["leader_resets"] = int(sum(r["leader_resets"] for r in runs))
     return out
 
 
 def mean_metrics(items: list[dict]) -> dict:
-    """Means over seeds; the worst second stays the worst of them."""
-    return {k: float((np.max if k == "worst_second" else np.mean)([i[k] for i in items]))
-            for k in items[0] if k not in ("seed", "temperature")}
+    """Means over seeds; the worst second stays the worst of them, and each figure measure also
+    gets its lowest and highest seed (KEY_min, KEY_max): a mean alone hides a seed that never turns."""
+    out = {k: float((np.max if k == "worst_second" else np.nanmean)([i[k] for i in items]))
+           for k in items[0] if k not in ("seed", "temperature")}
+    for k in FIGURE_KEYS:
+        if k in items[0]:
+            v = [i[k] for i in items]
+            out[f"{k}_min"], out[f"{k}_max"] = float(np.nanmin(v)), float(np.nanmax(v))
+    return out
