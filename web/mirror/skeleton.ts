@@ -253,7 +253,12 @@ export function forwardKinematicsReduced(
 
 /** A BVH file as the page uses it: parsed, reduced to 17 joints, at 30 fps (first phase). */
 export function motionFromBvhText(text: string, source = '<bvh>'): Motion {
-  const motion = reduceBvh(parseBvh(text, source), source);
+  return motionFromBvh(parseBvh(text, source), source);
+}
+
+/** A parsed BVH reduced to 17 joints, at 30 fps (first phase). */
+export function motionFromBvh(bvh: Bvh, source = '<bvh>'): Motion {
+  const motion = reduceBvh(bvh, source);
   try {
     return resample(motion, FPS, 0);
   } catch (error) {

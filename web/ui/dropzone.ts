@@ -1,73 +1,55 @@
 // The leader from a BVH file: a file button (through the panel) and drag-and-drop anywhere on the
-// page. The file is read with motionFromBvhText (web/mirror/skeleton.ts) and handed to main.ts, which puts
-// it on the simulation (setLeaderPlayback). Anything that cannot be danced -- not a BVH, an empty
-// or broken one, another skeleton, a frame rate that is not a multiple of 30 -- becomes a toast:
-// a short visible message that goes away by itself. The page keeps running; window.duet.error is
-// for fatal errors only and stays untouched.
+// page. The file is read and checked by leaderMotionFromText (web/ui/leaderfile.ts: the one place
+// that says whether a file is a dance), in a worker so a big file does not stop the dance, and handed
+// to main.ts, which puts it on the simulation (setLeaderPlayback). Anything that cannot be danced --
+// not a BVH, an empty or broken one, another skeleton, a frame rate that is not a multiple of 30,
+// numbers no dancer could have recorded -- becomes a toast: a short visible message that goes away
+// by itself. The page keeps running; window.duet.error is for fatal errors only and stays untouched.
 
-import { BvhError } from '../mirror/bvh';
 import { DuetError } from './errors';
-import { FPS, JOINT_NAMES, type Motion, motionFromBvhText } from '../mirror/skeleton';
+import { FPS, type Motion } from '../mirror/skeleton';
+import { displayName, leaderMotionFromText } from './leaderfile';
 import { type ToastKind, showToast } from './toast';
+
+export { displayName, leaderMotionFromText };
 
 /** Bigger files are refused before reading (a 10-minute 120 fps take is ~30 MB). */
 export const MAX_BVH_BYTES = 64 * 1024 * 1024;
 /** The same for avatars (web/draw/avatar.ts), which the page reads into memory whole. */
 export const MAX_AVATAR_BYTES = 100 * 1024 * 1024;
-/** Plausible standing height of a dancer, metres (foot to head along the bones). */
-const HEIGHT_RANGE: [number, number] = [0.5, 4];
-const NAME_LENGTH = 60;
 
 // =================================================================================================
 // Reading a leader file
 
-/** A file name fit for a message: no control characters, not endless. */
-export function displayName(name: string): string {
-  const clean = name.replace(/[\u0000-\u001f\u007f]/g, '').trim() || 'the file';
-  return clean.length > NAME_LENGTH ? `${clean.slice(0, NAME_LENGTH - 1)}…` : clean;
-}
+/** What leaderfile.worker.ts answers to a File: the motion, or the message saying why not. */
+export type FromLeaderWorker = { motion: Motion; error?: undefined } | { motion?: undefined; error: { title: string; detail: string } };
 
-/** Foot-to-head length along the bones (metres): the reduced offsets of hip → lFoot and hip → head. */
-function boneHeight(offsets: Float64Array): number {
-  const length = (j: number) => Math.hypot(offsets[3 * j], offsets[3 * j + 1], offsets[3 * j + 2]);
-  const chain = (names: string[]) => names.reduce((sum, n) => sum + length(JOINT_NAMES.indexOf(n as (typeof JOINT_NAMES)[number])), 0);
-  return chain(['abdomen', 'chest', 'neck', 'head']) + chain(['lThigh', 'lShin', 'lFoot']);
-}
+/** The worker did not start (its script did not load): the page reads the file itself. */
+class NoWorker extends Error {}
 
-/**
- * A BVH text as a leader motion (30 fps, metres), or a DuetError whose title and detail say what is
- * wrong with the file in words a dancer understands.
- */
-export function leaderMotionFromText(text: string, fileName: string): Motion {
-  const name = displayName(fileName);
-  const title = `Cannot dance ${name}`;
-  if (text.trim() === '') throw new DuetError(title, 'The file is empty. Choose a BVH motion capture file.');
-  if (!text.trimStart().startsWith('HIERARCHY')) {
-    throw new DuetError(title, 'This is not a BVH file (a BVH starts with HIERARCHY). Choose a .bvh motion capture file.');
-  }
-  let motion: Motion;
-  try {
-    motion = motionFromBvhText(text, name);
-  } catch (error) {
-    const message = error instanceof Error ? error.message : String(error);
-    if (error instanceof BvhError && /lacks joint/.test(message)) {
-      throw new DuetError(title, `${message}. The leader needs the 17-joint dancer skeleton (${JOINT_NAMES.join(', ')}).`);
+/** Read, check and reduce the file in a worker; rejects with a DuetError, or NoWorker. */
+function readInWorker(file: File): Promise<Motion> {
+  return new Promise((resolve, reject) => {
+    let worker: Worker;
+    try {
+      worker = new Worker(new URL('./leaderfile.worker.ts', import.meta.url), { type: 'module', name: 'duet leader file' });
+    } catch (error) {
+      reject(new NoWorker(String(error)));
+      return;
     }
-    if (error instanceof BvhError && /resample/.test(message)) {
-      throw new DuetError(title, `${message}. Use a BVH at 30, 60 or 120 frames per second.`);
-    }
-    throw new DuetError(title, message);
-  }
-  if (motion.frames < 2) throw new DuetError(title, `The motion has ${motion.frames} frame at 30 fps; the leader needs at least 2.`);
-  for (let i = 0; i < motion.positions.length; i++) {
-    if (!Number.isFinite(motion.positions[i])) throw new DuetError(title, 'The motion holds numbers that are not finite (NaN or infinity).');
-  }
-  const height = boneHeight(motion.offsets);
-  if (!(height >= HEIGHT_RANGE[0] && height <= HEIGHT_RANGE[1])) {
-    throw new DuetError(title, `The skeleton is ${height.toPrecision(3)} m from foot to head; expected a dancer of ` +
-      `${HEIGHT_RANGE[0]}–${HEIGHT_RANGE[1]} m (units as in the CMU dance BVH files).`);
-  }
-  return motion;
+    worker.onmessage = (event: MessageEvent<FromLeaderWorker>) => {
+      worker.terminate();
+      const { motion, error } = event.data;
+      if (motion) resolve(motion);
+      else reject(new DuetError(error!.title, error!.detail));
+    };
+    worker.onerror = (event) => {
+      event.preventDefault();
+      worker.terminate();
+      reject(new NoWorker(event.message || 'the leader file worker did not start'));
+    };
+    worker.postMessage(file);
+  });
 }
 
 /** Read a dropped or chosen file as a leader motion; a DuetError says why not. */
@@ -76,6 +58,14 @@ export async function readLeaderFile(file: File): Promise<Motion> {
   if (file.size === 0) throw new DuetError(`Cannot dance ${name}`, 'The file is empty. Choose a BVH motion capture file.');
   if (file.size > MAX_BVH_BYTES) {
     throw new DuetError(`Cannot dance ${name}`, `The file is ${(file.size / 2 ** 20).toFixed(0)} MB; the page reads BVH files up to ${MAX_BVH_BYTES / 2 ** 20} MB.`);
+  }
+  if (typeof Worker === 'function') {
+    try {
+      return await readInWorker(file);
+    } catch (error) {
+      if (!(error instanceof NoWorker)) throw error;
+      // e.g. offline, before the worker's script was ever kept by the service worker: read it here.
+    }
   }
   let text: string;
   try {
