@@ -1,5 +1,7 @@
 // Steering input: arrow keys / WASD and a touch joystick, both relative to where the camera looks,
 // turned into one 2D vector on the floor (world x, z) of length 0..1. Space pauses, R resets.
+// The keys steer wherever the focus is (a button, a checkbox, the partner menu): only a text field
+// keeps its keys.
 
 import type { Steer } from '../engine/types';
 
@@ -39,8 +41,11 @@ export class Controls {
 
   constructor(private readonly options: ControlsOptions) {
     // Keys are read by physical position (event.code), so WASD works on AZERTY keyboards too.
-    window.addEventListener('keydown', (event) => this.onKeyDown(event));
-    window.addEventListener('keyup', (event) => this.pressed.delete(event.code));
+    // Read at the window in the capture phase, before any element sees them: lil-gui stops key
+    // events inside the panel from reaching the window, so after a click on a panel control the
+    // arrows did not steer (nor R reset, nor Space pause), and a key released there stayed held.
+    window.addEventListener('keydown', (event) => this.onKeyDown(event), { capture: true });
+    window.addEventListener('keyup', (event) => this.pressed.delete(event.code), { capture: true });
     // A key released while the window had no focus would otherwise steer forever.
     window.addEventListener('blur', () => this.pressed.clear());
 
@@ -92,14 +97,15 @@ export class Controls {
 
   private onKeyDown(event: KeyboardEvent): void {
     // Typing a number into the settings panel must not steer or reset.
-    const target = event.target as HTMLElement | null;
-    if (target && (target.tagName === 'INPUT' || target.tagName === 'SELECT' || target.tagName === 'TEXTAREA')) return;
-    if (event.ctrlKey || event.metaKey || event.altKey) return; // Ctrl+R still reloads
+    if (typesText(event.target)) return;
+    if (event.ctrlKey || event.metaKey || event.altKey) return; // Ctrl+R still reloads; Alt+Down opens a menu
     if (event.code in KEY_DIRECTIONS) {
       this.pressed.add(event.code);
-      event.preventDefault(); // arrows would scroll the page
-    } else if (event.code === 'Space') {
+      // Arrows would scroll the page, or change the partner in a focused (closed) menu. An open
+      // menu's list is a popup of its own: its keys never come here.
       event.preventDefault();
+    } else if (event.code === 'Space') {
+      event.preventDefault(); // a focused button or checkbox would be pressed too
       if (!event.repeat) this.options.onPause();
     } else if (event.code === 'KeyR' && !event.repeat) {
       this.options.onReset();
@@ -158,4 +164,35 @@ export class Controls {
     this.joystick.right = 0;
     this.base.classList.remove('visible');
   }
+}
+
+/** Whether keys typed at `target` are text: a text field keeps its keys (arrows, Space, R). */
+function typesText(target: EventTarget | null): boolean {
+  if (target instanceof HTMLTextAreaElement) return true;
+  if (target instanceof HTMLInputElement) return !NOT_TEXT.has(target.type);
+  return target instanceof HTMLElement && target.isContentEditable;
+}
+
+const NOT_TEXT = new Set(['button', 'checkbox', 'color', 'file', 'image', 'radio', 'range', 'reset', 'submit']);
+
+/**
+ * After a click or tap on a button or checkbox inside `root` (the panel, the buttons by the title),
+ * or a choice in one of its menus, give the focus back to the page: a control that keeps the focus
+ * after a click takes Enter (and, but for Controls, Space) as another press of itself. A click
+ * made with the keyboard (Enter on a control reached with Tab) leaves the focus where it is, so
+ * that Tab goes on from there.
+ */
+export function releaseFocusAfterUse(root: HTMLElement): void {
+  let pointer = false;
+  root.addEventListener('pointerdown', () => (pointer = true), { capture: true });
+  window.addEventListener('keydown', () => (pointer = false), { capture: true });
+  root.addEventListener('click', () => {
+    const active = document.activeElement;
+    // A click on a menu opens it: the menu keeps the focus until a choice is made ('change').
+    if (!pointer || !(active instanceof HTMLElement) || active === document.body || !root.contains(active)) return;
+    if (!typesText(active) && !(active instanceof HTMLSelectElement)) active.blur();
+  });
+  root.addEventListener('change', (event) => {
+    if (event.target instanceof HTMLSelectElement) event.target.blur();
+  });
 }

@@ -18,7 +18,7 @@ import { GLUE_URL } from '../engine/wasm';
 import { LoadingBar } from './loading';
 import { Stage } from '../draw/scene';
 import { readBodies } from '../draw/body';
-import { Controls } from './controls';
+import { Controls, releaseFocusAfterUse } from './controls';
 import { Hud } from './hud';
 import { Panel } from './panel';
 import { CompareLayout } from './compare';
@@ -178,6 +178,8 @@ class Page {
       onReset: () => this.reset(),
     });
     const panel = this.createPanel();
+    // After a click on a control the keys belong to the dance again (controls.ts).
+    releaseFocusAfterUse(document.body);
     this.viewCentre = new ViewCentre(panel.gui.domElement, () => !panel.gui._closed);
     if (this.stage.bodies === 'skinned') panel.gui.add(this.stage, 'skeleton').name('skeleton');
     this.recorder = new Recorder(MAX_RECORD_FRAMES, () =>

@@ -1,0 +1,211 @@
+// End-to-end: the keys always steer. After a click on any control of the settings panel (a
+// button, a checkbox, a slider, the partner menu, a folder's title) the arrow keys steer the
+// leader and Space pauses; no control catches Space or Enter by accident.
+// Run: node --test tests/e2e/controls.test.mjs   (needs /usr/bin/chromium and models in public/models/)
+//
+// Steering is measured in steps of the dance, not in wall time: 45 steps are 1.5 s of dance
+// however busy the machine is (a slow machine dances in slow motion: web/ui/main.ts).
+
+import { after, before, describe, test } from 'node:test';
+import assert from 'node:assert/strict';
+import { distance, duet, launch, sleep, startServer, waitReady, waitSteps } from './harness.mjs';
+
+/** 1.5 s of dance. */
+const STEER_STEPS = 45;
+/** Held for STEER_STEPS, ArrowUp walked the leader 1.7-2.6 m when writing this test; a key the
+ *  page never saw left it within 0.1 m. */
+const MIN_STEER_M = 1;
+
+let server;
+
+before(async () => {
+  server = await startServer({ mode: 'dev' });
+});
+
+after(async () => {
+  await server?.stop();
+});
+
+/** How far ArrowUp, held for STEER_STEPS steps, walks the leader (m), from wherever it is. */
+async function steerUp(page) {
+  const start = await duet(page);
+  await page.keyboard.down('ArrowUp');
+  try {
+    await waitSteps(page, STEER_STEPS);
+  } finally {
+    await page.keyboard.up('ArrowUp');
+  }
+  return distance(start.leader.root, (await duet(page)).leader.root);
+}
+
+/** What has focus, for messages. */
+const focused = (page) => page.evaluate(() => {
+  const e = document.activeElement;
+  if (!e || e === document.body) return 'the page';
+  return `${e.tagName.toLowerCase()} "${(e.textContent || '').trim().slice(0, 30)}"`;
+});
+
+const exactly = (text) => new RegExp(`^\\s*${text.replace(/[.*+?^${}()|[\]\\]/g, '\\$&')}\\s*$`);
+/** A real click, without waiting for the element to stand still for two frames first (slow with
+ *  software rendering): the panel does not move. */
+const FAST = { force: true };
+const controller = (page, name) => page.locator('.duet-panel .lil-controller').filter({ has: page.locator('.lil-name', { hasText: exactly(name) }) });
+const button = (page, name) => page.locator('.duet-panel button', { hasText: name }).first();
+const recording = (page) => page.locator('.record-status.recording').isVisible();
+
+/** Click a slider where its value already is: a click on the slider, the value unchanged. */
+async function clickSlider(page, row) {
+  const box = await row.locator('.lil-slider').boundingBox();
+  // lil-gui draws the value as the fill's share of the slider's width.
+  const share = await row.locator('.lil-fill').evaluate((fill) => fill.getBoundingClientRect().width / fill.parentElement.getBoundingClientRect().width);
+  await page.mouse.click(box.x + Math.max(1, Math.min(box.width - 1, share * box.width)), box.y + box.height / 2);
+}
+
+describe('desktop: a click in the panel leaves the keys steering', () => {
+  let browser;
+  let page;
+  const dialogs = [];
+
+  before(async () => {
+    browser = await launch({ viewport: { width: 1280, height: 800 }, permissions: ['clipboard-read', 'clipboard-write'] });
+    page = browser.page;
+    page.on('dialog', (dialog) => {
+      dialogs.push(dialog.message());
+      dialog.dismiss().catch(() => undefined);
+    });
+    // With a listener the file choosers ("leader from BVH file…", the avatar) never open.
+    page.on('filechooser', () => undefined);
+    // At double speed the 1.5 s of dance per check take less of the test's time.
+    await page.goto(`${server.url}?seed=1&speed=2`);
+    await waitReady(page, 60_000);
+    await waitSteps(page, 5);
+  });
+
+  after(async () => {
+    await browser?.close();
+  });
+
+  test('after a click on any panel control (or the help button), ArrowUp walks the leader ≥ 1 m in 1.5 s of dance', async () => {
+    const results = [];
+    const check = async (what) => {
+      const moved = await steerUp(page);
+      results.push({ what, moved, focus: await focused(page) });
+    };
+    const rows = await page.locator('.duet-panel .lil-controller').evaluateAll((rows) =>
+      rows.map((row) => ({
+        name: row.querySelector('.lil-name').textContent.trim(),
+        kind: ['function', 'boolean', 'option', 'number'].find((k) => row.classList.contains(`lil-${k}`)),
+        disabled: row.classList.contains('lil-disabled'),
+      })),
+    );
+    const skipped = [];
+    for (const { name, kind, disabled } of rows) {
+      const row = controller(page, name);
+      // Recording and its download have a test of their own (below); disabled buttons take no click.
+      if (disabled || /record|download/.test(name)) {
+        skipped.push(name);
+        continue;
+      }
+      if (kind === 'function') {
+        await row.locator('button').click(FAST);
+        await sleep(100);
+        await check(`button "${name}"`);
+      } else if (kind === 'boolean') {
+        await row.locator('input').click(FAST);
+        await check(`checkbox "${name}"`);
+        await row.locator('input').click(FAST); // back as it was
+      } else if (kind === 'option') {
+        // As a person does: click the menu, choose another partner, then the first one again.
+        const select = row.locator('select');
+        const first = await select.inputValue();
+        const other = await select.evaluate((s) => [...s.options].find((o) => !o.selected).value);
+        const model = (await duet(page)).model;
+        await select.click(FAST);
+        await select.selectOption(other);
+        await page.waitForFunction((m) => window.duet.model !== m, model, { timeout: 30_000 });
+        await select.click(FAST);
+        await select.selectOption(first);
+        await page.waitForFunction(() => window.duet.model === 'ours', null, { timeout: 30_000 });
+        await waitSteps(page, 3);
+        await check(`menu "${name}"`);
+        assert.equal((await duet(page)).model, 'ours', 'the arrow keys did not change the partner');
+      } else if (kind === 'number') {
+        await clickSlider(page, row);
+        await check(`slider "${name}"`);
+        if (name === 'variety') {
+          // Its text field keeps the keys while it has them; Enter gives them back.
+          await row.locator('input').click(FAST);
+          await page.keyboard.press('Enter');
+          await check(`text field "${name}", then Enter`);
+        }
+      }
+    }
+    const report = () => {
+      const failed = results.filter((r) => r.moved < MIN_STEER_M);
+      assert.deepEqual(
+        failed.map((r) => `after ${r.what}: ${r.moved.toFixed(2)} m (focus on ${r.focus})`),
+        [],
+        `ArrowUp walked ${results.map((r) => r.moved.toFixed(2)).join(', ')} m; skipped here: ${skipped.join(', ')}`,
+      );
+    };
+    report();
+    const names = rows.map((r) => r.name);
+    for (const expected of ['partner', 'variety', 'speed', 'possible reactions', 'floor paths', 'show what the partner expects', 'start again (R)', 'copy link to this view', 'skeleton']) {
+      assert.ok(names.includes(expected), `the panel has "${expected}" (it has ${names.join(', ')})`);
+    }
+
+    // Folding a folder and the whole panel, and unfolding them again.
+    for (const title of ['record · play a file', 'settings']) {
+      const bar = page.locator('.duet-panel .lil-title', { hasText: title }).first();
+      await bar.click(FAST);
+      await sleep(400);
+      await bar.click(FAST);
+      await sleep(400);
+      await check(`title "${title}", twice`);
+    }
+    // The help's "?" by the title, and its "×".
+    await page.locator('.help-button').click(FAST);
+    await page.locator('.help-close').click(FAST);
+    await check('help "?", then "×"');
+    report();
+    assert.deepEqual(dialogs, [], 'no dialog');
+  });
+
+  test('after "● record", Space pauses and resumes the dance and the recording goes on; Enter presses nothing', async () => {
+    await button(page, '● record').click(FAST);
+    await page.locator('.record-status.recording').waitFor({ state: 'visible', timeout: 5000 });
+    await page.keyboard.press('Space');
+    await sleep(300);
+    const paused = await duet(page);
+    assert.equal(paused.paused, true, `Space did not pause (focus on ${await focused(page)})`);
+    assert.ok(await recording(page), 'Space stopped the recording');
+    await sleep(1000);
+    assert.equal((await duet(page)).frame, paused.frame, 'no step while paused');
+    await page.keyboard.press('Space');
+    await waitSteps(page, 5);
+    assert.equal((await duet(page)).paused, false, 'a second Space resumes');
+    assert.ok(await recording(page), 'still recording after the second Space');
+    await page.keyboard.press('Enter');
+    await sleep(300);
+    assert.ok(await recording(page), 'Enter stopped the recording');
+    const moved = await steerUp(page);
+    assert.ok(moved >= MIN_STEER_M, `after "● record": ArrowUp walked ${moved.toFixed(2)} m`);
+    assert.ok(await recording(page), 'steering stopped the recording');
+
+    await button(page, '■ stop recording').click(FAST);
+    await page.locator('.record-status', { hasText: 'not downloaded' }).waitFor({ state: 'visible', timeout: 5000 });
+    const afterStop = await steerUp(page);
+    assert.ok(afterStop >= MIN_STEER_M, `after "■ stop recording": ArrowUp walked ${afterStop.toFixed(2)} m`);
+    const downloads = [];
+    page.on('download', (d) => downloads.push(d));
+    await button(page, 'download BVH').click(FAST);
+    const afterDownload = await steerUp(page);
+    assert.ok(afterDownload >= MIN_STEER_M, `after "download BVH": ArrowUp walked ${afterDownload.toFixed(2)} m`);
+    assert.equal(downloads.length, 2, 'one BVH file per dancer');
+    assert.deepEqual(dialogs, [], 'no "Start a new take?" or any other dialog');
+  });
+
+  test('no console errors', () => {
+    assert.deepEqual(browser.consoleErrors, []);
+  });
+});
