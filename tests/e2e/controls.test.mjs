@@ -1,6 +1,7 @@
 // End-to-end: the keys always steer. After a click on any control of the settings panel (a
 // button, a checkbox, a slider, the partner menu, a folder's title) the arrow keys steer the
-// leader and Space pauses; no control catches Space or Enter by accident.
+// leader and Space pauses; no control catches Space or Enter by accident. The address keeps every
+// setting as it changes, and a link brings them all back.
 // Run: node --test tests/e2e/controls.test.mjs   (needs /usr/bin/chromium and models in public/models/)
 //
 // Steering is measured in steps of the dance, not in wall time: 45 steps are 1.5 s of dance
@@ -207,5 +208,115 @@ describe('desktop: a click in the panel leaves the keys steering', () => {
 
   test('no console errors', () => {
     assert.deepEqual(browser.consoleErrors, []);
+  });
+});
+
+function assertCamera(camera, expected, when) {
+  assert.ok(camera, `${when}: window.duet.camera`);
+  const turn = Math.abs(((camera.azimuth - expected.azimuth + 540) % 360) - 180);
+  assert.ok(turn < 0.5 && Math.abs(camera.polar - expected.polar) < 0.5 && Math.abs(camera.distance - expected.distance) < 0.05,
+    `${when}: camera ${JSON.stringify(camera)}, expected ${JSON.stringify(expected)}`);
+}
+
+describe('the address keeps every setting', () => {
+  let browser;
+
+  before(async () => {
+    browser = await launch({ viewport: { width: 1280, height: 800 } });
+  });
+
+  after(async () => {
+    await browser?.close();
+  });
+
+  /** Every panel control's value as shown: menus by their label, checkboxes, numbers. */
+  const shown = (page) => page.locator('.duet-panel .lil-controller').evaluateAll((rows) =>
+    Object.fromEntries(rows.flatMap((row) => {
+      const name = row.querySelector('.lil-name').textContent.trim();
+      const select = row.querySelector('select');
+      const input = row.querySelector('input');
+      if (select) return [[name, select.selectedOptions[0]?.textContent]];
+      if (input?.type === 'checkbox') return [[name, input.checked]];
+      if (input) return [[name, Number(input.value)]];
+      return [];
+    })));
+  const query = (page) => page.evaluate(() => Object.fromEntries(new URLSearchParams(location.search)));
+
+  /** The address once `key` in it has the value `value` (waits up to 3 s; then the assert says what it is). */
+  async function expectInAddress(page, key, value, after) {
+    const deadline = Date.now() + 3000;
+    let now = await query(page);
+    while (now[key] !== value && Date.now() < deadline) {
+      await sleep(100);
+      now = await query(page);
+    }
+    assert.equal(now[key], value, `after ${after}, the address is ?${new URLSearchParams(now)}`);
+  }
+
+  test('each change is written to the address (one history entry), and the address brings every setting back', async () => {
+    const { page } = browser;
+    // ?ref is not a setting of the page: it must stay as it is.
+    await page.goto(`${server.url}?seed=5&ref=notes`);
+    await waitReady(page, 60_000);
+    const entries = await page.evaluate(() => history.length);
+
+    await controller(page, 'partner').locator('select').selectOption({ label: 'baseline, no intention' });
+    await expectInAddress(page, 'model', 'ccm', 'choosing the baseline partner');
+    const ghosts = controller(page, 'possible reactions').locator('input');
+    await ghosts.fill('3');
+    await ghosts.press('Enter');
+    await expectInAddress(page, 'ghosts', '3', 'typing 3 possible reactions');
+    const speed = controller(page, 'speed').locator('input');
+    await speed.fill('1.5');
+    await speed.press('Enter');
+    await expectInAddress(page, 'speed', '1.5', 'typing speed 1.5');
+    const variety = controller(page, 'variety').locator('input');
+    await variety.fill('0.35');
+    await variety.press('Enter');
+    await expectInAddress(page, 'temperature', '0.35', 'typing variety 0.35');
+    await controller(page, 'floor paths').locator('input').click(FAST);
+    await expectInAddress(page, 'trajectories', '0', 'turning floor paths off');
+    await controller(page, 'show what the partner expects').locator('input').click(FAST);
+    await expectInAddress(page, 'intentions', '1', 'turning the expectations on');
+    await controller(page, 'skeleton').locator('input').click(FAST);
+    await expectInAddress(page, 'skeleton', '1', 'turning the skeleton on');
+    // The camera: a drag turns it; the address has its place once the glide after it is over.
+    await page.mouse.move(640, 420);
+    await page.mouse.down();
+    await page.mouse.move(800, 380, { steps: 8 });
+    await page.mouse.up();
+    const place = ({ azimuth, polar, distance }) => [azimuth, polar, distance].map((v) => String(Number(v.toFixed(1)))).join(',');
+    // OrbitControls' glide is counted in frames: with software rendering on a busy machine it
+    // can take many seconds.
+    let camera = null;
+    let address = await query(page);
+    let link = page.url();
+    for (const deadline = Date.now() + 30_000; Date.now() < deadline; address = await query(page)) {
+      link = page.url();
+      camera = (await duet(page)).camera;
+      if (address.camera === place(camera)) break;
+      await sleep(200);
+    }
+    assert.equal(address.camera, place(camera), `after a drag, the address is ?${new URLSearchParams(address)}`);
+    assert.equal(address.ref, 'notes', 'a parameter the page does not set stays');
+    assert.equal(address.seed, '5', 'the seed stays');
+    assert.equal(await page.evaluate(() => history.length), entries, 'no new history entries: the address is replaced, not pushed');
+
+    const settings = await shown(page);
+    await page.close();
+    // The link, opened afresh in another tab.
+    const second = await browser.context.newPage();
+    const errors = [];
+    second.on('pageerror', (error) => errors.push(String(error)));
+    second.on('console', (message) => message.type() === 'error' && errors.push(message.text()));
+    await second.goto(link);
+    await waitReady(second, 60_000);
+    await waitSteps(second, 3);
+    assert.deepEqual(await shown(second), settings, `the link ${link} shows the same panel`);
+    const state = await duet(second);
+    assert.equal(state.model, 'ccm');
+    const round = (v) => Math.round(v * 10) / 10; // the link's precision
+    assertCamera(state.camera, { azimuth: round(camera.azimuth), polar: round(camera.polar), distance: round(camera.distance) }, 'the link');
+    assert.deepEqual([...browser.consoleErrors, ...errors], []);
   });
 });

@@ -2,7 +2,7 @@
 // unknown, non-numeric or carrying markup leaves the default in place.
 
 import { describe, expect, it } from 'vitest';
-import { LIMITS, type Settings, defaultSettings, readCamera, readSettings, writeSettings } from '../../web/ui/share';
+import { LIMITS, type Settings, addressQuery, defaultSettings, readCamera, readSettings, writeSettings } from '../../web/ui/share';
 
 const defaults: Settings = { ...defaultSettings(0.5), seed: 42 };
 const read = (search: string) => readSettings(search, defaults);
@@ -21,7 +21,7 @@ describe('readSettings', () => {
   });
 
   it('reads valid values', () => {
-    const s = read('?model=compare&temperature=0.8&seed=123&ghosts=3&speed=2&trajectories=0&intentions=1&camera=30,40,6');
+    const s = read('?model=compare&temperature=0.8&seed=123&ghosts=3&speed=2&trajectories=0&intentions=1&skeleton=1&camera=30,40,6');
     expect(s.model).toBe('compare');
     expect(s.temperature).toBe(0.8);
     expect(s.seed).toBe(123);
@@ -29,6 +29,7 @@ describe('readSettings', () => {
     expect(s.speed).toBe(2);
     expect(s.trajectories).toBe(false);
     expect(s.intentions).toBe(true);
+    expect(s.skeleton).toBe(true);
     expect(s.camera).toEqual({ azimuth: 30, polar: 40, distance: 6 });
   });
 
@@ -106,7 +107,7 @@ describe('readCamera', () => {
 
 describe('writeSettings', () => {
   it('round-trips through readSettings', () => {
-    const settings: Settings = { ...defaults, model: 'ccm', temperature: 1.25, seed: 7, ghosts: 4, speed: 0.5, trajectories: false, intentions: true };
+    const settings: Settings = { ...defaults, model: 'ccm', temperature: 1.25, seed: 7, ghosts: 4, speed: 0.5, trajectories: false, intentions: true, skeleton: true };
     const camera = { azimuth: 12.34, polar: 45, distance: 5.5 };
     const query = writeSettings(settings, camera, defaults.temperature);
     const back = read(`?${query}`);
@@ -118,5 +119,27 @@ describe('writeSettings', () => {
 
   it('writes only what differs from a fresh visit, plus the seed', () => {
     expect(writeSettings(defaults, null, defaults.temperature)).toBe('seed=42');
+  });
+});
+
+describe('addressQuery', () => {
+  const changed: Settings = { ...defaults, model: 'compare', ghosts: 2, skeleton: true };
+
+  it('writes every setting that differs from a fresh visit, and reads back the same', () => {
+    const query = addressQuery('', changed, { azimuth: 90, polar: 60, distance: 4 }, defaults.temperature);
+    expect(Object.fromEntries(new URLSearchParams(query))).toEqual({ model: 'compare', seed: '42', camera: '90,60,4', ghosts: '2', skeleton: '1' });
+    expect({ ...read(`?${query}`), camera: null }).toEqual({ ...changed, camera: null });
+  });
+
+  it('replaces the settings it owns and keeps every other parameter', () => {
+    const query = new URLSearchParams(addressQuery('?threads=1&model=ccm&bodies=sticks&skeleton=1&camera=1,2,3', { ...defaults, ghosts: 2 }, null, defaults.temperature));
+    expect(query.get('threads')).toBe('1');
+    expect(query.get('bodies')).toBe('sticks');
+    expect(query.get('ghosts')).toBe('2');
+    // Back to their defaults: gone from the address.
+    expect(query.has('model')).toBe(false);
+    expect(query.has('skeleton')).toBe(false);
+    expect(query.has('camera')).toBe(false);
+    expect(query.getAll('seed')).toEqual(['42']);
   });
 });

@@ -174,6 +174,9 @@ export interface DuetHook {
   download?: { loaded: number; total: number };
   /** How the dancers are drawn: skinned characters, or capsule figures (?bodies=sticks). */
   bodies?: 'skinned' | 'sticks';
+  /** Where the camera is (read when asked): degrees around, degrees down from above, metres from
+   *  the pair's midpoint (web/draw/scene.ts CameraOrbit). */
+  camera?: { azimuth: number; polar: number; distance: number };
   /** Frames drawn so far (animation frames that drew nothing are not counted). */
   drawn?: number;
   /** When each stage of the start happened, ms since navigation (web/engine/boot.ts). */

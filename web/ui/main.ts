@@ -16,14 +16,14 @@ import { standingViews } from '../engine/standing';
 import { assetVersion, keepForOffline, registerOffline } from '../engine/offline';
 import { GLUE_URL } from '../engine/wasm';
 import { LoadingBar } from './loading';
-import { Stage } from '../draw/scene';
+import { DEFAULT_ORBIT, Stage } from '../draw/scene';
 import { readBodies } from '../draw/body';
 import { Controls, releaseFocusAfterUse } from './controls';
 import { Hud } from './hud';
 import { Panel } from './panel';
 import { CompareLayout } from './compare';
 import { ViewCentre } from './layout';
-import { LIMITS, type Settings, copyLink, defaultSettings, readSettings, writeSettings } from './share';
+import { LIMITS, type Settings, addressQuery, copyLink, defaultSettings, formatCamera, readSettings } from './share';
 import { FPS, type Motion } from '../mirror/skeleton';
 import { KEYS, N_KEY_JOINTS } from '../mirror/features';
 import { DancerTrack } from '../draw/interpolation';
@@ -49,6 +49,11 @@ const MAX_GHOSTS = LIMITS.ghosts[1];
 const WORKER_START_WAIT_MS = 300;
 const WARM_UP_DELAY_MS = 500;
 const PAUSED_STATUS = 'paused — Space to resume';
+/** After a drag the camera glides on (OrbitControls' damping, counted in frames: seconds at a low
+ *  frame rate). Its place is checked this often, and goes to the address when it changed, until
+ *  it stood still for CAMERA_STILL_CHECKS checks. */
+const CAMERA_CHECK_MS = 300;
+const CAMERA_STILL_CHECKS = 10;
 /** Each model gets its own noise stream, all derived from the one seed in the URL. */
 const MODEL_NAMES = ['leader', 'follower', 'follower_ccm'];
 
@@ -124,11 +129,17 @@ class Page {
   /** Steps, resets and model switches must not overlap: they all go through this queue. */
   private queue: Promise<void> = Promise.resolve();
   private leaderFile: { motion: Motion; name: string } | null = null;
+  /** The camera's place as the address last had it, checks since it last moved, and the timer. */
+  private cameraPlace = '';
+  private cameraStill = 0;
+  private cameraCheck = 0;
 
   // Set once the runtime has loaded.
   private createSimulation: CreateSimulation | null = null;
   private createPolicy: Runtime[1]['createPolicy'] | null = null;
   private readonly policies = new Map<string, Promise<Policy>>();
+  /** Sessions are made (and warmed up) one at a time: see policy(). */
+  private sessions: Promise<unknown> = Promise.resolve();
 
   // The display rate, for the HUD.
   private frames = 0;
@@ -153,13 +164,14 @@ class Page {
     // Skinned characters unless ?bodies=sticks (the bench compares both); ?skeleton=1 overlays the bones.
     const look = readBodies(location.search);
     bootMark('stage:start');
-    this.stage = new Stage(document.getElementById('app')!, manifest.skeleton.parents, MAX_GHOSTS, { ...look, offsets: manifest.skeleton.offsets });
+    this.stage = new Stage(document.getElementById('app')!, manifest.skeleton.parents, MAX_GHOSTS, { ...look, skeleton: this.settings.skeleton, offsets: manifest.skeleton.offsets });
     bootMark('stage:end'); // the renderer and the dancers' bodies: most of the loading scene's own work
     hook.bodies = this.stage.bodies;
     for (const dancer of ['leader', 'follower'] as const) {
       const stage = this.stage;
       Object.defineProperty(hook[dancer], 'screen', { enumerable: true, get: () => stage.screenPoint(dancer) });
     }
+    Object.defineProperty(hook, 'camera', { enumerable: true, get: () => this.stage.getOrbit() });
     if (this.settings.camera) this.stage.setOrbit(this.settings.camera);
     this.still = standingViews(manifest);
     this.leader.capture(this.still.leader, true);
@@ -181,7 +193,12 @@ class Page {
     // After a click on a control the keys belong to the dance again (controls.ts).
     releaseFocusAfterUse(document.body);
     this.viewCentre = new ViewCentre(panel.gui.domElement, () => !panel.gui._closed);
-    if (this.stage.bodies === 'skinned') panel.gui.add(this.stage, 'skeleton').name('skeleton');
+    // A drag or a wheel turn moved the camera: the address follows it until it stands still.
+    this.stage.controls.addEventListener('end', () => {
+      clearTimeout(this.cameraCheck);
+      this.cameraStill = 0;
+      this.watchCamera();
+    });
     this.recorder = new Recorder(MAX_RECORD_FRAMES, () =>
       showToast('Recording stopped', `It reached the ${formatDuration(MAX_RECORD_FRAMES / FPS)} limit. Download the take (“download BVH”).`, 'error', 15_000));
     this.leaderFileInput = new LeaderFileInput({
@@ -224,6 +241,8 @@ class Page {
       onGhosts: () => this.exclusive(() => this.refreshGhosts()).catch(this.fail),
       onReset: () => this.reset(),
       onShare: () => this.share(),
+      onSkeleton: this.stage.bodies === 'skinned' ? (on) => (this.stage.skeleton = on) : undefined,
+      onSettingsChange: () => this.writeAddress(),
       details: this.hud.details,
     });
   }
@@ -281,12 +300,45 @@ class Page {
     this.hud.setStatus(this.status());
   }
 
+  /** Write the camera's place to the address whenever it moved, until it has stood still a while. */
+  private readonly watchCamera = (): void => {
+    const place = formatCamera(this.stage.getOrbit());
+    if (place !== this.cameraPlace) {
+      this.cameraStill = 0;
+      this.writeAddress();
+    }
+    if (++this.cameraStill < CAMERA_STILL_CHECKS) this.cameraCheck = window.setTimeout(this.watchCamera, CAMERA_CHECK_MS);
+  };
+
+  /**
+   * Write the settings and the camera into the page's address (replaceState: one history entry
+   * however many changes), so that the address bar is always a link to this view. The camera only
+   * once it was moved from the first view. Returns the address.
+   */
+  private writeAddress(): string {
+    const orbit = this.stage.getOrbit();
+    this.cameraPlace = formatCamera(orbit);
+    const camera = this.cameraPlace === formatCamera(DEFAULT_ORBIT) ? null : orbit;
+    const query = addressQuery(location.search, this.settings, camera, this.defaults.temperature);
+    const url = `${location.origin}${location.pathname}?${query}${location.hash}`;
+    history.replaceState(history.state, '', url);
+    return url;
+  }
+
   /** One model's policy, created once. */
   private policy(name: string): Promise<Policy> {
     let loading = this.policies.get(name);
     if (!loading) {
       const seed = (this.settings.seed + MODEL_NAMES.indexOf(name) * 0x9e3779b9) >>> 0;
-      loading = this.fetcher.model(name).then((bytes) => bootSpan(`session:${name}`, () => this.createPolicy!(this.manifest, name, bytes, seed))).then((p) => {
+      // The downloads run side by side, the sessions are made one after another: with two made at
+      // once (a link with ?model=ccm or compare starts the leader's and the baseline's together)
+      // a warm-up run inside onnxruntime-web came back without its outputs ("Cannot read
+      // properties of null (reading '3')") on most loads of such a link.
+      loading = this.fetcher.model(name).then((bytes) => {
+        const created = this.sessions.then(() => bootSpan(`session:${name}`, () => this.createPolicy!(this.manifest, name, bytes, seed)));
+        this.sessions = created.catch(() => undefined);
+        return created;
+      }).then((p) => {
         hook.modelBytes += p.entry.bytes;
         return p;
       });
@@ -317,11 +369,9 @@ class Page {
     this.ghostPoses = simulation && settings.ghosts > 0 ? await simulation.ghosts(settings.ghosts) : [];
   }
 
-  /** Write the settings into the URL and copy it. */
+  /** Write the settings into the address and copy it. */
   private async share(): Promise<void> {
-    const query = writeSettings(this.settings, this.stage.getOrbit(), this.defaults.temperature);
-    const url = `${location.origin}${location.pathname}?${query}`;
-    history.replaceState(null, '', url);
+    const url = this.writeAddress();
     if (await copyLink(url)) {
       this.hud.setStatus('link copied');
       setTimeout(() => this.hud.setStatus(this.status()), 2000);

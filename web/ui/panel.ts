@@ -17,6 +17,10 @@ export interface PanelOptions {
   onGhosts(count: number): void;
   onReset(): void;
   onShare(): void;
+  /** Shows or hides the skeleton; without it (capsule figures) the panel has no skeleton switch. */
+  onSkeleton?(on: boolean): void;
+  /** A setting has its new value (a slider let go, a number typed, a box ticked, a menu chosen). */
+  onSettingsChange(): void;
   /** Live engine figures (the HUD's details line): shown inside the help's "about / details" fold. */
   details?: HTMLElement;
 }
@@ -84,6 +88,11 @@ export class Panel {
     this.gui.add(settings, 'intentions').name(label('intentions'));
     this.gui.add({ reset: options.onReset }, 'reset').name(label('reset'));
     this.gui.add({ share: options.onShare }, 'share').name(label('share'));
+    const onSkeleton = options.onSkeleton;
+    if (onSkeleton) this.gui.add(settings, 'skeleton').name(label('skeleton')).onChange((on: boolean) => onSkeleton(on));
+    // Every setting goes to the address once it has its value: not on every step of a slider's
+    // drag, which would write the address dozens of times a second.
+    this.gui.onFinishChange(() => options.onSettingsChange());
 
     this.help = new Help({
       controls: Object.values(CONTROLS),

@@ -1,6 +1,7 @@
 // Settings <-> URL query, so a link reproduces what someone saw: follower model, temperature,
 // sampling seed, camera, and the view options. Every value from the URL is parsed, validated and
-// clamped here; nothing from it ever reaches the page as markup.
+// clamped here; nothing from it ever reaches the page as markup. The page writes the settings into
+// its own address as they change (addressQuery), so the address bar is always such a link.
 
 import type { FollowerChoice } from '../engine/types';
 import type { CameraOrbit } from '../draw/scene';
@@ -14,6 +15,8 @@ export interface Settings {
   speed: number;
   trajectories: boolean;
   intentions: boolean;
+  /** The thin bones over the shaded bodies. */
+  skeleton: boolean;
   /** WASM threads; null = as many as the page may use (for the bench: ?threads=1). */
   threads: number | null;
 }
@@ -27,6 +30,9 @@ export const LIMITS = {
   threads: [1, 2],
 } as const;
 
+/** The query keys the settings own; addressQuery replaces these and keeps any other. */
+const KEYS = ['model', 'temperature', 'seed', 'camera', 'ghosts', 'speed', 'trajectories', 'intentions', 'skeleton'];
+
 const MODELS: readonly FollowerChoice[] = ['ours', 'ccm', 'compare'];
 
 export function defaultSettings(defaultTemperature: number): Settings {
@@ -39,6 +45,7 @@ export function defaultSettings(defaultTemperature: number): Settings {
     speed: 1,
     trajectories: true,
     intentions: false,
+    skeleton: false,
     threads: null,
   };
 }
@@ -54,6 +61,7 @@ export function readSettings(search: string, defaults: Settings): Settings {
   settings.speed = readNumber(query.get('speed'), LIMITS.speed, settings.speed);
   settings.trajectories = readBoolean(query.get('trajectories'), settings.trajectories);
   settings.intentions = readBoolean(query.get('intentions'), settings.intentions);
+  settings.skeleton = readBoolean(query.get('skeleton'), settings.skeleton);
   const seed = query.get('seed');
   if (seed !== null && /^\d{1,10}$/.test(seed) && Number(seed) <= 0xffffffff) settings.seed = Number(seed);
   const threads = query.get('threads');
@@ -68,12 +76,29 @@ export function writeSettings(settings: Settings, camera: CameraOrbit | null, de
   if (settings.model !== 'ours') query.set('model', settings.model);
   if (settings.temperature !== defaultTemperature) query.set('temperature', round(settings.temperature, 3));
   query.set('seed', String(settings.seed));
-  if (camera) query.set('camera', [camera.azimuth, camera.polar, camera.distance].map((v) => round(v, 1)).join(','));
+  if (camera) query.set('camera', formatCamera(camera));
   if (settings.ghosts) query.set('ghosts', String(settings.ghosts));
   if (settings.speed !== 1) query.set('speed', round(settings.speed, 2));
   if (!settings.trajectories) query.set('trajectories', '0');
   if (settings.intentions) query.set('intentions', '1');
+  if (settings.skeleton) query.set('skeleton', '1');
   return query.toString();
+}
+
+/**
+ * The page's query `search` with the settings written in (writeSettings), every other parameter
+ * (?threads=1, ?bodies=sticks, anything a link carried) kept as it was.
+ */
+export function addressQuery(search: string, settings: Settings, camera: CameraOrbit | null, defaultTemperature: number): string {
+  const query = new URLSearchParams(search);
+  for (const key of KEYS) query.delete(key);
+  for (const [key, value] of new URLSearchParams(writeSettings(settings, camera, defaultTemperature))) query.append(key, value);
+  return query.toString();
+}
+
+/** "azimuth,polar,distance" as a link writes it (degrees, degrees, metres; 0.1 apart). */
+export function formatCamera(camera: CameraOrbit): string {
+  return [camera.azimuth, camera.polar, camera.distance].map((v) => round(v, 1)).join(',');
 }
 
 /** "azimuth,polar,distance" in degrees, degrees, metres. */
