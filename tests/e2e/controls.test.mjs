@@ -1,7 +1,8 @@
 // End-to-end: the keys always steer. After a click on any control of the settings panel (a
 // button, a checkbox, a slider, the partner menu, a folder's title) the arrow keys steer the
 // leader and Space pauses; no control catches Space or Enter by accident. The address keeps every
-// setting as it changes, and a link brings them all back.
+// setting as it changes, and a link brings them all back. On a phone: the pause button, "reset
+// view", and camera limits that keep the pair in view whatever two fingers do.
 // Run: node --test tests/e2e/controls.test.mjs   (needs /usr/bin/chromium and models in public/models/)
 //
 // Steering is measured in steps of the dance, not in wall time: 45 steps are 1.5 s of dance
@@ -16,6 +17,8 @@ const STEER_STEPS = 45;
 /** Held for STEER_STEPS, ArrowUp walked the leader 1.7-2.6 m when writing this test; a key the
  *  page never saw left it within 0.1 m. */
 const MIN_STEER_M = 1;
+/** DEFAULT_ORBIT in web/draw/scene.ts. */
+const DEFAULT_CAMERA = { azimuth: 35, polar: 70, distance: 5.2 };
 
 let server;
 
@@ -86,7 +89,7 @@ describe('desktop: a click in the panel leaves the keys steering', () => {
     await browser?.close();
   });
 
-  test('after a click on any panel control (or the help button), ArrowUp walks the leader ≥ 1 m in 1.5 s of dance', async () => {
+  test('after a click on any panel control (or the buttons by the title), ArrowUp walks the leader ≥ 1 m in 1.5 s of dance', async () => {
     const results = [];
     const check = async (what) => {
       const moved = await steerUp(page);
@@ -151,7 +154,7 @@ describe('desktop: a click in the panel leaves the keys steering', () => {
     };
     report();
     const names = rows.map((r) => r.name);
-    for (const expected of ['partner', 'variety', 'speed', 'possible reactions', 'floor paths', 'show what the partner expects', 'start again (R)', 'copy link to this view', 'skeleton']) {
+    for (const expected of ['partner', 'variety', 'speed', 'possible reactions', 'floor paths', 'show what the partner expects', 'start again (R)', 'reset view', 'copy link to this view', 'skeleton']) {
       assert.ok(names.includes(expected), `the panel has "${expected}" (it has ${names.join(', ')})`);
     }
 
@@ -164,7 +167,10 @@ describe('desktop: a click in the panel leaves the keys steering', () => {
       await sleep(400);
       await check(`title "${title}", twice`);
     }
-    // The help's "?" by the title, and its "×".
+    // The buttons by the title: pause (twice: paused, then dancing) and the help's "?" and "×".
+    await page.locator('.pause-button').click(FAST);
+    await page.locator('.pause-button').click(FAST);
+    await check('pause button, twice');
     await page.locator('.help-button').click(FAST);
     await page.locator('.help-close').click(FAST);
     await check('help "?", then "×"');
@@ -204,6 +210,20 @@ describe('desktop: a click in the panel leaves the keys steering', () => {
     assert.ok(afterDownload >= MIN_STEER_M, `after "download BVH": ArrowUp walked ${afterDownload.toFixed(2)} m`);
     assert.equal(downloads.length, 2, 'one BVH file per dancer');
     assert.deepEqual(dialogs, [], 'no "Start a new take?" or any other dialog');
+  });
+
+  test('R puts the camera back to its first view, too', async () => {
+    await page.mouse.move(640, 420);
+    await page.mouse.down();
+    await page.mouse.move(900, 300, { steps: 10 });
+    await page.mouse.up();
+    await page.mouse.wheel(0, 400);
+    await sleep(1000); // the drag's glide
+    const turned = (await duet(page)).camera;
+    assert.ok(turned && Math.abs(turned.azimuth - DEFAULT_CAMERA.azimuth) > 10, `the drag turned the camera: ${JSON.stringify(turned)}`);
+    await page.keyboard.press('r');
+    await sleep(300);
+    assertCamera((await duet(page)).camera, DEFAULT_CAMERA, 'after R');
   });
 
   test('no console errors', () => {
@@ -318,5 +338,105 @@ describe('the address keeps every setting', () => {
     const round = (v) => Math.round(v * 10) / 10; // the link's precision
     assertCamera(state.camera, { azimuth: round(camera.azimuth), polar: round(camera.polar), distance: round(camera.distance) }, 'the link');
     assert.deepEqual([...browser.consoleErrors, ...errors], []);
+  });
+});
+
+/** Two fingers on the screen, from `from` to `to` ([[x, y], [x, y]] each), through the DevTools
+ *  protocol (Playwright has no multi-touch API). */
+async function twoFingers(page, from, to, steps = 6) {
+  const cdp = await page.context().newCDPSession(page);
+  const points = (t) => [0, 1].map((i) => ({
+    x: from[i][0] + (to[i][0] - from[i][0]) * t,
+    y: from[i][1] + (to[i][1] - from[i][1]) * t,
+    id: i + 1,
+    radiusX: 8,
+    radiusY: 8,
+    force: 1,
+  }));
+  await cdp.send('Input.dispatchTouchEvent', { type: 'touchStart', touchPoints: points(0) });
+  for (let s = 1; s <= steps; s++) {
+    await cdp.send('Input.dispatchTouchEvent', { type: 'touchMove', touchPoints: points(s / steps) });
+  }
+  await cdp.send('Input.dispatchTouchEvent', { type: 'touchEnd', touchPoints: [] });
+  await cdp.detach();
+  await sleep(1000); // the glide after the gesture (OrbitControls' damping)
+}
+
+describe('phone: pause, reset view, and a camera that keeps the pair in view', () => {
+  let browser;
+  let page;
+  const size = { width: 390, height: 844 };
+
+  before(async () => {
+    browser = await launch({ viewport: size, deviceScaleFactor: 3, isMobile: true, hasTouch: true });
+    page = browser.page;
+    await page.goto(`${server.url}?seed=1`);
+    await waitReady(page, 60_000);
+    await waitSteps(page, 5);
+  });
+
+  after(async () => {
+    await browser?.close();
+  });
+
+  test('the pause button stops the dance and starts it again', async () => {
+    const pause = page.locator('.pause-button');
+    assert.ok(await pause.isVisible(), 'a pause button is on screen');
+    await pause.tap();
+    await sleep(300); // a step already under way ends
+    const paused = await duet(page);
+    assert.equal(paused.paused, true);
+    await sleep(1000);
+    assert.equal((await duet(page)).frame, paused.frame, 'no step while paused');
+    assert.match(await pause.textContent(), /resume/);
+    await pause.tap();
+    await waitSteps(page, 5, 10_000);
+    assert.equal((await duet(page)).paused, false);
+    assert.match(await pause.textContent(), /pause/);
+  });
+
+  /** Both dancers' hips are drawn inside the screen. */
+  async function bothInView(when) {
+    const state = await duet(page);
+    for (const dancer of ['leader', 'follower']) {
+      const [x, y] = state[dancer].screen;
+      assert.ok(x >= 0 && x <= size.width && y >= 0 && y <= size.height,
+        `${when}: the ${dancer} is drawn at (${x.toFixed(0)}, ${y.toFixed(0)}), outside the ${size.width}x${size.height} screen (camera ${JSON.stringify(state.camera)})`);
+    }
+    return state.camera;
+  }
+
+  test('pinching and turning with two fingers never loses the pair; "reset view" brings the first view back', async () => {
+    await page.locator('.pause-button').tap(); // the pair stands still while the camera moves
+    try {
+      // Fingers apart, 8 times as far: closer, as close as it goes (from 5.2 m).
+      await twoFingers(page, [[175, 420], [215, 420]], [[35, 420], [355, 420]]);
+      await bothInView('pinched closer');
+      // Fingers together, twice: as far as it goes.
+      for (let i = 0; i < 2; i++) await twoFingers(page, [[35, 420], [355, 420]], [[175, 420], [215, 420]]);
+      const far = await bothInView('pinched away');
+      assert.ok(far.distance <= 12.01, `the camera went ${far.distance.toFixed(1)} m away, into the fog`);
+      // Two fingers up and down the screen: over the top, and down to the floor.
+      await twoFingers(page, [[150, 300], [240, 300]], [[150, 800], [240, 800]]);
+      const top = await bothInView('turned over the top');
+      await twoFingers(page, [[150, 700], [240, 700]], [[150, 100], [240, 100]]);
+      const low = await bothInView('turned down to the floor');
+      assert.ok(top.polar >= 4.9 && low.polar <= 88.1, `polar angle ${top.polar.toFixed(1)}..${low.polar.toFixed(1)}°`);
+
+      await page.locator('.duet-panel > .lil-title').tap();
+      await sleep(500); // lil-gui's open animation
+      await page.locator('.duet-panel button', { hasText: 'reset view' }).tap();
+      await sleep(300);
+      assertCamera((await duet(page)).camera, DEFAULT_CAMERA, 'after "reset view"');
+      await bothInView('after "reset view"');
+      await page.locator('.duet-panel > .lil-title').tap();
+      await sleep(500);
+    } finally {
+      await page.locator('.pause-button').tap();
+    }
+  });
+
+  test('no console errors', () => {
+    assert.deepEqual(browser.consoleErrors, []);
   });
 });

@@ -7,6 +7,7 @@ import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import type { Avatar } from './avatar';
 import { type Bodies, ContactMarks, type DancerBody, DancerMeshes, SkinnedDancer } from './body';
+import { LIMITS } from '../ui/share';
 
 export { DancerMeshes } from './body';
 
@@ -32,6 +33,9 @@ export const COLORS = {
 
 const FLOOR_SIZE = 200; // metres; one grid cell per metre
 const TARGET_HEIGHT = 0.9;
+/** Metres either side of the pair's midpoint that the picture always spans: partners stand about
+ *  a metre apart, so both dancers' hips stay on screen however close a pinch brings the camera. */
+export const PAIR_HALF_WIDTH = 0.8;
 
 /** A polyline with a dot at every point, rewritten in place from a Float32Array of world points. */
 export class PathOverlay {
@@ -145,6 +149,8 @@ export class Stage {
   private readonly rendered = { view: new THREE.Matrix4(), projection: new THREE.Matrix4(), size: new THREE.Vector2(), stale: true };
   /** The controls were updated by needsRender() since the last render(). */
   private controlsUpdated = false;
+  /** Metres either side of the orbit target kept in the picture (keepInView). */
+  private halfWidth = PAIR_HALF_WIDTH;
 
   constructor(container: HTMLElement, parents: number[], maxGhosts: number, options: StageOptions = {}) {
     this.renderer = new THREE.WebGLRenderer({ antialias: true });
@@ -163,9 +169,13 @@ export class Stage {
     this.controls = new OrbitControls(this.camera, this.canvas);
     this.controls.enableDamping = true;
     this.controls.enablePan = false; // the camera follows the dancers; panning would fight that
-    this.controls.minDistance = 1.5;
-    this.controls.maxDistance = 20;
-    this.controls.maxPolarAngle = THREE.MathUtils.degToRad(88); // stay above the floor
+    // Limits a wheel, a pinch or a drag cannot pass (the same a shared link's camera is clamped
+    // to): never straight overhead nor under the floor, never farther than where the fog begins
+    // (14 m), and never closer than the screen's shape allows (keepInView, set in resize()).
+    this.controls.minDistance = LIMITS.distance[0];
+    this.controls.maxDistance = LIMITS.distance[1];
+    this.controls.minPolarAngle = THREE.MathUtils.degToRad(LIMITS.polar[0]);
+    this.controls.maxPolarAngle = THREE.MathUtils.degToRad(LIMITS.polar[1]);
     // One finger steers (the joystick in controls.ts); two fingers orbit and zoom.
     this.controls.touches = { ONE: -1 as THREE.TOUCH, TWO: THREE.TOUCH.DOLLY_ROTATE };
     this.controls.target.copy(this.followTarget);
@@ -260,6 +270,19 @@ export class Stage {
     this.renderer.setSize(width, height, false);
     this.camera.aspect = width / height;
     this.camera.updateProjectionMatrix();
+    this.keepInView(this.halfWidth);
+  }
+
+  /**
+   * Keep `halfWidth` metres either side of the orbit target (the pair's midpoint) in the picture:
+   * the camera may come no closer than that allows on this screen's width. On a portrait phone a
+   * pinch used to bring it 1.5 m from the pair, where the picture is 0.6 m wide and neither
+   * dancer was on screen. The controls apply it at their next update.
+   */
+  keepInView(halfWidth: number): void {
+    this.halfWidth = halfWidth;
+    const tanHalfWidth = Math.tan(THREE.MathUtils.degToRad(this.camera.fov / 2)) * this.camera.aspect;
+    this.controls.minDistance = Math.max(LIMITS.distance[0], halfWidth / tanHalfWidth);
   }
 
   /** Keep the pair in view: move the orbit target (and the camera with it) toward their midpoint. */
@@ -267,8 +290,9 @@ export class Stage {
     const blend = snap ? 1 : 1 - Math.exp(-4 * dt);
     _delta.set(midX, TARGET_HEIGHT, midZ).sub(this.followTarget).multiplyScalar(blend);
     this.followTarget.add(_delta);
-    this.controls.target.add(_delta);
     this.camera.position.add(_delta);
+    // The camera turns around the pair, and around nothing else, whatever a gesture did.
+    this.controls.target.copy(this.followTarget);
     // The floor jumps by whole grid cells so it looks infinite without visibly moving.
     this.floor.position.x = Math.round(this.followTarget.x);
     this.floor.position.z = Math.round(this.followTarget.z);
@@ -284,6 +308,15 @@ export class Stage {
       polar: THREE.MathUtils.radToDeg(_spherical.phi),
       distance: _spherical.radius,
     };
+  }
+
+  /** The first view again (DEFAULT_ORBIT), the glide left from a drag stopped. */
+  resetView(): void {
+    // Without damping, update() spends what is left of a drag's glide at once, and zeroes it.
+    this.controls.enableDamping = false;
+    this.controls.update();
+    this.controls.enableDamping = true;
+    this.setOrbit(DEFAULT_ORBIT);
   }
 
   /** azimuth 0 puts the camera at -z of the target, looking along +z. */

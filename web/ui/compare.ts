@@ -5,7 +5,7 @@
 // Drawing only: nothing the models see changes.
 
 import { Vector3 } from 'three';
-import type { Stage } from '../draw/scene';
+import { PAIR_HALF_WIDTH, type Stage } from '../draw/scene';
 
 /** Metres between the two pairs' centres: a pair is about a metre wide, so a clear gap. */
 export const PAIR_SPACING = 2.2;
@@ -55,12 +55,15 @@ export class CompareLayout {
       this.heights = [];
       const overlay = document.getElementById('overlay');
       this.overlayBottom = overlay ? overlay.getBoundingClientRect().bottom : 0;
-      const needed = HALF_WIDTH / Math.tan(Math.atan(Math.tan((stage.camera.fov * Math.PI) / 360) * stage.camera.aspect));
+      // No pinch can bring the camera closer than this either, while compare mode lasts.
+      stage.keepInView(HALF_WIDTH);
+      const needed = stage.controls.minDistance;
       if (orbit.distance < needed) {
         this.distanceBefore = orbit.distance;
-        stage.setOrbit({ ...orbit, distance: Math.min(needed, 20) });
+        stage.setOrbit({ ...orbit, distance: needed });
       }
     } else {
+      stage.keepInView(PAIR_HALF_WIDTH);
       if (this.distanceBefore !== null) stage.setOrbit({ ...orbit, distance: this.distanceBefore });
       this.distanceBefore = null;
       this.offset.x = this.offset.z = 0;

@@ -82,3 +82,25 @@ export function formatBytes(bytes: number): string {
   if (bytes >= 1e3) return `${(bytes / 1e3).toFixed(0)} kB`;
   return `${bytes} B`;
 }
+
+/** The pause / resume button by the title: Space's twin, for phones (no keyboard) and mice. */
+export class PauseButton {
+  readonly element: HTMLButtonElement;
+
+  constructor(onClick: () => void) {
+    this.element = document.createElement('button');
+    this.element.type = 'button';
+    this.element.className = 'pause-button';
+    this.element.addEventListener('click', onClick);
+    // Next to the title (the overlay lets drags through; the button takes its own clicks).
+    const title = document.querySelector('#overlay .title-row');
+    (title ?? document.body).append(this.element);
+    this.show(false);
+  }
+
+  /** Say what a press does next. */
+  show(paused: boolean): void {
+    this.element.textContent = paused ? 'resume' : 'pause';
+    this.element.title = paused ? 'resume the dance (Space)' : 'pause the dance (Space)';
+  }
+}

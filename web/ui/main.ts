@@ -19,7 +19,7 @@ import { LoadingBar } from './loading';
 import { DEFAULT_ORBIT, Stage } from '../draw/scene';
 import { readBodies } from '../draw/body';
 import { Controls, releaseFocusAfterUse } from './controls';
-import { Hud } from './hud';
+import { Hud, PauseButton } from './hud';
 import { Panel } from './panel';
 import { CompareLayout } from './compare';
 import { ViewCentre } from './layout';
@@ -48,7 +48,7 @@ const MIN_STEP_BUDGET_MS = 50;
 const MAX_GHOSTS = LIMITS.ghosts[1];
 const WORKER_START_WAIT_MS = 300;
 const WARM_UP_DELAY_MS = 500;
-const PAUSED_STATUS = 'paused — Space to resume';
+const PAUSED_STATUS = 'paused — Space or “resume” to go on';
 /** After a drag the camera glides on (OrbitControls' damping, counted in frames: seconds at a low
  *  frame rate). Its place is checked this often, and goes to the address when it changed, until
  *  it stood still for CAMERA_STILL_CHECKS checks. */
@@ -108,6 +108,7 @@ class Page {
   private readonly stage: Stage;
   private readonly hud: Hud;
   private readonly controls: Controls;
+  private readonly pauseButton: PauseButton;
   private readonly recorder: Recorder;
   private readonly leaderFileInput: LeaderFileInput;
   private readonly avatarInput: HTMLInputElement;
@@ -190,6 +191,7 @@ class Page {
       onReset: () => this.reset(),
     });
     const panel = this.createPanel();
+    this.pauseButton = new PauseButton(() => this.togglePause());
     // After a click on a control the keys belong to the dance again (controls.ts).
     releaseFocusAfterUse(document.body);
     this.viewCentre = new ViewCentre(panel.gui.domElement, () => !panel.gui._closed);
@@ -240,6 +242,7 @@ class Page {
       onModel: (choice) => this.useModel(choice).catch(this.fail),
       onGhosts: () => this.exclusive(() => this.refreshGhosts()).catch(this.fail),
       onReset: () => this.reset(),
+      onResetView: () => this.resetView(),
       onShare: () => this.share(),
       onSkeleton: this.stage.bodies === 'skinned' ? (on) => (this.stage.skeleton = on) : undefined,
       onSettingsChange: () => this.writeAddress(),
@@ -284,6 +287,7 @@ class Page {
     this.stage.follow(0.5 * (leader.root[2] + followers[0].root[2]), 0.5 * (leader.root[3] + followers[0].root[3]), 0, true);
   }
 
+  /** Both dancers back to the opening pose, and the camera to its first view (R). */
   private reset(): Promise<void> {
     return this.exclusive(() => {
       if (!this.simulation) return;
@@ -291,12 +295,19 @@ class Page {
       this.accumulator = 0;
       this.capture(true);
       this.snapCamera();
+      this.resetView();
     });
+  }
+
+  private resetView(): void {
+    this.stage.resetView();
+    this.writeAddress();
   }
 
   private togglePause(): void {
     this.paused = !this.paused;
     hook.paused = this.paused;
+    this.pauseButton.show(this.paused);
     this.hud.setStatus(this.status());
   }
 

@@ -16,6 +16,7 @@ export interface PanelOptions {
   onModel(model: FollowerChoice): void;
   onGhosts(count: number): void;
   onReset(): void;
+  onResetView(): void;
   onShare(): void;
   /** Shows or hides the skeleton; without it (capsule figures) the panel has no skeleton switch. */
   onSkeleton?(on: boolean): void;
@@ -49,7 +50,8 @@ export const CONTROLS = {
   ghosts: ['possible reactions', 'Faint extra partners, each another move the partner could have made right now.'],
   trajectories: ['floor paths', "Each dancer's path on the floor, a second ahead."],
   intentions: ['show what the partner expects', "Purple lines: where the partner expects your head, hands and feet to go over the next second."],
-  reset: ['start again (R)', 'Both dancers go back to the opening pose.'],
+  reset: ['start again (R)', 'Both dancers go back to the opening pose, and the camera to its first view.'],
+  view: ['reset view', 'Puts the camera back where it started, both dancers in view.'],
   share: ['copy link to this view', 'Copies a link that opens the page with these settings and this camera.'],
   skeleton: ['skeleton', 'Shows the thin bones inside each body.'],
   record: ['● record', 'Records both dancers; press again to stop.'],
@@ -58,6 +60,7 @@ export const CONTROLS = {
   leaderModel: ['leader back to model', 'Gives your dancer back to your keys or thumb.'],
   avatar: ['partner avatar (.vrm)…', 'Dresses your partner in a VRM avatar file (on a computer you can also drop one on either dancer).'],
   plainBodies: ['plain bodies again', 'Takes off the avatars the dancers wear.'],
+  pause: ['pause', 'The button by the title (or Space) stops the dance; press it again to go on.'],
 } as const satisfies Record<string, readonly [string, string]>;
 
 const [label, help] = [(k: keyof typeof CONTROLS) => CONTROLS[k][0], (k: keyof typeof CONTROLS) => CONTROLS[k][1]];
@@ -87,6 +90,7 @@ export class Panel {
     this.gui.add(settings, 'trajectories').name(label('trajectories'));
     this.gui.add(settings, 'intentions').name(label('intentions'));
     this.gui.add({ reset: options.onReset }, 'reset').name(label('reset'));
+    this.gui.add({ view: options.onResetView }, 'view').name(label('view'));
     this.gui.add({ share: options.onShare }, 'share').name(label('share'));
     const onSkeleton = options.onSkeleton;
     if (onSkeleton) this.gui.add(settings, 'skeleton').name(label('skeleton')).onChange((on: boolean) => onSkeleton(on));

@@ -25,8 +25,10 @@ export const LIMITS = {
   temperature: [0, 2],
   ghosts: [0, 8],
   speed: [0.25, 4],
+  /** The camera (web/draw/scene.ts): degrees down from straight above; metres from the pair, at
+   *  most 12, short of the fog (from 14 m). */
   polar: [5, 88],
-  distance: [1.5, 20],
+  distance: [1.5, 12],
   threads: [1, 2],
 } as const;
 
