@@ -351,6 +351,10 @@ def features_fixture(rng: np.random.Generator, lead: Track, follow: Track) -> di
         },
         "followerInput": out7(feat.follower_input(lead, follow, frames)),
         "leaderInput": out7(feat.leader_input(follow, lead, frames)),
+        # The figure block asked for: the follower's own turn ahead, as the leader's samples carry it.
+        "partnerTurn": out7(feat.partner_turn(follow, frames)),
+        "leaderInputAsked": out7(feat.leader_input(follow, lead, frames,
+                                                   feat.figure_block(feat.partner_turn(follow, frames), len(frames)))),
         "followerOutput": out7(feat.output_features(follow, frames)),
         "leaderOutput": out7(feat.output_features(lead, frames)),
         "followerIntention": out7(feat.intention_target(lead, follow, frames)),
@@ -408,7 +412,10 @@ def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_o
         ([0.2, 0.9], None, "jump"),
         ([1.0, 1.0], "far", None),
     ]
+    ask = {1: -1}   # before step 1 the visitor asks for a clockwise turn
     for i, (stick, lead_bad, follow_bad) in enumerate(scenarios):
+        if i in ask:
+            ro.ask_turn(duet, ask[i])
         before_velocity = duet.steering.velocity.copy()
         ro.steer_plan(duet.leader, duet.steering, np.array(stick, float))
         planned_root = duet.leader.track.root.copy()
@@ -429,7 +436,7 @@ def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_o
             "leaderInput": out7(xl), "followerInput": out7(xf),
             "leaderOutput": [None if not np.isfinite(v) else float(v) for v in lead_out],
             "followerOutput": [float(v) for v in follow_out],
-            "followerIntention": exact(fi), "absurd": absurd,
+            "followerIntention": exact(fi), "absurd": absurd, "ask": ask.get(i),
             "leader": dancer_state(duet.leader), "follower": dancer_state(duet.follower),
         })
     # The guards: the leader drawn toward its anchor; a follower 3.3 m away leashed.
@@ -467,6 +474,10 @@ def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_o
         "startPose": start_pose,
         "startDuet": {"leader": dancer_state(started.leader), "follower": dancer_state(started.follower)},
         "steps": steps,
+        # A request's figure keys over its life: (frames since asked, direction) -> keys; None once over.
+        "figureInputs": [{"frame": f, "direction": d,
+                          "keys": out7(ro.figure_input(ro.TurnRequest(d, f)))}
+                         for f, d in ((0, 1), (7, -1), (30, 1), (59, -1), (74, 1))],
     }
 
 

@@ -164,7 +164,8 @@ def test_onnx_graphs(exported):
         sess = session(exported["models"] / f"{name}.onnx")
         latent = sess.get_inputs()[2].shape[1]
         for b in (1, 7):
-            r = run_onnx(sess, np.zeros((b, feat.INPUT_SIZE), np.float32), 0.5, np.full((b, latent), 0.3, np.float32))
+            width = feat.LEADER_INPUT_SIZE if name == "leader" else feat.INPUT_SIZE
+            r = run_onnx(sess, np.zeros((b, width), np.float32), 0.5, np.full((b, latent), 0.3, np.float32))
             assert r["output"].shape == (b, feat.OUTPUT_SIZE)
 
 

@@ -41,7 +41,7 @@ def moved(track: F.Track, angle: float, shift) -> F.Track:
 
 def test_block_sizes():
     assert F.INPUT_SIZE == sum(s for _, s in F.FOLLOWER_INPUT_LAYOUT) == 660
-    assert sum(s for _, s in F.LEADER_INPUT_LAYOUT) == 660
+    assert sum(s for _, s in F.LEADER_INPUT_LAYOUT) == F.LEADER_INPUT_SIZE == 667   # + the figure block
     assert F.OUTPUT_SIZE == sum(s for _, s in F.OUTPUT_LAYOUT) == 323
     assert F.INTENTION_SIZE == sum(s for _, s in F.INTENTION_LAYOUT) == 90
     sizes = dict(F.FOLLOWER_INPUT_LAYOUT + F.LEADER_INPUT_LAYOUT + F.OUTPUT_LAYOUT)
@@ -58,7 +58,7 @@ def test_real_feature_arrays_have_the_layout_widths(take_tracks):
     n = len(s["frame"])
     assert n == len(F.valid_frames(take_tracks[0].frames)) > 200
     for role in ("follower", "leader"):
-        assert s[f"{role}_input"].shape == (n, 660)
+        assert s[f"{role}_input"].shape == (n, F.INPUT_SIZES[role])
         assert s[f"{role}_output"].shape == (n, 323)
         assert s[f"{role}_intention"].shape == (n, 90)
         assert s[f"{role}_input"].dtype == np.float32

@@ -116,7 +116,15 @@ describe('model inputs, outputs and intention', () => {
     expectClose(perFrame(F.INPUT_SIZE, (t, o, at) => F.followerInput(leader, follower, t, o, at)), data.followerInput, 'follower input');
   });
   it('leaderInput (partner = follower, control = own future)', () => {
-    expectClose(perFrame(F.INPUT_SIZE, (t, o, at) => F.leaderInput(follower, leader, t, o, at)), data.leaderInput, 'leader input');
+    expectClose(perFrame(F.LEADER_INPUT_SIZE, (t, o, at) => F.leaderInput(follower, leader, t, o, at)), data.leaderInput, 'leader input');
+  });
+  it('leaderInput with a figure asked for (the partner\'s turn ahead)', () => {
+    const turns = data.partnerTurn as number[];
+    const asked = perFrame(F.LEADER_INPUT_SIZE, (t, o, at) => {
+      const i = at / F.LEADER_INPUT_SIZE;
+      F.leaderInput(follower, leader, t, o, at, turns.slice(i * F.KEYS, (i + 1) * F.KEYS));
+    });
+    expectClose(asked, data.leaderInputAsked, 'leader input, asked');
   });
   it('outputFeatures of both dancers (incl. foot contacts)', () => {
     expectClose(perFrame(F.OUTPUT_SIZE, (t, o, at) => F.outputFeatures(follower, t, o, at)), data.followerOutput, 'follower output');

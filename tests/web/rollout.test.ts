@@ -3,7 +3,7 @@
 // reset a dancer: NaN, a root jump, a joint too far).
 
 import { describe, expect, it } from 'vitest';
-import { INPUT_SIZE } from '../../web/mirror/features';
+import { INPUT_SIZE, LEADER_INPUT_SIZE } from '../../web/mirror/features';
 import * as R from '../../web/mirror/rollout';
 import { type Json, expectClose, fixture, trackOf } from './fixture';
 
@@ -76,17 +76,19 @@ describe('the duet loop, step by step', () => {
     startPose: data.startPose,
     steering: new R.Steering(),
     frame: 0,
+    request: null,
   };
   const nan = (values: (number | null)[]) => Float32Array.from(values, (v) => (v === null ? NaN : v));
 
   (data.steps as Json[]).forEach((step, i) => {
     it(`step ${i}: steerPlan, stepInputs, outputIsAbsurd, finishStep (absurd: ${step.absurd})`, () => {
+      if (step.ask !== null) R.askTurn(duet, step.ask);
       duet.steering.velocity.set(step.steeringBefore);
       R.steerPlan(duet.leader, duet.steering, step.stick[0], step.stick[1]);
       expectClose(duet.steering.velocity, step.steeringAfter, 'steering velocity');
       expectClose(duet.leader.track.root, step.plannedLeaderRoot, 'steered plan');
 
-      const leaderIn = new Float32Array(INPUT_SIZE);
+      const leaderIn = new Float32Array(LEADER_INPUT_SIZE);
       const followerIn = new Float32Array(INPUT_SIZE);
       R.stepInputs(duet, leaderIn, [followerIn]);
       expectClose(leaderIn, step.leaderInput, 'leader input');
@@ -100,6 +102,25 @@ describe('the duet loop, step by step', () => {
       expectDancer(duet.followers[0], step.follower, 'follower');
       expect(duet.frame).toBe(i + 1);
     });
+  });
+});
+
+describe('a turn asked for', () => {
+  it('figureInput gives the planned partner turn over the request\'s life', () => {
+    for (const c of data.figureInputs as { frame: number; direction: number; keys: number[] }[]) {
+      expectClose(R.figureInput({ frame: c.frame, direction: c.direction })!, c.keys, `figure keys at ${c.frame}`);
+    }
+    expect(R.figureInput(null)).toBeNull();
+  });
+  it('a request ends after REQUEST_SECONDS', () => {
+    const duet = R.startDuet({ skeleton: { offsets: data.offsets }, startPose: data.startPose });
+    R.askTurn(duet, 1);
+    const still = new Float32Array(data.steps[0].followerOutput.length);
+    for (let i = 0; i < R.REQUEST_SECONDS * 30; i++) {
+      expect(duet.request).not.toBeNull();
+      R.finishStep(duet, null, [still]);
+    }
+    expect(duet.request).toBeNull();
   });
 });
 

@@ -83,6 +83,11 @@ def prepare(data: str, out: str, validation: list[str], test: list[str], leader:
     for role in ("follower", "leader"):
         for kind in ("input", "output", "intention"):
             mean, std = F.normalization(arrays["train"][f"{role}_{kind}"])
+            if role == "leader" and kind == "input":
+                # The figure block is read as it is (turns, and `asked` in {0, 1}): every stored
+                # sample is asked, so its own statistics would put the unasked 0 a hundred stds away.
+                fig = F.block_slices(F.LEADER_INPUT_LAYOUT)["figure"]
+                mean[fig], std[fig] = 0.0, 1.0
             stats[f"{role}_{kind}_mean"], stats[f"{role}_{kind}_std"] = mean, std
     # Bone offsets of each role (the first take's, as export ships them): the training terms on
     # the decoded body (partner_losses) run forward kinematics with them. In the CMU takes each
@@ -94,7 +99,8 @@ def prepare(data: str, out: str, validation: list[str], test: list[str], leader:
     # The recording's range of poses and speeds (evaluation.plausibility): what a generated frame is
     # judged against (export copies it into the manifest).
     P.save_ranges(outdir / "plausibility.json", P.ranges(recorded_bodies))
-    summary["sizes"] = {"input": F.INPUT_SIZE, "output": F.OUTPUT_SIZE, "intention": F.INTENTION_SIZE}
+    summary["sizes"] = {"input": F.INPUT_SIZE, "leader input": F.LEADER_INPUT_SIZE, "output": F.OUTPUT_SIZE,
+                        "intention": F.INTENTION_SIZE}
     return summary
 
 

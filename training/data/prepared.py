@@ -48,7 +48,7 @@ def load_split(prepared: str, split: str, role: str, tempo_copies: bool = False)
             arrays = {k: z[f"{role}_{k}"] for k in ("input", "output", "intention")}
     except Exception as e:  # zipfile, pickle and key errors all mean the same thing here
         raise _unreadable(path, e) from None
-    sizes = {"input": feat.INPUT_SIZE, "output": feat.OUTPUT_SIZE, "intention": feat.INTENTION_SIZE}
+    sizes = {"input": feat.INPUT_SIZES[role], "output": feat.OUTPUT_SIZE, "intention": feat.INTENTION_SIZE}
     for k, n in sizes.items():
         if arrays[k].shape[1] != n:
             raise TrainError(f"{path}: {role} {k} has {arrays[k].shape[1]} features, this code "

@@ -48,14 +48,22 @@ METHODS = {
     "ccm": ("follower_ccm", "follower_ccm_no_proximity", False),
     "ours_tempo": ("follower_tempo", "follower_no_proximity", True),
     "ccm_tempo": ("follower_ccm_tempo", "follower_ccm_no_proximity", True),
-    # The shipped recipes (decoders that read the pose, proximity, state noise, state dropout).
+    # The shipped recipes (decoders that read the pose, proximity, state noise, state dropout, the
+    # turn onsets weighed 4x), and the same before the turn weight.
     "ours_steady": ("follower_steady", "follower", False),
     "ccm_steady": ("follower_ccm_steady", "follower_ccm", False),
+    "ours_no_turn_weight": ("follower_no_turn_weight", "follower_no_turn_weight", False),
+    "ccm_no_turn_weight": ("follower_ccm_no_turn_weight", "follower_ccm_no_turn_weight", False),
 }
 # implausible / worst second: the free-running follower's frames with its body low, folded or split,
 # against the fold's own training range (evaluate's plausibility; n/a for evaluations without it).
+# The figures (evaluation.figures): the follower's turns per minute and spin frames as a ratio to
+# the recorded follower's on the same test takes, and the recall and precision of her turns.
 METRICS = {"mpjpe_cm": "MPJPE cm", "fid": "FID", "codebook_error": "codebook error",
-           "implausible": "implausible frames", "worst_second": "worst second"}
+           "implausible": "implausible frames", "worst_second": "worst second",
+           "turns_ratio": "turns/min ratio", "spin_ratio": "spin frames ratio", "recall": "turn recall",
+           "precision": "turn precision"}
+RATIOS = {"turns_ratio": "turns_per_min", "spin_ratio": "spin_frames"}   # over the recording's
 CONFIDENCE = 0.95
 
 
@@ -229,11 +237,15 @@ def report(out: Path, plan: dict, seconds: float, name: str = "crossval") -> dic
                 path = out / f"fold{f['fold']}" / f"seed{s}" / f"eval_{run}" / "metrics.json"
                 if path.exists():
                     res = json.loads(path.read_text())["methods"]
-                    values[m][(f["fold"], s)] = {k: res[NAMES.get(run, run)].get(k) for k in METRICS}
+                    row, ref = res[NAMES.get(run, run)], res.get("ground_truth", {})
+                    for k, base in RATIOS.items():
+                        row[k] = row[base] / ref[base] if row.get(base) is not None and ref.get(base) else None
+                    values[m][(f["fold"], s)] = {k: row.get(k) for k in METRICS}
     fold_ids = [f["fold"] for f in plan["folds"] if all((f["fold"], s) in values[m] for m in methods for s in seeds)]
     comparisons = {}
     pairs = [(a, b) for a, b in (("ours", "ccm"), ("ours_tempo", "ours"), ("ccm_tempo", "ccm"), ("ours_tempo", "ccm_tempo"),
-                                 ("ours_steady", "ccm_steady"), ("ours_steady", "ours"), ("ccm_steady", "ccm"))
+                                 ("ours_steady", "ccm_steady"), ("ours_steady", "ours"), ("ccm_steady", "ccm"),
+                                 ("ours_steady", "ours_no_turn_weight"), ("ccm_steady", "ccm_no_turn_weight"))
              if a in methods and b in methods]
     for a, b in pairs:
         comparisons[f"{a} - {b}"] = {k: paired(values[a], values[b], fold_ids, seeds, k) for k in METRICS}
@@ -258,7 +270,8 @@ def _num(v, digits):
 
 def markdown(res: dict) -> str:
     plan = res["plan"]
-    digits = {"mpjpe_cm": 2, "fid": 1, "codebook_error": 4, "implausible": 3, "worst_second": 2}
+    digits = {"mpjpe_cm": 2, "fid": 1, "codebook_error": 4, "implausible": 3, "worst_second": 2,
+              "turns_ratio": 2, "spin_ratio": 2, "recall": 2, "precision": 2}
     lines = [f"Folds {len(res['complete_folds'])} of {len(plan['folds'])} complete, seeds "
              f"{','.join(map(str, plan['seeds']))}, {plan['intention_epochs']} + {plan['epochs']} epochs, "
              f"free runs at variety {plan.get('temperature', 0.5):g}"

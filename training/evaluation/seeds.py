@@ -26,6 +26,7 @@ from tqdm import tqdm
 from ..data.dataset import DataError, TEST_TAKES
 from ..data.folders import add_folder
 from ..mirror.skeleton import FPS
+from . import figures as Fg
 from . import options as O
 from . import plausibility as P
 from .evaluate_inputs import EvalError, find_models, load_eval_takes, load_onnx
@@ -45,7 +46,27 @@ def recording_row(data: str, names: list[str], r: dict) -> dict:
         duets.append(P.duet(lead, follow, r))
         inter.append(measure(lead, follow, contact_labels(lead), contact_labels(follow)))
         frames.append(len(lead))
-    return {**P.summarize(duets, frames), **weighted(inter, frames)}
+    figs = {who: Fg.summarize([dancer_figures(getattr(t, part).positions) for t in takes])
+            for who, part in (("leader", "lead"), ("follower", "follow"))}
+    return {**P.summarize(duets, frames), **weighted(inter, frames), "figures": figs}
+
+
+def dancer_figures(positions: np.ndarray) -> dict:
+    """figures.dancer without its per-turn lists (the JSON keeps one number a measure)."""
+    return {k: v for k, v in Fg.dancer(positions).items() if not isinstance(v, list)}
+
+
+def figures_row(per_seed: list[dict]) -> dict:
+    """Each dancer's figures pooled over the seeds, with the seed that turns least (a mean alone
+    would hide a seed whose follower never turns)."""
+    out = {}
+    for who in ("leader", "follower"):
+        items = [s["figures"][who] for s in per_seed]
+        worst = min(range(len(items)), key=lambda i: items[i]["turns_per_min"])
+        out[who] = {**Fg.summarize(items), "worst_seed": per_seed[worst]["seed"],
+                    "worst_turns_per_min": items[worst]["turns_per_min"],
+                    "seeds_without_turns": int(sum(i["turns"] == 0 for i in items))}
+    return out
 
 
 def weighted(rows: list[dict], frames: list[int]) -> dict:
@@ -75,7 +96,8 @@ def _one(job: tuple[int, int, float]) -> dict:
     rec: dict = {}
     O.restart_count(w["follower"])
     soak = soak_one(w["manifest"], w["leader"], w["follower"], seed, frames, temperature, rec)
-    out = {"seed": seed, "resets": soak["resets"], "guarded": getattr(w["follower"], "guarded", 0)}
+    out = {"seed": seed, "resets": soak["resets"], "guarded": getattr(w["follower"], "guarded", 0),
+           "figures": {"leader": dancer_figures(rec["leader"]), "follower": dancer_figures(rec["follower"])}}
     for kind, suffix in (("alone", ""), ("layer", "_shown")):
         lead, follow = rec["leader" + suffix], rec["follower" + suffix]
         out[kind] = {**P.duet(lead, follow, w["ranges"]),
@@ -102,7 +124,7 @@ def run_method(args, method: str, r: dict, test: list[str], bar) -> dict:
         per_seed = list(counted(map(_one, jobs)))
     row = {"per_seed": per_seed, "resets": int(sum(s["resets"] for s in per_seed)),
            "guarded": int(sum(s["guarded"] for s in per_seed)),
-           "seeds_guarded": int(sum(s["guarded"] > 0 for s in per_seed))}
+           "seeds_guarded": int(sum(s["guarded"] > 0 for s in per_seed)), "figures": figures_row(per_seed)}
     for kind in ("alone", "layer"):
         duets = [s[kind] for s in per_seed]
         row[kind] = {**P.summarize(duets, [frames] * len(duets)), **weighted(duets, [frames] * len(duets))}
@@ -192,6 +214,23 @@ def write_markdown(path: Path, res: dict) -> None:
             s, q = row[kind], row["ratio"][kind]
             lines.append(f"| {m} {kind} | {s['path_ratio']:.2f} ({fmt(q['path_ratio'])}×) | " +
                          " | ".join(f"{fmt(s[k], 3)} ({fmt(q[k])}×)" for k in INTERACTION) + f" | {row['resets']} |")
+    lines += ["", "## Salsa figures (training.evaluation.figures)", "",
+              "Turns per minute (300 degrees within 2.5 s), spin frames, body motion (joint speed relative "
+              "to the hips) and travel of each dancer, pooled over the seeds, as a ratio to the recorded "
+              "dancer's; the seed that turns least, and how many seeds have no turn at all.", "",
+              "| method | dancer | turns/min | spin frames | body motion m/s | travel m/s | least-turning seed | seeds without a turn |",
+              "|---|---|---|---|---|---|---|---|"]
+    for who in ("leader", "follower"):
+        f0 = ref["figures"][who]
+        lines.append(f"| recording | {who} | {f0['turns_per_min']:.1f} | {fmt(f0['spin_frames'], pct=True)} | "
+                     f"{f0['body_motion']:.2f} | {f0['travel']:.2f} | – | – |")
+        for m, row in res["methods"].items():
+            f = row["figures"][who]
+            q = Fg.ratios(f, f0)
+            lines.append(f"| {m} | {who} | {f['turns_per_min']:.1f} ({q['turns_per_min']:.2f}×) | "
+                         f"{fmt(f['spin_frames'], pct=True)} ({q['spin_frames']:.2f}×) | {f['body_motion']:.2f} "
+                         f"({q['body_motion']:.2f}×) | {f['travel']:.2f} ({q['travel']:.2f}×) | "
+                         f"seed {f['worst_seed']}: {f['worst_turns_per_min']:.1f}/min | {f['seeds_without_turns']} |")
     if cfg.get("guard"):
         lines += ["", f"The network followers' upright guard (training/mirror/guard.py): "
                       f"{cfg.get('guard')} samples" +

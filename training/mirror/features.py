@@ -27,6 +27,7 @@ KEY_JOINTS_SIZE = KEYS * N_KEY_JOINTS * 3    # 90
 POSE_SIZE = N_JOINTS * 12                    # 204
 ROOT_UPDATE_SIZE = 3
 CONTACTS_SIZE = 2
+FIGURE_SIZE = 1 + KEYS                       # 7: asked, then the partner's planned turn at each key
 
 # (name, size) in order; docs/features.md explains each block.
 FOLLOWER_INPUT_LAYOUT = [
@@ -39,17 +40,18 @@ LEADER_INPUT_LAYOUT = [
     ("partner_trajectory_past", TRAJECTORY_SIZE), ("partner_key_joints_past", KEY_JOINTS_SIZE),
     ("partner_pose", POSE_SIZE),
     ("self_trajectory_past", TRAJECTORY_SIZE), ("self_key_joints_past", KEY_JOINTS_SIZE),
-    ("self_pose", POSE_SIZE), ("control", TRAJECTORY_SIZE),
+    ("self_pose", POSE_SIZE), ("control", TRAJECTORY_SIZE), ("figure", FIGURE_SIZE),
 ]
 OUTPUT_LAYOUT = [
     ("root_update", ROOT_UPDATE_SIZE), ("trajectory_future", TRAJECTORY_SIZE),
     ("key_joints_future", KEY_JOINTS_SIZE), ("pose", POSE_SIZE), ("contacts", CONTACTS_SIZE),
 ]
 INTENTION_LAYOUT = [("partner_key_joints_future", KEY_JOINTS_SIZE)]
-INPUT_SIZE = sum(s for _, s in FOLLOWER_INPUT_LAYOUT)     # 660
+INPUT_SIZE = sum(s for _, s in FOLLOWER_INPUT_LAYOUT)     # 660: the follower's input
+LEADER_INPUT_SIZE = sum(s for _, s in LEADER_INPUT_LAYOUT)  # 667: the same blocks, control and figure
 OUTPUT_SIZE = sum(s for _, s in OUTPUT_LAYOUT)            # 323
 INTENTION_SIZE = KEY_JOINTS_SIZE                          # 90
-assert INPUT_SIZE == sum(s for _, s in LEADER_INPUT_LAYOUT)
+INPUT_SIZES = {"follower": INPUT_SIZE, "leader": LEADER_INPUT_SIZE}
 
 # Foot contact: ankle joint near the floor and nearly still. The ankle of a flat foot sits
 # 7-11 cm up in this data (heels included), so 15 cm leaves room; 0.5 m/s separates a planted
@@ -190,8 +192,29 @@ def follower_input(partner: Track, me: Track, frames: np.ndarray) -> np.ndarray:
     ], -1)
 
 
-def leader_input(partner: Track, me: Track, frames: np.ndarray) -> np.ndarray:
-    """Input I [N, 660] for the leader (partner = follower, control = own future trajectory)."""
+def figure_block(partner_turn: np.ndarray | None, n: int) -> np.ndarray:
+    """The leader's figure block [n, 7]: `asked` (1 when a figure is asked for), then how far the
+    partner is to have turned at each future key, in full turns from now (signed like the heading:
+    +1 is a full turn counterclockwise seen from above). None: nobody asks (zeros), and the leader
+    leads what he likes, as he learnt from the samples whose figure was hidden."""
+    out = np.zeros((n, FIGURE_SIZE))
+    if partner_turn is not None:
+        out[:, 0] = 1.0
+        out[:, 1:] = partner_turn
+    return out
+
+
+def partner_turn(partner: Track, frames: np.ndarray) -> np.ndarray:
+    """[N, KEYS] the recorded partner's turn from each frame to each future key, in full turns
+    (the root heading unwrapped over the take): the figure label of the leader's samples."""
+    heading = np.unwrap(partner.heading)
+    idx = frames[:, None] + FUTURE_OFFSETS[None]
+    return (heading[idx] - heading[frames][:, None]) / (2 * np.pi)
+
+
+def leader_input(partner: Track, me: Track, frames: np.ndarray, figure: np.ndarray | None = None) -> np.ndarray:
+    """Input I [N, 667] for the leader (partner = follower, control = own future trajectory, then
+    the figure block: figure_block's [N, 7], zeros when not given)."""
     root, heading = me.root[frames], me.heading[frames]
     return np.concatenate([
         _trajectory_at(partner, frames, PAST_OFFSETS, root, heading),
@@ -201,6 +224,7 @@ def leader_input(partner: Track, me: Track, frames: np.ndarray) -> np.ndarray:
         _key_joints_at(me, frames, PAST_OFFSETS, root, heading),
         _pose_at(me, frames, root, heading),
         _trajectory_at(me, frames, FUTURE_OFFSETS, root, heading),
+        figure_block(None, len(frames)) if figure is None else figure,
     ], -1)
 
 

@@ -36,6 +36,14 @@ ANCHOR_RATE = 0.3          # share of the leader's distance to its anchor closed
 LEASH_DISTANCE = 2.0       # m: beyond this a follower is drawn toward its leader ...
 LEASH_RATE = 0.1           # ... closing this share of the excess every frame
 START_DISTANCE = 0.8       # m between the partners at the start and after a reset
+# A visitor's request to lead the partner's turn (ask_turn) becomes the leader's figure block
+# (features.figure_block): the partner's planned turn, one full turn eased in and out from
+# TURN_START to TURN_START + TURN_SECONDS after the request. Recorded turns take about 1.2 s from
+# their first 30 degrees to 330 (median over the 79 whole turns of the 12 takes). The request
+# ends after REQUEST_SECONDS, when the leader leads as he likes again.
+TURN_START = 0.4           # s
+TURN_SECONDS = 1.2         # s
+REQUEST_SECONDS = 2.5      # s
 
 
 def rotations_from_vectors(forward: np.ndarray, up: np.ndarray) -> np.ndarray:
@@ -167,6 +175,35 @@ def steer_plan(leader: Dancer, steering: Steering, stick: np.ndarray) -> None:
         t.root[NOW + off] += weight * (target - t.root[NOW + off])
 
 
+@dataclass
+class TurnRequest:
+    """The visitor asked the leader to lead the partner's turn: +1 counterclockwise seen from
+    above (her left), -1 clockwise; `frame` counts the steps since the request."""
+    direction: int
+    frame: int = 0
+
+
+def planned_turn(seconds: float) -> float:
+    """Full turns the partner is planned to have made `seconds` after a request (smoothstep)."""
+    u = min(1.0, max(0.0, (seconds - TURN_START) / TURN_SECONDS))
+    return u * u * (3 - 2 * u)
+
+
+def figure_input(request: TurnRequest | None) -> np.ndarray | None:
+    """The leader's figure keys [KEYS] for a request (None: nobody asks): how far the partner is
+    to turn from now to each future key, in full turns, signed by the direction."""
+    if request is None:
+        return None
+    now = request.frame / FPS
+    return np.array([request.direction * (planned_turn(now + off / FPS) - planned_turn(now))
+                     for off in FUTURE_OFFSETS])
+
+
+def ask_turn(duet: "Duet", direction: int) -> None:
+    """Ask the leader to lead the partner's turn now (a request still running starts anew)."""
+    duet.request = TurnRequest(1 if direction >= 0 else -1)
+
+
 def shift_dancer(d: Dancer, shift: np.ndarray) -> None:
     """Slide a dancer on the floor: current root, current pose and planned path together."""
     t = d.track
@@ -217,6 +254,7 @@ class Duet:
     # What is shown after the contact layer: [leader, follower] world positions [17, 3].
     shown: np.ndarray = field(default_factory=lambda: np.zeros((2, feat.N_JOINTS, 3)))
     resets_seen: int = 0
+    request: TurnRequest | None = None
 
 
 def show(duet: Duet) -> None:
@@ -239,8 +277,11 @@ def start_duet(manifest: dict) -> Duet:
 
 
 def step_inputs(duet: Duet) -> tuple[np.ndarray, np.ndarray]:
+    """Both models' inputs at NOW. The follower's never holds the request: she reads the leader."""
     now = np.array([NOW])
-    return (leader_input(duet.follower.track, duet.leader.track, now)[0],
+    keys = figure_input(duet.request)
+    figure = None if keys is None else feat.figure_block(keys[None], 1)
+    return (leader_input(duet.follower.track, duet.leader.track, now, figure)[0],
             follower_input(duet.leader.track, duet.follower.track, now)[0])
 
 
@@ -258,6 +299,10 @@ def finish_step(duet: Duet, leader_output: np.ndarray, follower_output: np.ndarr
                 follow_anchor(d, duet.steering)
     if keep_close(duet.follower, duet.leader):
         duet.follower.leashed += 1
+    if duet.request is not None:
+        duet.request.frame += 1
+        if duet.request.frame >= REQUEST_SECONDS * FPS:
+            duet.request = None
     if follower_intention is not None:
         f = duet.follower
         keys = follower_intention.reshape(KEYS, len(KEY_JOINTS), 3)

@@ -1,6 +1,6 @@
 // The neural policies: one ONNX InferenceSession per model, stepped once per frame.
 //
-// I/O contract (docs/features.md): inputs `input` [B, 660], `temperature` [1], `noise` [B, C·D]
+// I/O contract (docs/features.md): inputs `input` [B, 660] (the leader's [B, 667]), `temperature` [1], `noise` [B, C·D]
 // uniform in (0, 1); outputs `output` [B, 323], `intention` [B, 90] (only models with an intention
 // predictor), `code` [B, C]. Everything here is allocated once: callers write into `input`, call
 // run(), and read `result`, so stepping at 30 Hz creates no garbage of ours.
@@ -9,7 +9,12 @@ import { ort } from './ort';
 import type { Manifest, ModelEntry, PolicyResult, StepPolicy } from './types';
 import { DuetError } from '../ui/errors';
 import { createUniform, fillUniform } from './random';
-import { INPUT_SIZE, INTENTION_SIZE, OUTPUT_SIZE } from '../mirror/features';
+import { INPUT_SIZES, INTENTION_SIZE, OUTPUT_SIZE } from '../mirror/features';
+
+/** The input width of a model's role (the leader's input adds the figure block). */
+function inputSize(entry: ModelEntry): number {
+  return INPUT_SIZES[entry.role] ?? INPUT_SIZES.follower;
+}
 
 type Session = Awaited<ReturnType<typeof ort.InferenceSession.create>>;
 type Tensor = InstanceType<typeof ort.Tensor>;
@@ -24,7 +29,7 @@ interface Batch {
 }
 
 export class Policy implements StepPolicy {
-  /** Write the [660] input features here before run(). */
+  /** Write the [660] (leader: [667]) input features here before run(). */
   readonly input: Float32Array;
   /** Filled by run(); the same object and arrays every call. */
   readonly result: PolicyResult;
@@ -81,14 +86,15 @@ export class Policy implements StepPolicy {
     let batch = this.batches.get(k);
     if (!batch) {
       const noiseSize = this.entry.channels * this.entry.classes;
-      const input = new Float32Array(k * INPUT_SIZE);
+      const width = inputSize(this.entry);
+      const input = new Float32Array(k * width);
       const noise = new Float32Array(k * noiseSize);
       batch = {
         size: k,
         input,
         noise,
         feeds: {
-          input: new ort.Tensor('float32', input, [k, INPUT_SIZE]),
+          input: new ort.Tensor('float32', input, [k, width]),
           temperature: this.temperatureTensor,
           noise: new ort.Tensor('float32', noise, [k, noiseSize]),
         },
@@ -145,7 +151,7 @@ export async function createPolicy(manifest: Manifest, name: string, bytes: Uint
 async function warmUp(session: Session, entry: ModelEntry): Promise<void> {
   const noise = entry.channels * entry.classes;
   const outputs = await session.run({
-    input: new ort.Tensor('float32', new Float32Array(INPUT_SIZE), [1, INPUT_SIZE]),
+    input: new ort.Tensor('float32', new Float32Array(inputSize(entry)), [1, inputSize(entry)]),
     temperature: new ort.Tensor('float32', new Float32Array([1]), [1]),
     noise: new ort.Tensor('float32', new Float32Array(noise).fill(0.5), [1, noise]),
   }, entry.intention ? ['output', 'intention'] : ['output']);
@@ -155,7 +161,7 @@ async function warmUp(session: Session, entry: ModelEntry): Promise<void> {
 /** The ONNX graph must have the inputs and outputs of the contract, with matching widths. */
 function checkSession(name: string, entry: ModelEntry, session: Session): void {
   const bad = (detail: string) => new DuetError('A model does not match this page', `${name}: ${detail}`);
-  const widths: Record<string, number> = { input: INPUT_SIZE, noise: entry.channels * entry.classes };
+  const widths: Record<string, number> = { input: inputSize(entry), noise: entry.channels * entry.classes };
   for (const input of ['input', 'temperature', 'noise']) {
     if (!session.inputNames.includes(input)) throw bad(`no input named "${input}"`);
   }

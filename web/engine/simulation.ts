@@ -13,7 +13,7 @@ import { type GuardSettings, type Ranges, mostUpright, uprightMargin } from '../
 import { LeaderPlayback } from './playback';
 import { StepTimer } from './timing';
 import {
-  Dancer, type Duet, NOW, applyOutput, finishStep, outputIsAbsurd, startDuet, steerPlan, stepInputs,
+  Dancer, type Duet, NOW, applyOutput, askTurn, finishStep, outputIsAbsurd, startDuet, steerPlan, stepInputs,
 } from '../mirror/rollout';
 import type { DancerView, Simulation, SimulationOptions, StepPolicy, Steer } from './types';
 
@@ -107,6 +107,23 @@ export class DuetSimulation implements Simulation {
     this.playback?.start(this.duet.leader.track);
     this.timer.clear();
     this.updateViews(true);
+  }
+
+  /**
+   * Ask the leader to lead the partner's turn now: +1 counterclockwise seen from above (her left),
+   * -1 clockwise. Only the leader model reads it (its figure block); the followers read the leader.
+   * A recorded leader (playback) leads nothing: the request then does nothing. Returns whether
+   * the leader took it.
+   */
+  askTurn(direction: number): boolean {
+    if (this.playback) return false;
+    askTurn(this.duet, direction);
+    return true;
+  }
+
+  /** Whether a turn the visitor asked for is being led, and its direction (0: none). */
+  get turnAsked(): number {
+    return this.duet.request?.direction ?? 0;
   }
 
   async step(steer: Steer, temperature: number): Promise<void> {

@@ -40,6 +40,10 @@ export interface DancerView {
 export interface Simulation {
   /** Back to the start pose; keeps the models. */
   reset(): void;
+  /** Ask the leader model to lead the partner's turn (-1 her right, +1 her left); false while a file leads. */
+  askTurn(direction: number): boolean;
+  /** The turn being led: -1, +1, or 0 when none. */
+  readonly turnAsked: number;
   /** Advance one 1/30 s step. */
   step(steer: Steer, temperature: number): Promise<void>;
   leader: DancerView;
@@ -105,6 +109,8 @@ export interface ModelEntry {
   classes: number;
   /** Whether the model has an `intention` output. */
   intention: boolean;
+  /** 'leader' or 'follower': which input layout the model reads. */
+  role: string;
 }
 
 /** public/models/manifest.json, written by training/learning/export.py. */
@@ -157,6 +163,11 @@ export interface DuetHook {
   stepMs: { median: number; p95: number };
   /** Follower model in use: 'ours', 'ccm' or 'compare'. */
   model: string;
+  /** Ask the leader to lead the partner's turn, as T does (-1 her right, +1 her left); false
+   *  before the dance starts or while a file leads. */
+  askTurn?: (direction: number) => boolean;
+  /** The turn being led: -1, +1, or 0 when none. */
+  turnAsked?: number;
   /** The contact layer's hand hold between the leader and the (first) follower, 0..1
    *  (web/mirror/contact.ts): 1 when the closest hands meet. */
   hold: number;

@@ -26,6 +26,7 @@ export const KEY_JOINTS_SIZE = KEYS * N_KEY_JOINTS * 3; // 90
 export const POSE_SIZE = N_JOINTS * 12; // 204
 export const ROOT_UPDATE_SIZE = 3;
 export const CONTACTS_SIZE = 2;
+export const FIGURE_SIZE = 1 + KEYS; // 7: asked, then the partner's planned turn at each key
 
 export type Layout = ReadonlyArray<readonly [string, number]>;
 
@@ -40,7 +41,7 @@ export const LEADER_INPUT_LAYOUT: Layout = [
   ['partner_trajectory_past', TRAJECTORY_SIZE], ['partner_key_joints_past', KEY_JOINTS_SIZE],
   ['partner_pose', POSE_SIZE],
   ['self_trajectory_past', TRAJECTORY_SIZE], ['self_key_joints_past', KEY_JOINTS_SIZE],
-  ['self_pose', POSE_SIZE], ['control', TRAJECTORY_SIZE],
+  ['self_pose', POSE_SIZE], ['control', TRAJECTORY_SIZE], ['figure', FIGURE_SIZE],
 ];
 export const OUTPUT_LAYOUT: Layout = [
   ['root_update', ROOT_UPDATE_SIZE], ['trajectory_future', TRAJECTORY_SIZE],
@@ -48,10 +49,11 @@ export const OUTPUT_LAYOUT: Layout = [
 ];
 export const INTENTION_LAYOUT: Layout = [['partner_key_joints_future', KEY_JOINTS_SIZE]];
 const layoutSize = (layout: Layout) => layout.reduce((sum, [, size]) => sum + size, 0);
-export const INPUT_SIZE = layoutSize(FOLLOWER_INPUT_LAYOUT); // 660
+export const INPUT_SIZE = layoutSize(FOLLOWER_INPUT_LAYOUT); // 660: the follower's input
+export const LEADER_INPUT_SIZE = layoutSize(LEADER_INPUT_LAYOUT); // 667: the same blocks, control and figure
 export const OUTPUT_SIZE = layoutSize(OUTPUT_LAYOUT); // 323
 export const INTENTION_SIZE = KEY_JOINTS_SIZE; // 90
-if (INPUT_SIZE !== layoutSize(LEADER_INPUT_LAYOUT)) throw new Error('leader and follower inputs differ in size');
+export const INPUT_SIZES: Readonly<Record<string, number>> = { follower: INPUT_SIZE, leader: LEADER_INPUT_SIZE };
 
 // Foot contact: ankle joint near the floor and nearly still. The ankle of a flat foot sits
 // 7-11 cm up in this data (heels included), so 15 cm leaves room; 0.5 m/s separates a planted
@@ -327,7 +329,20 @@ const INPUT_BLOCKS: Record<string, InputBlock> = {
   self_pose: (_partner, me, t, x, z, h, out, at) => poseAt(me, t, x, z, h, out, at),
   // The leader's control is its own planned (steered) future trajectory.
   control: (_partner, me, t, x, z, h, out, at) => trajectoryAt(me, t, FUTURE_OFFSETS, x, z, h, out, at),
+  // Nobody asks for a figure here; leaderInput writes the request over it when there is one.
+  figure: (_partner, _me, _t, _x, _z, _h, out, at) => figureBlock(null, out, at),
 };
+
+/**
+ * The leader's figure block [7] at out[at..]: `asked` (1 when a figure is asked for), then how
+ * far the partner is to have turned at each future key, in full turns from now (signed like the
+ * heading: +1 is a full turn counterclockwise seen from above). null: nobody asks (zeros), and
+ * the leader leads what he likes, as he learnt from the samples whose figure was hidden.
+ */
+export function figureBlock(partnerTurn: ArrayLike<number> | null, out: Out, at = 0): void {
+  out[at] = partnerTurn ? 1 : 0;
+  for (let k = 0; k < KEYS; k++) out[at + 1 + k] = partnerTurn ? partnerTurn[k] : 0;
+}
 
 /** A layout table as (writer, start) pairs in its order (Python concatenates; here every block writes at its offset). */
 function inputPlan(layout: Layout): { write: InputBlock; start: number }[] {
@@ -355,9 +370,15 @@ export function followerInput(partner: Track, me: Track, t: number, out: Out, at
   writeInput(FOLLOWER_PLAN, partner, me, t, out, at);
 }
 
-/** Input I [660] for the leader (partner = follower, control = own future trajectory). */
-export function leaderInput(partner: Track, me: Track, t: number, out: Out, at = 0): void {
+const FIGURE_AT = blockSlices(LEADER_INPUT_LAYOUT).figure.start;
+
+/**
+ * Input I [667] for the leader (partner = follower, control = own future trajectory, then the
+ * figure block: figureBlock of `figure`, the partner's planned turn per key, zeros when null).
+ */
+export function leaderInput(partner: Track, me: Track, t: number, out: Out, at = 0, figure: ArrayLike<number> | null = null): void {
   writeInput(LEADER_PLAN, partner, me, t, out, at);
+  if (figure) figureBlock(figure, out, at + FIGURE_AT);
 }
 
 /** Output O [323]: the self at t+1, in the root space of t+1 (root update in t's). */

@@ -35,6 +35,14 @@ export const ANCHOR_RATE = 0.3; // share of the leader's distance to its anchor 
 export const LEASH_DISTANCE = 2.0; // m: beyond this a follower is drawn toward its leader ...
 export const LEASH_RATE = 0.1; // ... closing this share of the excess every frame
 export const START_DISTANCE = 0.8; // m between the partners at the start and after a reset
+// A visitor's request to lead the partner's turn (askTurn) becomes the leader's figure block
+// (features figureBlock): the partner's planned turn, one full turn eased in and out from
+// TURN_START to TURN_START + TURN_SECONDS after the request. Recorded turns take about 1.2 s from
+// their first 30 degrees to 330 (median over the 79 whole turns of the 12 takes). The request
+// ends after REQUEST_SECONDS, when the leader leads as he likes again.
+export const TURN_START = 0.4; // s
+export const TURN_SECONDS = 1.2; // s
+export const REQUEST_SECONDS = 2.5; // s
 
 /**
  * `count` forward (R ez) and up (R ey) vectors -> orthonormal row-major 3x3 matrices at out[at..]
@@ -329,6 +337,41 @@ export function keepClose(follower: Dancer, leader: Dancer): boolean {
   return true;
 }
 
+/**
+ * The visitor asked the leader to lead the partner's turn: +1 counterclockwise seen from above
+ * (her left), -1 clockwise; `frame` counts the steps since the request.
+ */
+export interface TurnRequest {
+  direction: number;
+  frame: number;
+}
+
+/** Full turns the partner is planned to have made `seconds` after a request (smoothstep). */
+export function plannedTurn(seconds: number): number {
+  const u = Math.min(1, Math.max(0, (seconds - TURN_START) / TURN_SECONDS));
+  return u * u * (3 - 2 * u);
+}
+
+const figureKeys = new Float64Array(KEYS);
+
+/**
+ * The leader's figure keys [KEYS] for a request (null: nobody asks): how far the partner is to
+ * turn from now to each future key, in full turns, signed by the direction. A shared scratch array.
+ */
+export function figureInput(request: TurnRequest | null): Float64Array | null {
+  if (!request) return null;
+  const now = request.frame / FPS;
+  for (let k = 0; k < KEYS; k++) {
+    figureKeys[k] = request.direction * (plannedTurn(now + FUTURE_OFFSETS[k] / FPS) - plannedTurn(now));
+  }
+  return figureKeys;
+}
+
+/** Ask the leader to lead the partner's turn now (a request still running starts anew). */
+export function askTurn(duet: Duet, direction: number): void {
+  duet.request = { direction: direction >= 0 ? 1 : -1, frame: 0 };
+}
+
 export interface Duet {
   leader: Dancer;
   /** One, or two in compare mode; the leader reacts to the first. */
@@ -336,6 +379,8 @@ export interface Duet {
   startPose: { leader: StartPose; follower: StartPose };
   steering: Steering;
   frame: number;
+  /** A turn the visitor asked the leader to lead, while it runs; null otherwise. */
+  request: TurnRequest | null;
 }
 
 /** The parts of manifest.json a duet starts from. */
@@ -376,14 +421,17 @@ export function startDuet(manifest: DuetManifest, followerCount = 1): Duet {
   const leader = startDancer(offsets.leader.flat(), startPose.leader, 0, 0, 0);
   const followers = Array.from({ length: followerCount }, () =>
     startDancer(offsets.follower.flat(), startPose.follower, 0, START_DISTANCE, Math.PI));
-  const duet: Duet = { leader, followers, startPose, steering: new Steering(), frame: 0 };
+  const duet: Duet = { leader, followers, startPose, steering: new Steering(), frame: 0, request: null };
   setAnchor(duet);
   return duet;
 }
 
-/** Both models' inputs at NOW: the leader's (partner = first follower) and each follower's. */
+/**
+ * Both models' inputs at NOW: the leader's (partner = first follower) and each follower's. The
+ * followers' never hold the request: they read the leader.
+ */
 export function stepInputs(duet: Duet, leaderOut: Out | null, followerOuts: Out[]): void {
-  if (leaderOut) leaderInput(duet.followers[0].track, duet.leader.track, NOW, leaderOut);
+  if (leaderOut) leaderInput(duet.followers[0].track, duet.leader.track, NOW, leaderOut, 0, figureInput(duet.request));
   duet.followers.forEach((f, i) => followerInput(duet.leader.track, f.track, NOW, followerOuts[i]));
 }
 
@@ -413,6 +461,10 @@ export function finishStep(
     }
   } else {
     setAnchor(duet); // a recording leads: the anchor waits where the model will take over
+  }
+  if (duet.request) {
+    duet.request.frame += 1;
+    if (duet.request.frame >= REQUEST_SECONDS * FPS) duet.request = null;
   }
   duet.followers.forEach((f, i) => {
     if (outputIsAbsurd(followerOutputs[i])) resetBeside(f, duet.leader, duet.startPose.follower);

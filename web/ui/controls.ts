@@ -28,6 +28,8 @@ export interface ControlsOptions {
   viewForward(out: { x: number; z: number }): void;
   onPause(): void;
   onReset(): void;
+  /** T: lead the partner's turn to her right (clockwise seen from above, -1); Shift+T to her left (+1). */
+  onTurn(direction: number): void;
 }
 
 export class Controls {
@@ -109,6 +111,8 @@ export class Controls {
       if (!event.repeat) this.options.onPause();
     } else if (event.code === 'KeyR' && !event.repeat) {
       this.options.onReset();
+    } else if (event.code === 'KeyT' && !event.repeat) {
+      this.options.onTurn(event.shiftKey ? 1 : -1);
     }
   }
 

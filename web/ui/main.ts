@@ -20,6 +20,7 @@ import { DEFAULT_ORBIT, Stage } from '../draw/scene';
 import { readBodies } from '../draw/body';
 import { Controls, releaseFocusAfterUse } from './controls';
 import { Hud, PauseButton } from './hud';
+import { TurnButtons } from './turns';
 import { Panel } from './panel';
 import { CompareLayout } from './compare';
 import { ViewCentre } from './layout';
@@ -73,6 +74,7 @@ const hook: DuetHook = {
   bootTimings,
 };
 window.duet = hook;
+
 installGlobalErrorHandlers();
 
 function publish(target: DuetHook['leader'], view: DancerView): void {
@@ -109,6 +111,7 @@ class Page {
   private readonly hud: Hud;
   private readonly controls: Controls;
   private readonly pauseButton: PauseButton;
+  private readonly turnButtons: TurnButtons;
   private readonly recorder: Recorder;
   private readonly leaderFileInput: LeaderFileInput;
   private readonly avatarInput: HTMLInputElement;
@@ -189,9 +192,12 @@ class Page {
       viewForward: (out) => this.stage.viewForward(out),
       onPause: () => this.togglePause(),
       onReset: () => this.reset(),
+      onTurn: (direction) => this.askTurn(direction),
     });
     const panel = this.createPanel();
     this.pauseButton = new PauseButton(() => this.togglePause());
+    this.turnButtons = new TurnButtons((direction) => this.askTurn(direction));
+    hook.askTurn = (direction) => this.askTurn(direction); // tests lead a turn the way T does
     // After a click on a control the keys belong to the dance again (controls.ts).
     releaseFocusAfterUse(document.body);
     this.viewCentre = new ViewCentre(panel.gui.domElement, () => !panel.gui._closed);
@@ -279,6 +285,23 @@ class Page {
     const stats = simulation.stepMs();
     hook.stepMs.median = stats.median;
     hook.stepMs.p95 = stats.p95;
+    hook.turnAsked = simulation.turnAsked;
+    this.turnButtons.show(simulation.turnAsked);
+  }
+
+  /**
+   * Ask the leader to lead the partner's turn (T, Shift+T, the turn buttons): his model reads
+   * the request; she only reads him. A leader dancing a file leads nothing, and says so.
+   */
+  private askTurn(direction: number): boolean {
+    const simulation = this.simulation;
+    if (!simulation) return false;
+    if (!simulation.askTurn(direction)) {
+      showToast('The leader dances a file', 'A recorded leader cannot be asked for a turn: choose “leader back to model” first.', 'info', 5000);
+      return false;
+    }
+    this.turnButtons.show(direction);
+    return true;
   }
 
   /** Put the camera between the partners at once. */

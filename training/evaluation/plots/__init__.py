@@ -16,6 +16,8 @@ lambda_sweep.png            last-epoch validation codebook error and MSE against
 rollout_topview.png         top view of free-running rollouts on a test take, leader played back
                             from the recording (evaluate.rollout), ours vs CCM vs the recording.
 training_curves.png         validation MSE and codebook error per epoch of every model.
+facing_angle.png            the follower's facing over time beside the played-back recorded leader:
+                            recorded, ours, CCM, Motion Matching, each turn marked (figures.py).
 
 Codebook error of one frame: the MSE between the one-hot target code (argmax of S per channel)
 and the one-hot estimate (argmax of Ŝ, temperature 0), i.e. 2k/(C*D) for k channels that differ,
@@ -33,11 +35,12 @@ from pathlib import Path
 from .codebook import figure_codebook
 from .common import FILES, Skip
 from .curves import figure_curves
+from .facing import figure_facing
 from .rollout import figure_rollout
 from .sweep import figure_sweep
 from .tsne import figure_tsne
 
-FIGURES = ["tsne", "codebook", "sweep", "rollout", "curves"]
+FIGURES = ["tsne", "codebook", "sweep", "rollout", "curves", "facing"]
 
 
 def main(argv=None) -> int:
@@ -74,7 +77,7 @@ def main(argv=None) -> int:
     torch.set_num_threads(args.threads)
     out = Path(args.out)
     makers = {"tsne": figure_tsne, "codebook": figure_codebook, "sweep": figure_sweep,
-              "rollout": figure_rollout, "curves": figure_curves}
+              "rollout": figure_rollout, "curves": figure_curves, "facing": figure_facing}
     written, skipped = [], []
     for f in wanted:
         try:

@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 FILES = {"tsne": "tsne_latent.png", "codebook": "codebook_error_density.png", "sweep": "lambda_sweep.png",
-         "rollout": "rollout_topview.png", "curves": "training_curves.png"}
+         "rollout": "rollout_topview.png", "curves": "training_curves.png", "facing": "facing_angle.png"}
 DPI = 110
 
 # One colour per method across every figure: ours red, CCM blue/grey, Motion Matching green.

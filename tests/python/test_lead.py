@@ -1,0 +1,101 @@
+"""Leading a turn: the leader's figure block (features.figure_block, partner_turn), the request's
+plan (rollout.ask_turn, figure_input), the training's hidden figures and turn onsets, and the
+evaluation tool training.evaluation.lead."""
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+import torch
+
+from training.evaluation import lead
+from training.learning import train as T
+from training.mirror import features as feat
+from training.mirror import rollout as ro
+from training.mirror.features import FUTURE_OFFSETS, KEYS, Track
+from training.mirror.skeleton import FPS
+
+
+def spinning_track(frames: int, degrees_per_second: float) -> Track:
+    """A track whose root heading turns at a constant rate (positions unused by partner_turn)."""
+    heading = np.angle(np.exp(1j * np.radians(degrees_per_second) * np.arange(frames) / FPS))
+    return Track(np.zeros((frames, 17, 3)), np.zeros((frames, 17, 3, 3)), np.zeros((frames, 2)), heading)
+
+
+def test_partner_turn_counts_whole_turns_through_the_wrap():
+    # 540 deg/s: one and a half turns a second, wrapping the heading many times.
+    turns = feat.partner_turn(spinning_track(200, 540.0), np.array([40, 90]))
+    assert np.allclose(turns, 1.5 * FUTURE_OFFSETS[None] / FPS, atol=1e-9)
+    clockwise = feat.partner_turn(spinning_track(200, -200.0), np.array([50]))
+    assert np.all(clockwise < 0) and clockwise[0, -1] == pytest.approx(-200 / 360)
+
+
+def test_the_figure_block_says_whether_anyone_asked():
+    assert np.all(feat.figure_block(None, 3) == 0)
+    asked = feat.figure_block(np.full((2, KEYS), 0.25), 2)
+    assert asked.shape == (2, feat.FIGURE_SIZE) and np.all(asked[:, 0] == 1) and np.all(asked[:, 1:] == 0.25)
+    assert feat.LEADER_INPUT_SIZE == feat.INPUT_SIZE + feat.FIGURE_SIZE
+
+
+def test_a_request_plans_one_full_turn_and_ends():
+    assert ro.planned_turn(0.0) == 0 and ro.planned_turn(ro.TURN_START + ro.TURN_SECONDS) == 1
+    keys = [ro.figure_input(ro.TurnRequest(-1, f)) for f in range(int(ro.REQUEST_SECONDS * FPS))]
+    assert all(np.all(k <= 0) for k in keys)                       # clockwise all the way
+    # Summed over the request, the keys 1 s ahead cover the whole planned turn once.
+    ahead = [-k[-1] for k in keys]
+    assert max(ahead) == pytest.approx(ro.planned_turn(1.0 + 0.4) - ro.planned_turn(0.4), abs=0.05)
+    assert ro.figure_input(None) is None
+    offsets = np.zeros((17, 3)).tolist()
+    duet = ro.start_duet({"skeleton": {"offsets": {"leader": offsets, "follower": offsets}}, "startPose": START_POSE})
+    ro.ask_turn(duet, 1)
+    x_leader, x_follower = ro.step_inputs(duet)
+    fig = feat.block_slices(feat.LEADER_INPUT_LAYOUT)["figure"]
+    assert x_leader.shape == (feat.LEADER_INPUT_SIZE,) and x_leader[fig][0] == 1
+    assert x_follower.shape == (feat.INPUT_SIZE,)                  # the follower is never told
+
+
+START_POSE = {r: {"hip": [0.0, 0.9, 0.0], "forward": [[0.0, 0.0, 1.0]] * 17, "up": [[0.0, 1.0, 0.0]] * 17}
+              for r in ("leader", "follower")}
+
+
+def test_training_hides_the_figure_in_a_share_of_samples():
+    x = torch.ones(4000, feat.LEADER_INPUT_SIZE)
+    hidden = T.hide_figure(x, 0.5, torch.Generator().manual_seed(0))
+    fig = feat.block_slices(feat.LEADER_INPUT_LAYOUT)["figure"]
+    share = (hidden[:, fig] == 0).all(1).float().mean().item()
+    assert 0.45 < share < 0.55
+    assert torch.equal(hidden[:, :fig.start], x[:, :fig.start])   # nothing else is touched
+
+
+def test_turn_onsets_need_a_turn_ahead_and_none_behind():
+    si, so = feat.block_slices(feat.FOLLOWER_INPUT_LAYOUT), feat.block_slices(feat.OUTPUT_LAYOUT)
+
+    def sample(past_deg, future_deg):
+        x, y = np.zeros(feat.INPUT_SIZE), np.zeros(feat.OUTPUT_SIZE)
+        # Headings of the keys, turning evenly: past keys end at 0 now, future keys start from 0.
+        past = np.radians(past_deg) * (np.arange(-KEYS, 0) / KEYS)
+        fut = np.radians(future_deg) * (np.arange(1, KEYS + 1) / KEYS)
+        x[si["self_trajectory_past"]] = np.stack([0 * past, 0 * past, np.sin(past), np.cos(past)], -1).ravel()
+        y[so["trajectory_future"]] = np.stack([0 * fut, 0 * fut, np.sin(fut), np.cos(fut)], -1).ravel()
+        return x, y
+
+    cases = [(0, 300, True), (0, -200, True), (0, 120, False), (200, 300, False)]
+    x, y = map(np.stack, zip(*[sample(p, f) for p, f, _ in cases]))
+    assert T.turn_onsets(x, y).tolist() == [c[2] for c in cases]
+
+
+def test_lead_runs_on_freshly_exported_models(exported, data3, tmp_path, capsys):
+    """The tool runs to its report on smoke models (whose dancing means nothing)."""
+    out = tmp_path / "lead"
+    rc = lead.main(["--models", str(exported["models"]), "--data", str(data3), "--takes", "06",
+                    "--seeds", "2", "--seconds", "9", "--out", str(out), "--quiet"])
+    assert rc == 0
+    res = json.loads((out / "lead.json").read_text())
+    assert res["summary"]["requests"] == 2                          # one at 3 s in each 9 s duet
+    assert "Requests" in capsys.readouterr().out
+
+
+def test_lead_names_missing_models(tmp_path, capsys):
+    assert lead.main(["--models", str(tmp_path), "--seeds", "1"]) == 2
+    assert "manifest.json not found" in capsys.readouterr().err

@@ -1,0 +1,197 @@
+"""python -m training.evaluation.lead: does the visitor's "lead a turn" work, and does the couple dance
+when nobody steers? -> lead.json + lead.md
+
+    python -m training.evaluation.lead --models public/models --seeds 100 --out runs/lead
+
+Two measurements on the shipped models, the dancers run as the page runs them (options.py):
+
+1. Requests. Each seed dances a duet with nobody steering; every REQUEST_EVERY seconds the duet is
+   copied and the copy is asked to lead a turn (rollout.ask_turn, a random direction), while the
+   original goes on unasked. Both are danced REQUEST_SECONDS on with the same random stream and the
+   follower's turns are counted (figures.turns, from the request on): a request works when the
+   follower completes a turn in that time, and the same moment unasked tells how often she would
+   have turned anyway. The follower never sees the request; she reads the leader.
+2. Unasked dancing. The same duets, before any copy: each dancer's turns per minute, spin frames,
+   body motion and travel (figures.py) against the recorded dancers of --takes, and how far the
+   leader goes from where he started (the couple must stay on screen).
+"""
+from __future__ import annotations
+
+import argparse
+import copy
+import json
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+from tqdm import tqdm
+
+from ..data.dataset import DataError, TEST_TAKES
+from ..data.folders import add_folder
+from ..mirror.rollout import NOW, REQUEST_SECONDS, ask_turn, start_duet, step
+from ..mirror.skeleton import FPS
+from . import figures as Fg
+from . import options as O
+from .evaluate_inputs import EvalError, find_models, load_eval_takes, load_onnx
+
+REQUEST_EVERY = 6.0      # s between requests in one duet (a turn and the time to settle after it)
+WARM_UP = 3.0            # s of dancing before the first request
+
+
+def branch(duet, leader, follower, temperature: float, rng: np.random.Generator, direction: int | None,
+           frames: int) -> np.ndarray:
+    """Dance a copy of the duet `frames` steps on (asked for a turn in `direction` first, or not):
+    the follower's world positions [frames + 1, 17, 3], the request's frame first."""
+    d = copy.deepcopy(duet)
+    if direction is not None:
+        ask_turn(d, direction)
+    out = np.zeros((frames + 1, 17, 3))
+    out[0] = d.follower.track.positions[NOW]
+    for f in range(frames):
+        step(d, leader, follower, np.zeros(2), temperature, rng)
+        out[f + 1] = d.follower.track.positions[NOW]
+    return out
+
+
+def one_duet(manifest, leader, follower, temperature: float, seed: int, seconds: float) -> dict:
+    rng = np.random.default_rng(seed)
+    duet = start_duet(manifest)
+    frames = int(seconds * FPS)
+    window = int(REQUEST_SECONDS * FPS)
+    ask_at = set(range(int(WARM_UP * FPS), frames - window, int(REQUEST_EVERY * FPS)))
+    lead, follow = np.zeros((frames, 17, 3)), np.zeros((frames, 17, 3))
+    requests = []
+    for f in range(frames):
+        if f in ask_at:
+            direction = int(rng.choice([-1, 1]))
+            state = rng.bit_generator.state
+            asked = branch(duet, leader, follower, temperature, np.random.default_rng(seed * 1000 + f), direction, window)
+            unasked = branch(duet, leader, follower, temperature, np.random.default_rng(seed * 1000 + f), None, window)
+            rng.bit_generator.state = state
+            turns_asked, turns_unasked = Fg.turns(Fg.facing(asked)), Fg.turns(Fg.facing(unasked))
+            requests.append({"frame": f, "direction": direction,
+                             "turned": bool(turns_asked), "turned_that_way": any(d == direction for _, d in turns_asked),
+                             "seconds": turns_asked[0][0] / FPS if turns_asked else None,
+                             "turned_unasked": bool(turns_unasked)})
+        step(duet, leader, follower, np.zeros(2), temperature, rng)
+        lead[f], follow[f] = duet.leader.track.positions[NOW], duet.follower.track.positions[NOW]
+    strip = lambda d: {k: v for k, v in d.items() if not isinstance(v, list)}
+    return {"seed": seed, "requests": requests, "leader": strip(Fg.dancer(lead)), "follower": strip(Fg.dancer(follow)),
+            "leader_from_start_m": float(np.linalg.norm(lead[:, 0, [0, 2]] - lead[0, 0, [0, 2]], axis=-1).max())}
+
+
+def summary(per_seed: list[dict], ref: dict) -> dict:
+    req = [r for s in per_seed for r in s["requests"]]
+    n = len(req)
+    share = lambda k: sum(r[k] for r in req) / n if n else float("nan")
+    out = {"requests": n, "turned": share("turned"), "turned_that_way": share("turned_that_way"),
+           "turned_unasked": share("turned_unasked"),
+           "median_seconds": float(np.median([r["seconds"] for r in req if r["seconds"] is not None]))
+           if any(r["turned"] for r in req) else None}
+    for who in ("leader", "follower"):
+        items = [s[who] for s in per_seed]
+        worst = min(range(len(items)), key=lambda i: items[i]["turns_per_min"])
+        out[who] = {**Fg.summarize(items), "ratio": Fg.ratios(Fg.summarize(items), ref[who]),
+                    "worst_seed": per_seed[worst]["seed"], "worst_turns_per_min": items[worst]["turns_per_min"]}
+    far = [s["leader_from_start_m"] for s in per_seed]
+    out["leader_from_start_m"] = {"median": float(np.median(far)), "max": float(np.max(far)),
+                                  "worst_seed": per_seed[int(np.argmax(far))]["seed"]}
+    # The seed whose requests worked least often: the one to look at.
+    by_seed = [(sum(r["turned"] for r in s["requests"]) / max(1, len(s["requests"])), s["seed"]) for s in per_seed]
+    out["worst_request_seed"] = min(by_seed)[1]
+    return out
+
+
+def recording(data: str, takes: list[str]) -> dict:
+    tk = load_eval_takes(data, takes, None, None)
+    return {who: Fg.summarize([Fg.dancer(getattr(t, part).positions) for t in tk])
+            for who, part in (("leader", "lead"), ("follower", "follow"))}
+
+
+def write_markdown(path: Path, res: dict) -> None:
+    s, ref, cfg = res["summary"], res["recording"], res["config"]
+    L = [f"# Leading a turn, and dancing unasked: {cfg['seeds']} seeds × {cfg['seconds']:g} s, nobody steering", "",
+         f"Models `{cfg['models']}`; leader variety {cfg['temperature']:g}, follower {cfg['follower_temperature']:g}, "
+         f"guard {cfg['guard']}. Wall time {cfg['wall_seconds'] / 60:.1f} min.", "",
+         "## Requests", "",
+         f"{s['requests']} requests, one every {REQUEST_EVERY:g} s after {WARM_UP:g} s; each danced "
+         f"{REQUEST_SECONDS:g} s asked and, from the same moment with the same random stream, unasked.", "",
+         "| follower completes a turn within 2.5 s | share |", "|---|---|",
+         f"| asked | {100 * s['turned']:.0f} % (the asked direction: {100 * s['turned_that_way']:.0f} %) |",
+         f"| the same moments, unasked | {100 * s['turned_unasked']:.0f} % |",
+         f"| ratio asked / unasked | {s['turned'] / s['turned_unasked']:.1f}× |" if s["turned_unasked"] else
+         "| ratio asked / unasked | – (no turn unasked) |", "",
+         f"Median time from the request to the turn's 300 degrees: {s['median_seconds']:.2f} s. "
+         f"Seed whose requests worked least often: {s['worst_request_seed']}." if s["median_seconds"] is not None else
+         "No request was followed by a turn.", "",
+         "## Dancing unasked (figures.py), against the recording of takes " + ", ".join(res["takes"]), "",
+         "| dancer | turns/min | spin frames | body motion m/s | travel m/s | least-turning seed |",
+         "|---|---|---|---|---|---|"]
+    for who in ("leader", "follower"):
+        r, q, f0 = s[who], s[who]["ratio"], ref[who]
+        L.append(f"| recorded {who} | {f0['turns_per_min']:.1f} | {100 * f0['spin_frames']:.1f} % | "
+                 f"{f0['body_motion']:.2f} | {f0['travel']:.2f} | – |")
+        L.append(f"| {who} | {r['turns_per_min']:.1f} ({q['turns_per_min']:.2f}×) | {100 * r['spin_frames']:.1f} % "
+                 f"({q['spin_frames']:.2f}×) | {r['body_motion']:.2f} ({q['body_motion']:.2f}×) | {r['travel']:.2f} "
+                 f"({q['travel']:.2f}×) | seed {r['worst_seed']}: {r['worst_turns_per_min']:.1f}/min |")
+    far = s["leader_from_start_m"]
+    L += ["", f"The leader's largest distance from where he started: median {far['median']:.2f} m, "
+              f"worst {far['max']:.2f} m (seed {far['worst_seed']})."]
+    path.write_text("\n".join(L) + "\n")
+
+
+def run(args) -> dict:
+    t0 = time.time()
+    manifest, onnx, leader_path = find_models(args.models)
+    if leader_path is None or "ours" not in onnx and args.method not in onnx:
+        raise EvalError(f"{args.models}: needs leader.onnx and the follower {args.method}")
+    error = O.resolve(args, manifest)
+    if error:
+        raise EvalError(f"{args.models}/manifest.json: {error}")
+    leader = load_onnx(leader_path)
+    follower = O.follower_policy(load_onnx(onnx[args.method]), manifest, args, args.temperature)
+    takes = [t for t in args.takes.split(",") if t]
+    ref = recording(args.data, takes)
+    per_seed = []
+    for seed in tqdm(range(args.first_seed, args.first_seed + args.seeds), desc="duets", unit="duet",
+                     file=sys.stderr, disable=args.quiet):
+        per_seed.append(one_duet(manifest, leader, follower, args.temperature, seed, args.seconds))
+    return {"takes": takes, "recording": ref, "per_seed": per_seed, "summary": summary(per_seed, ref),
+            "config": {"models": str(args.models), "method": args.method, "seeds": args.seeds,
+                       "seconds": args.seconds, "temperature": args.temperature,
+                       "follower_temperature": args.follower_temperature, "guard": args.guard,
+                       "wall_seconds": time.time() - t0}}
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m training.evaluation.lead", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    add_folder(ap, "data", "read: the recorded dancers to compare with")
+    add_folder(ap, "models", "read: the leader and the follower")
+    ap.add_argument("--method", default="ours", help="the follower (ours, ccm, or another follower model's name)")
+    ap.add_argument("--takes", default=",".join(TEST_TAKES))
+    ap.add_argument("--seeds", type=int, default=100)
+    ap.add_argument("--first-seed", type=int, default=0)
+    ap.add_argument("--seconds", type=float, default=30.0, help="per duet (a request every 6 s after 3 s)")
+    O.add_options(ap)
+    ap.add_argument("--out", default="runs/lead")
+    ap.add_argument("--quiet", action="store_true")
+    args = ap.parse_args(argv)
+    if args.seeds < 1 or args.seconds < WARM_UP + REQUEST_SECONDS:
+        ap.error(f"--seeds must be at least 1 and --seconds at least {WARM_UP + REQUEST_SECONDS:g}")
+    try:
+        res = run(args)
+    except (EvalError, DataError) as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "lead.json").write_text(json.dumps(res, indent=1))
+    write_markdown(out / "lead.md", res)
+    print((out / "lead.md").read_text())
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
