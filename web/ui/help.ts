@@ -68,7 +68,7 @@ export class Help {
     const list = element('dl', 'help-controls');
     for (const [name, text] of options.controls) list.append(element('dt', '', name), element('dd', '', text));
     card.append(list);
-    card.append(element('p', 'help-keys-line', 'Keys: arrows or WASD lead · T lead her turn to her right, Shift+T to her left · Space pause · R start again (the camera too) · drag to turn the camera, wheel to zoom. Phone: drag one finger to lead, two fingers to turn and zoom; “pause” and the two “turn” buttons by the title.'));
+    card.append(element('p', 'help-keys-line', 'Keys: arrows or WASD lead · T lead her turn to her right, Shift+T to her left · Space pause · R start again (the camera too) · “● clip” saves a 6 s video, the corners button goes full screen · drag to turn the camera, wheel to zoom. Phone: drag one finger to lead, two fingers to turn and zoom; “pause” and the two “turn” buttons by the title.'));
 
     this.details = element('details', 'about-details');
     this.details.append(element('summary', '', 'about / details'), element('p', '', RESEARCH), element('p', '', options.note));

@@ -21,6 +21,7 @@ import { readBodies } from '../draw/body';
 import { Controls, releaseFocusAfterUse } from './controls';
 import { Hud, PauseButton } from './hud';
 import { TurnButtons } from './turns';
+import { ClipButton, FullscreenButton } from './clip';
 import { Panel } from './panel';
 import { CompareLayout } from './compare';
 import { ViewCentre } from './layout';
@@ -197,6 +198,9 @@ class Page {
     const panel = this.createPanel();
     this.pauseButton = new PauseButton(() => this.togglePause());
     this.turnButtons = new TurnButtons((direction) => this.askTurn(direction));
+    // Save a clip of the canvas, and full screen (clip.ts): beside the turn buttons.
+    new ClipButton(this.stage.canvas);
+    new FullscreenButton();
     hook.askTurn = (direction) => this.askTurn(direction); // tests lead a turn the way T does
     // After a click on a control the keys belong to the dance again (controls.ts).
     releaseFocusAfterUse(document.body);
