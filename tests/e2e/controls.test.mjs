@@ -56,6 +56,8 @@ const FAST = { force: true };
 const controller = (page, name) => page.locator('.duet-panel .lil-controller').filter({ has: page.locator('.lil-name', { hasText: exactly(name) }) });
 const button = (page, name) => page.locator('.duet-panel button', { hasText: name }).first();
 const recording = (page) => page.locator('.record-status.recording').isVisible();
+/** The pause / resume button (the turn, clip and full screen buttons by the title share its look: class pause-button). */
+const pauseButton = (page) => page.locator('.title-row .pause-button', { hasText: /^\s*(pause|resume)\s*$/ });
 
 /** Click a slider where its value already is: a click on the slider, the value unchanged. */
 async function clickSlider(page, row) {
@@ -168,8 +170,8 @@ describe('desktop: a click in the panel leaves the keys steering', () => {
       await check(`title "${title}", twice`);
     }
     // The buttons by the title: pause (twice: paused, then dancing) and the help's "?" and "×".
-    await page.locator('.pause-button').click(FAST);
-    await page.locator('.pause-button').click(FAST);
+    await pauseButton(page).click(FAST);
+    await pauseButton(page).click(FAST);
     await check('pause button, twice');
     await page.locator('.help-button').click(FAST);
     await page.locator('.help-close').click(FAST);
@@ -380,7 +382,7 @@ describe('phone: pause, reset view, and a camera that keeps the pair in view', (
   });
 
   test('the pause button stops the dance and starts it again', async () => {
-    const pause = page.locator('.pause-button');
+    const pause = pauseButton(page);
     assert.ok(await pause.isVisible(), 'a pause button is on screen');
     await pause.tap();
     await sleep(300); // a step already under way ends
@@ -407,7 +409,7 @@ describe('phone: pause, reset view, and a camera that keeps the pair in view', (
   }
 
   test('pinching and turning with two fingers never loses the pair; "reset view" brings the first view back', async () => {
-    await page.locator('.pause-button').tap(); // the pair stands still while the camera moves
+    await pauseButton(page).tap(); // the pair stands still while the camera moves
     try {
       // Fingers apart, 8 times as far: closer, as close as it goes (from 5.2 m).
       await twoFingers(page, [[175, 420], [215, 420]], [[35, 420], [355, 420]]);
@@ -432,7 +434,7 @@ describe('phone: pause, reset view, and a camera that keeps the pair in view', (
       await page.locator('.duet-panel > .lil-title').tap();
       await sleep(500);
     } finally {
-      await page.locator('.pause-button').tap();
+      await pauseButton(page).tap();
     }
   });
 
