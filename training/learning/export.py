@@ -41,11 +41,11 @@ MANIFEST_VERSION = 1
 OPSET = 18
 # Each dancer's variety (Gumbel temperature). The follower's is the page's slider. At 1 the 24
 # code channels are drawn each on its own, and a mix of "turn" and "step" channels decodes to a
-# step: beside the recorded leader the follower turns 4.4 times a minute at 1 against 19.3 at 0.5
+# step: beside the recorded leader the follower turns 1.9 times a minute at 1 against 11.5 at 0.5
 # (the recording: 25.9; test takes 02, 13, 5 seeds). But beside our steered leader, lower
-# varieties let her sink: seeds with a second of hips or head low were 0 of 20 at 1, 1 at 0.7,
-# 5 at 0.5, 9 at 0.3 and 15 at 0 (docs/results.md, "Salsa turns"): the page keeps 1. The leader
-# dances steadiest at 0.5 (docs/plausibility.md).
+# varieties let her sink (seeds with a second of hips or head low, of 20: 0 at 1, 1 at 0.7, 5 at
+# 0.5, 9 at 0.3, 15 at 0; docs/results.md, "Salsa turns"): the page keeps 1. The leader dances
+# steadiest at 0.5 (docs/plausibility.md).
 DEFAULT_TEMPERATURE = 1.0
 LEADER_TEMPERATURE = 0.5
 # int8 weights snapped to every 4th level (coarsen): 1.0 MB less for a first visit to download,
