@@ -176,6 +176,11 @@ describe('desktop: a click in the panel leaves the keys steering', () => {
     await page.locator('.help-button').click(FAST);
     await page.locator('.help-close').click(FAST);
     await check('help "?", then "×"');
+    // Leading a turn (a request to the leader's network) by its button and by T leaves the keys steering.
+    await page.locator('.turn-button').first().click(FAST);
+    await check('turn button "↻ turn"');
+    await page.keyboard.press('KeyT');
+    await check('T (lead a turn)');
     report();
     assert.deepEqual(dialogs, [], 'no dialog');
   });

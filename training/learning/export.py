@@ -43,8 +43,9 @@ OPSET = 18
 # code channels are drawn each on its own, and a mix of "turn" and "step" channels decodes to a
 # step: beside the recorded leader the follower turns 1.9 times a minute at 1 against 11.5 at 0.5
 # (the recording: 25.9; test takes 02, 13, 5 seeds). But beside our steered leader, lower
-# varieties let her sink (seeds with a second of hips or head low, of 20: 0 at 1, 1 at 0.7, 5 at
-# 0.5, 9 at 0.3, 15 at 0; docs/results.md, "Salsa turns"): the page keeps 1. The leader dances
+# varieties let a follower sink (the turn-onset recipe follower_turns, seeds with a second of hips
+# or head low, of 20: 0 at 1, 1 at 0.7, 5 at 0.5, 9 at 0.3, 15 at 0; docs/results.md, "Salsa
+# turns"): the page keeps 1. The leader dances
 # steadiest at 0.5 (docs/plausibility.md).
 DEFAULT_TEMPERATURE = 1.0
 LEADER_TEMPERATURE = 0.5

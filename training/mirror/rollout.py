@@ -38,8 +38,8 @@ LEASH_RATE = 0.1           # ... closing this share of the excess every frame
 START_DISTANCE = 0.8       # m between the partners at the start and after a reset
 # A visitor's request to lead the partner's turn (ask_turn) becomes the leader's figure block
 # (features.figure_block): the partner's planned turn, one full turn eased in and out from
-# TURN_START to TURN_START + TURN_SECONDS after the request. Recorded turns take about 1.2 s from
-# their first 30 degrees to 330 (median over the 79 whole turns of the 12 takes). The request
+# TURN_START to TURN_START + TURN_SECONDS after the request. Recorded turns take about 1.3 s from
+# their first 30 degrees to 300 (median 39 frames over the 79 whole turns of the 12 takes). The request
 # ends after REQUEST_SECONDS, when the leader leads as he likes again.
 TURN_START = 0.4           # s
 TURN_SECONDS = 1.2         # s

@@ -37,8 +37,8 @@ export const LEASH_RATE = 0.1; // ... closing this share of the excess every fra
 export const START_DISTANCE = 0.8; // m between the partners at the start and after a reset
 // A visitor's request to lead the partner's turn (askTurn) becomes the leader's figure block
 // (features figureBlock): the partner's planned turn, one full turn eased in and out from
-// TURN_START to TURN_START + TURN_SECONDS after the request. Recorded turns take about 1.2 s from
-// their first 30 degrees to 330 (median over the 79 whole turns of the 12 takes). The request
+// TURN_START to TURN_START + TURN_SECONDS after the request. Recorded turns take about 1.3 s from
+// their first 30 degrees to 300 (median 39 frames over the 79 whole turns of the 12 takes). The request
 // ends after REQUEST_SECONDS, when the leader leads as he likes again.
 export const TURN_START = 0.4; // s
 export const TURN_SECONDS = 1.2; // s
@@ -462,10 +462,6 @@ export function finishStep(
   } else {
     setAnchor(duet); // a recording leads: the anchor waits where the model will take over
   }
-  if (duet.request) {
-    duet.request.frame += 1;
-    if (duet.request.frame >= REQUEST_SECONDS * FPS) duet.request = null;
-  }
   duet.followers.forEach((f, i) => {
     if (outputIsAbsurd(followerOutputs[i])) resetBeside(f, duet.leader, duet.startPose.follower);
     else applyOutput(f, followerOutputs[i]);
@@ -477,5 +473,10 @@ export function finishStep(
       fromRootSpacePoints(intentionLocal, 0, KEYS * KEY_JOINTS.length, f.rootX, f.rootZ, f.heading, f.intention, 0);
     }
   });
+  // After both dancers, as Python's finish_step: the request's clock, ended after REQUEST_SECONDS.
+  if (duet.request) {
+    duet.request.frame += 1;
+    if (duet.request.frame >= REQUEST_SECONDS * FPS) duet.request = null;
+  }
   duet.frame += 1;
 }

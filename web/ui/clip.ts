@@ -9,6 +9,7 @@
 // The full screen button toggles document.documentElement fullscreen; it is hidden where
 // fullscreen is unavailable (document.fullscreenEnabled false, e.g. iPhone Safari).
 
+import { downloadBlob } from './download';
 import { showToast } from './toast';
 
 export const CLIP_SECONDS = 6;
@@ -106,7 +107,7 @@ export class ClipButton {
         showToast('The clip is empty', 'The browser recorded no frames.', 'error');
         return;
       }
-      saveBlob(blob, clipName(type));
+      downloadBlob(clipName(type), blob);
       showToast('Clip saved', `${clipName(type)} · ${(blob.size / 1e6).toFixed(1)} MB`, 'info', 4000);
     });
     recorder.addEventListener('error', () => {
@@ -118,20 +119,6 @@ export class ClipButton {
       if (recorder.state !== 'inactive') recorder.stop();
     }, CLIP_SECONDS * 1000);
   }
-}
-
-/** Save a blob through a temporary <a download> and an object URL, revoked a while after. */
-function saveBlob(blob: Blob, name: string): void {
-  const url = URL.createObjectURL(blob);
-  const link = document.createElement('a');
-  link.href = url;
-  link.download = name;
-  link.style.display = 'none';
-  document.body.appendChild(link);
-  link.click();
-  link.remove();
-  // Revoking at once can cancel the download in some browsers.
-  setTimeout(() => URL.revokeObjectURL(url), 60_000);
 }
 
 /** Full screen and back; hidden where the browser offers no fullscreen (iPhone Safari). */

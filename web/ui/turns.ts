@@ -4,6 +4,7 @@
 
 export class TurnButtons {
   private readonly buttons: HTMLButtonElement[] = [];
+  private shown = 0;
 
   /** `onTurn(direction)`: -1 her right (clockwise seen from above), +1 her left. */
   constructor(onTurn: (direction: number) => void) {
@@ -24,8 +25,10 @@ export class TurnButtons {
     }
   }
 
-  /** Mark the button of the turn being led (0: none). */
+  /** Mark the button of the turn being led (0: none). Called every frame: touches the page only on a change. */
   show(direction: number): void {
+    if (direction === this.shown) return;
+    this.shown = direction;
     this.buttons.forEach((b, i) => b.classList.toggle('leading', direction === (i === 0 ? -1 : 1)));
   }
 }
