@@ -444,10 +444,12 @@ def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_o
     shift = np.array([2.1, 2.5])
     apart.follower.track.root += shift
     apart.follower.track.positions[..., [0, 2]] += shift
-    apart.steering.anchor = np.array([-0.7, 0.4])
+    apart.steering.anchor = np.array([-1.4, 0.8])
+    apart.steering.velocity = np.array([0.2, 0.0])     # steered a little: a smaller free circle
     ro.follow_anchor(apart.leader, apart.steering)
     leashed = ro.keep_close(apart.follower, apart.leader)
-    guards = {"shift": exact(shift), "anchor": exact(apart.steering.anchor), "leashed": leashed,
+    guards = {"shift": exact(shift), "anchor": exact(apart.steering.anchor),
+              "velocity": exact(apart.steering.velocity), "leashed": leashed,
               "leader": dancer_state(apart.leader), "follower": dancer_state(apart.follower)}
     # The upright guard (training/mirror/guard.py): plausible follower outputs, one tipped over by its
     # rotations alone (positions standing), one sunk by its hip (its ankles below the floor, so the

@@ -138,6 +138,7 @@ describe('partner guards', () => {
       }
     }
     apart.steering.anchor.set(g.anchor);
+    apart.steering.velocity.set(g.velocity);
     R.followAnchor(apart.leader, apart.steering);
     expect(R.keepClose(f, apart.leader)).toBe(g.leashed);
     expectDancer(apart.leader, g.leader, 'leader');

@@ -4,7 +4,7 @@
 
 import { describe, expect, it } from 'vitest';
 import { FOLLOWER_INPUT_LAYOUT, INPUT_SIZE, LEADER_INPUT_LAYOUT, OUTPUT_LAYOUT, OUTPUT_SIZE, Track, blockSlices } from '../../web/mirror/features';
-import { ANCHOR_RATE, NOW } from '../../web/mirror/rollout';
+import { ANCHOR_FREE, ANCHOR_RATE, NOW } from '../../web/mirror/rollout';
 import { type DuetSimulation, createSimulation } from '../../web/engine/simulation';
 import type { Motion } from '../../web/mirror/skeleton';
 import type { Manifest, StepPolicy } from '../../web/engine/types';
@@ -175,14 +175,18 @@ describe('createSimulation', () => {
 
   it('moves the drawn future and root with the model output', async () => {
     const { sim } = simulation([{ role: 'follower', step: 0.02 }], { role: 'leader', step: 0.02, contacts: [0.4, 0.2] });
-    for (let i = 0; i < 10; i++) await sim.step(steer, 0.5);
+    for (let i = 0; i < 60; i++) await sim.step(steer, 0.5);
     // The leader faces +Z and steps 2 cm a frame, while its anchor (nobody steers) stays at the
-    // origin and draws it back by ANCHOR_RATE of the distance each frame, times the share of the
-    // frame its feet are free (1 - the larger contact, 0.4).
+    // origin: free within ANCHOR_FREE of it, beyond that drawn back by ANCHOR_RATE of the excess
+    // each frame, times the share of the frame its feet are free (1 - the larger contact, 0.4).
     let lead = 0;
-    for (let i = 0; i < 10; i++) lead = (lead + 0.02) * (1 - ANCHOR_RATE * 0.6);
+    for (let i = 0; i < 60; i++) {
+      lead += 0.02;
+      if (lead > ANCHOR_FREE) lead -= (lead - ANCHOR_FREE) * ANCHOR_RATE * 0.6;
+    }
+    expect(lead).toBeGreaterThan(ANCHOR_FREE + 0.01);
     expect(sim.leader.root[1]).toBeCloseTo(lead, 6);
-    expect(sim.followers[0].root[1]).toBeCloseTo(0.6, 6); // follower faces -Z
+    expect(sim.followers[0].root[1]).toBeCloseTo(0.8 - 60 * 0.02, 6); // follower faces -Z
     expect(sim.leader.future[11]).toBeCloseTo(lead + 0.02 * 30, 5);
   });
 
@@ -238,6 +242,21 @@ describe('createSimulation', () => {
     expect(s.duet.followers[0].track.positions).toEqual(track);
     expect(sim.followers[0].positions).toEqual(drawn);
     expect(await sim.ghosts(0)).toEqual([]);
+  });
+
+  it('ghosts dance on by themselves and branch from the partner again, each at its own moment', async () => {
+    const { sim } = simulation([{ role: 'follower', spread: 0.05 }]);
+    await sim.step(steer, 0.5);
+    let ghosts: Float32Array[] = [];
+    for (let call = 0; call < 15; call++) ghosts = await sim.ghosts(3);
+    // Sample i steps 0.05·i sideways (world -X) per call. Of 30 calls, ghost 1 branches at call
+    // 20 and ghost 2 at call 10: after 15 calls ghost 1 has danced 15 steps, ghost 2 only 5.
+    expect(ghosts[1][0] - ghosts[0][0]).toBeCloseTo(-0.05 * 15, 4);
+    expect(ghosts[2][0] - ghosts[0][0]).toBeCloseTo(-0.1 * 5, 4);
+    // reset(): all branch again from the new start.
+    sim.reset();
+    ghosts = await sim.ghosts(3);
+    expect(ghosts[2][0] - ghosts[0][0]).toBeCloseTo(-0.1, 5);
   });
 
   it('reset() goes back to the start pose', async () => {

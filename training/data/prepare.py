@@ -1,7 +1,8 @@
 """python -m training.data.prepare: paired BVH takes -> feature arrays for training (git-ignored).
 
 Reads the BVH couples in --data; writes PREPARED/{train,validation,test}.npz (both roles, all phase
-offsets, mirrored copies in train), PREPARED/plausibility.json (the training dancers' range of
+offsets, mirrored copies in train), PREPARED/train_tracks.npz (the training couples at 30 fps, phase
+0, as recorded and mirrored: what training's own rollouts dance beside), PREPARED/plausibility.json (the training dancers' range of
 poses and speeds: training.evaluation.plausibility) and PREPARED/stats.npz (normalization, from
 the recorded tempo: recipes with and without tempo copies normalize alike), then prints frames
 per split and feature sizes. With --tempos it also writes PREPARED/train_tempo.npz, the training couples time-warped to
@@ -32,6 +33,16 @@ def split_of(take: str, validation: list[str], test: list[str]) -> str:
     return "validation" if take in validation else "test" if take in test else "train"
 
 
+def add_tracks(store: dict[str, np.ndarray], tracks, mirror: bool) -> None:
+    """Keep one training couple (leader, follower Tracks at 30 fps) as couple i of
+    train_tracks.npz: what training's own rollouts (training/learning/own_rollouts.py) dance beside."""
+    i = len(store) // 9
+    for role, t in zip(("leader", "follower"), tracks):
+        for k in ("positions", "rotations", "root", "heading"):
+            store[f"{i}_{role}_{k}"] = getattr(t, k)
+    store[f"{i}_mirror"] = np.array(mirror)
+
+
 def prepare(data: str, out: str, validation: list[str], test: list[str], leader: str | None = None,
             all_phases: bool = True, quiet: bool = False, tempos: list[float] | None = None) -> dict:
     takes = discover_takes(data, leader)
@@ -42,6 +53,7 @@ def prepare(data: str, out: str, validation: list[str], test: list[str], leader:
     parts: dict[str, list[dict]] = {"train": [], "validation": [], "test": [], "train_tempo": []}
     dancer_frames = {"train": 0, "validation": 0, "test": 0}
     recorded_bodies: list[np.ndarray] = []   # world positions of every training dancer, as recorded
+    train_tracks: dict[str, np.ndarray] = {}  # the training couples themselves (train_tracks.npz)
     for take in tqdm(takes, desc="prepare", unit="take", disable=quiet):
         lead, follow = load_pair(take)
         split = split_of(take.name, validation, test)
@@ -59,6 +71,8 @@ def prepare(data: str, out: str, validation: list[str], test: list[str], leader:
                     s = samples(*tracks)
                     if split == "train" and tempo == 1.0 and phase == 0 and not mirror:
                         recorded_bodies += [t.positions for t in tracks]
+                    if split == "train" and tempo == 1.0 and phase == 0:
+                        add_tracks(train_tracks, tracks, mirror)
                     n = len(s["frame"])
                     s["take"] = np.full(n, names.index(take.name), np.int16)
                     s["phase"] = np.full(n, phase, np.int8)
@@ -79,6 +93,7 @@ def prepare(data: str, out: str, validation: list[str], test: list[str], leader:
         arrays[split] = {k: np.concatenate([p[k] for p in plist]) for k in plist[0]}
         np.savez(outdir / f"{split}.npz", takes=np.array(names), **arrays[split])
         summary["samples"][split] = len(arrays[split]["frame"])
+    np.savez(outdir / "train_tracks.npz", **train_tracks)
     stats = {}
     for role in ("follower", "leader"):
         for kind in ("input", "output", "intention"):

@@ -30,7 +30,8 @@ from .distributed import (average_gradients, broadcast_parameters, pick_device, 
                           wait_for_all)
 from ..data.folders import add_folder
 from ..evaluation.loss_plot import plot_history
-from .models import CodebookMatching, Discriminator, IntentionPredictor, ModelConfig, code_logits, sample_codes
+from .models import CodebookMatching, Discriminator, IntentionPredictor, ModelConfig, StepModel, code_logits, sample_codes
+from .own_rollouts import load_couples, own_rollout_samples
 from ..data.prepared import (TrainError, load_mirror_flags, load_offsets, load_split, load_stats, normalize,
                        pose_error_cm)
 from .runs import load_checkpoint, save_checkpoint
@@ -97,6 +98,16 @@ class TrainConfig:
     # really made over the next second) is hidden, as when nobody asks for a figure. Shown, the
     # leader learns what leading that turn looks like; hidden, he learns to lead on his own.
     figure_dropout: float = 1.0
+    # Samples from the network's own rollouts beside the recorded partner, the target still the
+    # recorded next frame (own_rollouts.py): from matching epoch `own_rollouts_from` on (None:
+    # never), made anew every `own_rollouts_every` epochs with the network as it is then, each
+    # rollout `own_rollouts_horizon` frames long, one starting every `own_rollouts_stride` frames
+    # of the training couples (as recorded and mirrored), at the temperatures taken in turn.
+    own_rollouts_from: int | None = None
+    own_rollouts_every: int = 2
+    own_rollouts_horizon: int = 30
+    own_rollouts_stride: int = 10
+    own_rollouts_temperatures: tuple[float, ...] = (0.5, 1.0)
     seed: int = 1
 
 
@@ -180,6 +191,13 @@ MODELS = {
     # precision 35 % against 52 %); the state hidden in 70 % of the samples matches 20 %.
     "follower_turns": replace(steady(OURS), state_dropout=0.5, turn_weight=4.0),
     "follower_ccm_turns": replace(steady(CCM), state_dropout=0.5, turn_weight=4.0),
+    # Trained on its own rollouts too (TrainConfig.own_rollouts_from, own_rollouts.py).
+    "follower_own": replace(steady(OURS), state_dropout=0.5, turn_weight=4.0, own_rollouts_from=10),
+    "follower_ccm_own": replace(steady(CCM), state_dropout=0.5, turn_weight=4.0, own_rollouts_from=10),
+    "follower_own_8": replace(steady(OURS), state_dropout=0.5, turn_weight=4.0, own_rollouts_from=10,
+                              own_rollouts_horizon=8, own_rollouts_stride=4),
+    "follower_ccm_own_8": replace(steady(CCM), state_dropout=0.5, turn_weight=4.0, own_rollouts_from=10,
+                                  own_rollouts_horizon=8, own_rollouts_stride=4),
     "follower_turns_8": replace(steady(OURS), state_dropout=0.5, turn_weight=8.0),
     "follower_turns_sd70": replace(steady(OURS), state_dropout=0.7, turn_weight=4.0),
     # The leader's partner is the follower: it gets the same terms (its own weights, above).
@@ -198,6 +216,10 @@ MODELS = {
     # more often, with the samples where she starts a turn weighed 4x: a request works no better.
     "leader_state_dropout": replace(steady(LEADER_STOP_MOTION), figure_dropout=0.5, state_dropout=0.5),
     "leader_lead": replace(steady(LEADER_STOP_MOTION), figure_dropout=0.3, state_dropout=0.5, turn_weight=4.0),
+    # The dancing leader (state dropout) trained on his own rollouts too (own_rollouts.py).
+    "leader_own": replace(steady(LEADER_STOP_MOTION), figure_dropout=0.5, state_dropout=0.5, own_rollouts_from=10, seed=2),
+    "leader_own_8": replace(steady(LEADER_STOP_MOTION), figure_dropout=0.5, state_dropout=0.5, own_rollouts_from=10,
+                            own_rollouts_horizon=8, own_rollouts_stride=4, seed=2),
     # The three before their decoders read the pose (stop-motion, falls; docs/plausibility.md).
     "leader_stop_motion": LEADER_STOP_MOTION,
     "follower_stop_motion": OURS,
@@ -361,9 +383,10 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
     xr = torch.from_numpy(train["input"]).float()          # raw, for leader augmentation
     partner_weights = {"penetration": cfg.lambda_penetration, "foot_contact": cfg.lambda_foot_contact,
                        "interaction": cfg.lambda_interaction}
-    if any(partner_weights.values()):
+    if any(partner_weights.values()) or cfg.own_rollouts_from is not None:
         offsets = load_offsets(data, role, device)
-        mirrored = torch.from_numpy(load_mirror_flags(data, cfg.tempo_copies)).long()
+    mirrored = torch.from_numpy(load_mirror_flags(data, cfg.tempo_copies)).long()
+    couples = load_couples(data) if cfg.own_rollouts_from is not None else []
     y, j = normalize(train["output"], stats, "output"), normalize(train["intention"], stats, "intention")
     sample_weight = torch.ones(len(xr))
     if cfg.turn_weight != 1.0:
@@ -379,7 +402,7 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
     gen_params = list(matching.parameters()) + (list(predictor.parameters()) if cfg.end_to_end else [])
     opt_g = torch.optim.AdamW(gen_params, lr=cfg.lr, weight_decay=cfg.weight_decay)
     opt_d = torch.optim.AdamW(disc.parameters(), lr=cfg.lr, weight_decay=cfg.weight_decay)
-    history = {"intention_train": [], "intention_val": [], "reconstruction": [], "codebook": [],
+    history = {"intention_train": [], "intention_val": [], "reconstruction": [], "codebook": [], "own_rollout_samples": [],
                "generator": [], "discriminator": [], "val_mse": [], "val_codebook": [],
                "val_mpjpe_cm": [], **{k: [] for k, w in partner_weights.items() if w},
                **({"proximity": []} if cfg.lambda_proximity else {})}
@@ -490,8 +513,28 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
     # Raw features back from normalized ones, for the terms on the decoded body (set up once).
     scale = {k: (stats[f"{k}_std"].to(device).float(), stats[f"{k}_mean"].to(device).float()) for k in ("input", "output")}
     raw = lambda t, k: t * scale[k][0] + scale[k][1]
+    recorded_n = n                 # the prepared samples; own rollouts' samples follow them
+    made_at = None                 # the epoch whose network danced the rollouts held now
     while epoch < cfg.epochs:
         t0 = time.time()
+        start = cfg.own_rollouts_from
+        if start is not None and epoch >= start and (made_at is None or epoch - made_at >= cfg.own_rollouts_every):
+            step_model = StepModel(mcfg, predictor if mcfg.intention else None, matching, stats).eval()
+            rolled = own_rollout_samples(step_model, couples, offsets.cpu().double().numpy(), role,
+                                      cfg.own_rollouts_stride, cfg.own_rollouts_horizon,
+                                      cfg.own_rollouts_temperatures, gen)
+            xr = torch.cat([xr[:recorded_n], torch.from_numpy(rolled["input"])])
+            y = torch.cat([y[:recorded_n], normalize(rolled["output"], stats, "output")])
+            j = torch.cat([j[:recorded_n], normalize(rolled["intention"], stats, "intention")])
+            w_own = torch.ones(len(rolled["input"]))
+            if cfg.turn_weight != 1.0:
+                w_own[torch.from_numpy(turn_onsets(rolled["input"], rolled["output"], role))] = cfg.turn_weight
+            sample_weight = torch.cat([sample_weight[:recorded_n], w_own])
+            mirrored = torch.cat([mirrored[:recorded_n], torch.from_numpy(rolled["mirror"]).long()])
+            n, made_at = len(xr), epoch
+            history["own_rollout_samples"].append(len(w_own))
+            if rank == 0 and not quiet:
+                print(f"{name} own rollouts at epoch {epoch}: {len(w_own)} samples beside {recorded_n} recorded")
         matching.train(); disc.train()
         if cfg.end_to_end:
             predictor.train()

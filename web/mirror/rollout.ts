@@ -32,6 +32,7 @@ export const MAX_JOINT_DISTANCE = 3.0; // m from the root: beyond this the outpu
 export const MAX_ROOT_JUMP = 1.0; // m in one step
 export const MIN_ANKLE_HEIGHT = 0.04; // m: the lowest ankle height in the recordings
 export const ANCHOR_RATE = 0.3; // share of the leader's distance to its anchor closed every free frame
+export const ANCHOR_FREE = 0.75; // m around the anchor where a leader nobody steers is not drawn at all
 export const LEASH_DISTANCE = 2.0; // m: beyond this a follower is drawn toward its leader ...
 export const LEASH_RATE = 0.1; // ... closing this share of the excess every frame
 export const START_DISTANCE = 0.8; // m between the partners at the start and after a reset
@@ -311,14 +312,22 @@ export function shiftDancer(d: Dancer, sx: number, sz: number): void {
  *
  * The leader model reads the steered plan as an intention, not an order: fed its own predicted
  * path it wanders (about 1.7 m in 3 s here), and steered it answers only in part. Pulling the
- * root toward the anchor lets it dance freely around the spot the user left it at and travel
- * where the user steers. The pull moves the whole body, so it acts only as far as no foot is
- * planted (1 - the larger contact): a planted foot is never slid by it.
+ * root toward the anchor lets it travel where the user steers and keeps it near the spot the
+ * user left it at. The pull moves the whole body, so it acts only as far as no foot is planted
+ * (1 - the larger contact): a planted foot is never slid by it. Nobody steering, the pull spares
+ * a circle of ANCHOR_FREE around the anchor (shrinking to nothing as the steered speed grows, so
+ * steering answers as before): pinned to one spot, the leader hardly travelled.
  */
 export function followAnchor(leader: Dancer, steering: Steering): void {
   const free = 1 - Math.max(leader.contacts[0], leader.contacts[1]);
-  const rate = ANCHOR_RATE * free;
-  shiftDancer(leader, (steering.anchor[0] - leader.rootX) * rate, (steering.anchor[1] - leader.rootZ) * rate);
+  const speed = Math.hypot(steering.velocity[0], steering.velocity[1]);
+  const radius = ANCHOR_FREE * Math.max(0, 1 - speed / MAX_SPEED);
+  const dx = steering.anchor[0] - leader.rootX;
+  const dz = steering.anchor[1] - leader.rootZ;
+  const dist = Math.hypot(dx, dz);
+  if (dist <= radius) return;
+  const rate = (1 - radius / dist) * ANCHOR_RATE * free;
+  shiftDancer(leader, dx * rate, dz * rate);
 }
 
 /**

@@ -1,0 +1,147 @@
+"""Training samples from the network's own rollouts: from wherever its own motion took it, do
+what the recorded dancer did next.
+
+Teacher-forced, every input a network sees holds its dancer's recorded past. At run time that past
+is its own earlier outputs, and a follower that did not start a turn when the recorded one did
+reads a history the recording never shows: nothing in training told it what to do there, so it
+goes on stepping (the follower that continues a recorded turn but hardly ever starts one:
+docs/results.md, "Salsa turns"). So, from epoch `TrainConfig.own_rollouts_from` on, every few epochs the
+network dances short stretches of the training takes beside the played-back recorded partner (a
+follower beside the recorded leader; a leader beside the recorded follower, his plan the recorded
+path laid down from where he stands, as evaluation steers him), and each frame it reaches becomes
+a training sample whose target is still the recorded next frame, read in the dancer's own root
+space. This is DAgger with the recording as the expert, as scheduled sampling does it for
+sequence models.
+
+The couples come from PREPARED/train_tracks.npz (training.data.prepare writes it).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from ..data.prepared import TrainError
+from ..mirror import features as feat
+from ..mirror.features import HISTORY, Track
+from ..mirror.rollout import NOW, Dancer, apply_output, output_is_absurd
+
+FIELDS = ("positions", "rotations", "root", "heading")
+
+
+@dataclass
+class Couple:
+    leader: Track
+    follower: Track
+    mirror: bool
+    partner_turn: np.ndarray     # [F, KEYS] the follower's turn ahead of each frame (the leader's figure)
+
+
+def load_couples(prepared: str) -> list[Couple]:
+    path = Path(prepared) / "train_tracks.npz"
+    if not path.exists():
+        raise TrainError(f"{path} not found (a recipe with own rollouts dances beside the training couples): "
+                         f"re-run `python -m training.data.prepare --prepared {prepared}`")
+    with np.load(path) as z:
+        n = sum(1 for k in z.files if k.endswith("_mirror"))
+        out = []
+        for i in range(n):
+            lead, follow = (Track(*(z[f"{i}_{role}_{k}"] for k in FIELDS)) for role in ("leader", "follower"))
+            turn = np.zeros((follow.frames, feat.KEYS))
+            frames = np.arange(follow.frames - HISTORY)
+            turn[frames] = feat.partner_turn(follow, frames)
+            out.append(Couple(lead, follow, bool(z[f"{i}_mirror"]), turn))
+    return out
+
+
+def window(track: Track, t: int) -> Track:
+    """A copy of the 61 frames around t (the rollout's layout, t at NOW)."""
+    sl = slice(t - HISTORY, t + HISTORY + 1)
+    return Track(*(getattr(track, k)[sl].copy() for k in FIELDS))
+
+
+def lay_recorded_plan(me: Dancer, recorded: Track, t: int) -> None:
+    """A leader's plan: the recorded future path at t, relative to the recorded root, laid down
+    from where he stands now (what evaluation's steer_along_recording does)."""
+    keys = t + feat.FUTURE_OFFSETS
+    local = feat.trajectory_block(recorded.root[keys], recorded.heading[keys], recorded.root[t],
+                                  recorded.heading[t]).reshape(-1, 4)
+    tr = me.track
+    pos = feat.from_root_space_points(np.stack([local[:, 0], np.zeros(len(local)), local[:, 1]], -1),
+                                      tr.root[NOW], tr.heading[NOW])
+    tr.root[NOW + feat.FUTURE_OFFSETS] = pos[:, [0, 2]]
+    tr.heading[NOW + feat.FUTURE_OFFSETS] = tr.heading[NOW] + np.arctan2(local[:, 2], local[:, 3])
+
+
+@dataclass
+class Run:
+    couple: Couple
+    me: Dancer
+    t: int          # the recorded frame the rollout is at
+    steps: int      # steps left
+
+
+def inputs_at(run: Run, role: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(input, recorded output, intention target) of a rollout at its frame: the input from its own
+    track beside the recorded partner; the targets the recording's."""
+    c, t, now = run.couple, run.t, np.array([NOW])
+    if role == "follower":
+        partner, recorded = window(c.leader, t), c.follower
+        x = feat.follower_input(partner, run.me.track, now)[0]
+    else:
+        partner, recorded = window(c.follower, t), c.leader
+        lay_recorded_plan(run.me, recorded, t)
+        x = feat.leader_input(partner, run.me.track, now, feat.figure_block(c.partner_turn[t][None], 1))[0]
+    y = feat.output_features(recorded, np.array([t]))[0]
+    j = feat.intention_target(partner, run.me.track, now)[0]
+    return x, y, j
+
+
+@torch.no_grad()
+def own_rollout_samples(step, couples: list[Couple], offsets: np.ndarray, role: str, every: int,
+                        horizon: int, temperatures: tuple[float, ...], gen: torch.Generator) -> dict[str, np.ndarray]:
+    """Roll `step` (a StepModel on raw features) out for `horizon` frames from every `every`-th
+    frame of each couple, all rollouts as one batch per step, at temperatures taken in turn. The
+    first frame of each is the recording itself and is skipped; a rollout that produces absurd
+    output ends there. Returns raw {"input", "output", "intention"} float32 and "mirror" bool."""
+    runs: list[Run] = []
+    for c in couples:
+        side = c.follower if role == "follower" else c.leader
+        last = side.frames - HISTORY - 2 - horizon
+        for t0 in range(HISTORY + 1, last, every):
+            runs.append(Run(c, Dancer(offsets[int(c.mirror)], window(side, t0)), t0, horizon))
+    temps = torch.tensor([temperatures[i % len(temperatures)] for i in range(len(runs))], dtype=torch.float32)
+    xs, ys, js, ms = [], [], [], []
+    latent = step.cfg.channels * step.cfg.classes
+    for k in range(horizon):
+        live = [i for i, r in enumerate(runs) if r.steps > 0]
+        if not live:
+            break
+        batch = [inputs_at(runs[i], role) for i in live]
+        x = np.stack([b[0] for b in batch])
+        if k > 0:
+            xs.append(x); ys.append(np.stack([b[1] for b in batch])); js.append(np.stack([b[2] for b in batch]))
+            ms.append(np.array([runs[i].couple.mirror for i in live]))
+        noise = torch.rand(len(live), latent, generator=gen)
+        out = np.empty((len(live), feat.OUTPUT_SIZE))
+        for temp in temperatures:
+            rows = (temps[live] == temp).nonzero()[:, 0]
+            if len(rows):
+                out[rows.numpy()] = step(torch.from_numpy(x[rows.numpy()]).float(),
+                                         torch.tensor([temp]), noise[rows])[0].double().numpy()
+        for o, i in zip(out, live):
+            r = runs[i]
+            if output_is_absurd(o):
+                r.steps = 0
+                continue
+            apply_output(r.me, o)
+            r.t += 1
+            r.steps -= 1
+    if not xs:
+        size = feat.INPUT_SIZES[role]
+        return {"input": np.zeros((0, size), np.float32), "output": np.zeros((0, feat.OUTPUT_SIZE), np.float32),
+                "intention": np.zeros((0, feat.INTENTION_SIZE), np.float32), "mirror": np.zeros(0, bool)}
+    return {"input": np.concatenate(xs).astype(np.float32), "output": np.concatenate(ys).astype(np.float32),
+            "intention": np.concatenate(js).astype(np.float32), "mirror": np.concatenate(ms)}
