@@ -111,6 +111,8 @@ export class DancerMeshes implements DancerBody {
   private readonly boneChildren: number[];
   private readonly jointCount: number;
   private readonly perDancer: number;
+  /** Per extra of a dancer: lighter (hands, > 0) or darker (feet, face, < 0) than its colour. */
+  private readonly shades: number[];
 
   constructor(
     private readonly parents: number[],
@@ -143,16 +145,35 @@ export class DancerMeshes implements DancerBody {
       this.group.add(mesh);
     }
     // Shades are fixed: written once here, never per frame.
-    const shades = new Array<number>(this.perDancer).fill(SHADE.joint);
+    this.shades = new Array<number>(this.perDancer).fill(SHADE.joint);
+    const shades = this.shades;
     shades[this.jointCount + EXTRA_L_HAND] = shades[this.jointCount + EXTRA_R_HAND] = SHADE.hand;
     shades[this.jointCount + EXTRA_L_FOOT] = shades[this.jointCount + EXTRA_R_FOOT] = SHADE.foot;
     shades[this.jointCount + EXTRA_NOSE] = shades[this.jointCount + EXTRA_VISOR] = SHADE.face;
-    for (let i = 0; i < capacity * this.perDancer; i++) {
-      const s = shades[i % this.perDancer];
-      _color.copy(this.color).lerp(s >= 0 ? _white : _black, Math.abs(s));
-      this.joints.setColorAt(i, _color);
-    }
+    for (let i = 0; i < capacity; i++) this.paint(i, this.color);
     this.setCount(capacity);
+  }
+
+  /**
+   * Give dancer `index` a colour of its own (the possible reactions: eight translucent partners
+   * in one colour read as one blur). The bones take it as an instance colour, which multiplies
+   * the material's: give such a DancerMeshes a white material.
+   */
+  tint(index: number, color: THREE.ColorRepresentation): void {
+    _tint.set(color);
+    this.paint(index, _tint);
+    for (let b = 0; b < this.boneChildren.length; b++) this.bones.setColorAt(index * this.boneChildren.length + b, _tint);
+    if (this.bones.instanceColor) this.bones.instanceColor.needsUpdate = true;
+  }
+
+  /** Dancer `index`'s joints in `color`, hands lighter, feet and face darker. */
+  private paint(index: number, color: THREE.Color): void {
+    for (let k = 0; k < this.perDancer; k++) {
+      const s = this.shades[k];
+      _color.copy(color).lerp(s >= 0 ? _white : _black, Math.abs(s));
+      this.joints.setColorAt(index * this.perDancer + k, _color);
+    }
+    if (this.joints.instanceColor) this.joints.instanceColor.needsUpdate = true;
   }
 
   /** How many of the `capacity` dancers to draw. */
@@ -587,5 +608,6 @@ const _centre = new THREE.Vector3();
 const _hipForward = new THREE.Vector3();
 const _chestForward = new THREE.Vector3();
 const _color = new THREE.Color();
+const _tint = new THREE.Color();
 const _white = new THREE.Color(0xffffff);
 const _black = new THREE.Color(0x000000);

@@ -20,6 +20,11 @@ export interface StageOptions {
   skeleton?: boolean;
 }
 
+/** The possible reactions' colours, one each so that eight of them read as eight, not as one
+ *  blur: the partner's red first, then warm and green hues, clear of your dancer's blue and the
+ *  intention's purple. */
+export const GHOST_TINTS = [0xe0413a, 0xf08a24, 0xc9a400, 0x3fa34d, 0x17a2a0, 0xd6408f, 0x8d5a3b, 0x7a8a00];
+
 export const COLORS = {
   leader: 0x2f6fe4,
   follower: 0xe0413a,
@@ -214,13 +219,15 @@ export class Stage {
     this.dancers = [this.leader, ...this.followers, this.leaderCopy];
     this.skeleton = options.skeleton ?? false;
     this.contacts = new ContactMarks(this.dancers.length);
+    // White: each ghost takes its own tint (GHOST_TINTS) as instance colours.
     const ghostMaterial = new THREE.MeshStandardMaterial({
-      color: COLORS.follower,
+      color: 0xffffff,
       transparent: true,
-      opacity: 0.18,
+      opacity: 0.24,
       depthWrite: false, // overlapping translucent ghosts should blend, not hide each other
     });
     this.ghosts = new DancerMeshes(parents, Math.max(1, maxGhosts), ghostMaterial, false);
+    for (let i = 0; i < this.ghosts.capacity; i++) this.ghosts.tint(i, GHOST_TINTS[i % GHOST_TINTS.length]);
     this.ghosts.setCount(0);
     this.scene.add(this.leader.group, this.ghosts.group, ...this.followers.map((f) => f.group), this.leaderCopy.group, this.contacts.group);
 

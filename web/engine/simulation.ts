@@ -54,6 +54,10 @@ class View implements DancerView {
   }
 }
 
+/** Steps a possible reaction dances on its own before it branches from the partner again (1 s):
+ *  long enough to part from her, short enough to stay a reaction to this moment. */
+const GHOST_LIFE = 30;
+
 export class DuetSimulation implements Simulation {
   readonly leader: DancerView;
   readonly followers: DancerView[];
@@ -77,7 +81,11 @@ export class DuetSimulation implements Simulation {
   private readonly layer = new ContactLayer();
   private playback: LeaderPlayback | null = null;
   private temperature: number;
-  private readonly ghost: Dancer;
+  /** The possible reactions: copies of the first follower dancing on by themselves (ghosts()). */
+  private readonly ghostDancers: Dancer[] = [];
+  /** Whether each ghost has branched yet (a new one branches at its first call). */
+  private ghostBranched: boolean[] = [];
+  private ghostCalls = 0;
   private readonly ghostPoses: Float32Array[] = [];
 
   constructor(private readonly options: SimulationOptions) {
@@ -97,12 +105,12 @@ export class DuetSimulation implements Simulation {
     this.followers = this.followerViews;
     this.followerOutputs = followers.map(() => new Float32Array(OUTPUT_SIZE));
     this.followerIntentions = followers.map((p) => (p.hasIntention ? new Float32Array(INTENTION_SIZE) : null));
-    this.ghost = new Dancer(this.duet.followers[0].offsets);
     this.updateViews(true);
   }
 
   reset(): void {
     this.duet = startDuet(this.options.manifest, this.followerPolicies.length);
+    this.ghostBranched = []; // the possible reactions branch again from the new start
     this.upright = 0;
     this.playback?.start(this.duet.leader.track);
     this.timer.clear();
@@ -175,24 +183,36 @@ export class DuetSimulation implements Simulation {
   }
 
   /**
-   * k alternative next poses of the first follower: its model run once on k copies of its current
-   * input (each sample draws its own noise), each output applied to a scratch copy of the dancer.
+   * k possible futures of the first follower, drawn as faint partners ("possible reactions").
+   * Each is a copy of her that branched off and dances on by her model with its own noise, one
+   * step per call (one batched run for all k: call once per step). The copies branch again from
+   * her every GHOST_LIFE calls, each at its own moment, so at any time they are k different ages
+   * along their own futures and stand apart: sampled one step from the same pose, as the page
+   * first drew them, they differ by millimetres and read as one blur. A copy whose model output
+   * is absurd branches again at once. The real dancers are never touched.
    */
   async ghosts(k: number): Promise<Float32Array[]> {
     if (k <= 0) return [];
     const policy = this.followerPolicies[0];
     const follower = this.duet.followers[0];
+    while (this.ghostDancers.length < k) this.ghostDancers.push(new Dancer(follower.offsets));
+    for (let i = 0; i < k; i++) {
+      // Ghost i branches when the count reaches its own offset in the cycle (i of k parts of it).
+      if (!this.ghostBranched[i] || (this.ghostCalls + Math.round((i * GHOST_LIFE) / k)) % GHOST_LIFE === 0) this.ghostDancers[i].copyFrom(follower);
+      this.ghostBranched[i] = true;
+    }
     const input = policy.batchInput(k);
-    followerInput(this.duet.leader.track, follower.track, NOW, input, 0);
-    for (let i = 1; i < k; i++) input.copyWithin(i * INPUT_SIZE, 0, INPUT_SIZE);
+    for (let i = 0; i < k; i++) followerInput(this.duet.leader.track, this.ghostDancers[i].track, NOW, input, i * INPUT_SIZE);
     const { output } = await policy.runBatch(k, this.temperature);
     while (this.ghostPoses.length < k) this.ghostPoses.push(new Float32Array(POSITIONS_SIZE));
     for (let i = 0; i < k; i++) {
-      this.ghost.copyFrom(follower);
-      if (!outputIsAbsurd(output, i * OUTPUT_SIZE)) applyOutput(this.ghost, output, i * OUTPUT_SIZE);
-      const p = this.ghost.track.positions;
+      const ghost = this.ghostDancers[i];
+      if (outputIsAbsurd(output, i * OUTPUT_SIZE)) ghost.copyFrom(follower);
+      else applyOutput(ghost, output, i * OUTPUT_SIZE);
+      const p = ghost.track.positions;
       for (let n = 0; n < POSITIONS_SIZE; n++) this.ghostPoses[i][n] = p[NOW * POSITIONS_SIZE + n];
     }
+    this.ghostCalls++;
     return this.ghostPoses.slice(0, k);
   }
 

@@ -50,6 +50,7 @@ export interface Simulation {
   /** One follower, or two in compare mode (ours first). */
   followers: DancerView[];
   /** k alternative next follower poses sampled from the model, each 17 × (x, y, z) world. */
+  /** k possible futures of the first follower, each dancing on from its own branch point (call once per step). */
   ghosts(k: number): Promise<Float32Array[]>;
   /** Wall time of step() over the last 300 steps, milliseconds. */
   stepMs(): { median: number; p95: number };
@@ -181,8 +182,9 @@ export interface DuetHook {
   firstFrameMs: number | null;
   /** performance.now() once the floor and the standing pair are first painted (loading scene). */
   sceneMs?: number | null;
-  /** Bytes of the first dance's downloads (wasm + models), so far and in all. */
-  download?: { loaded: number; total: number };
+  /** Bytes of the first dance's downloads (wasm + models), so far and in all: compressed, as
+   *  they travel, once `sized`; decoded before. */
+  download?: { loaded: number; total: number; sized: boolean };
   /** How the dancers are drawn: skinned characters, or capsule figures (?bodies=sticks). */
   bodies?: 'skinned' | 'sticks';
   /** Where the camera is (read when asked): degrees around, degrees down from above, metres from
@@ -199,6 +201,10 @@ export interface DuetHook {
    *  degrees, between its bones as drawn and the dancer's, and how far, cm, its ankles are from the
    *  dancer's, scaled to its size (web/draw/avatar.ts). */
   avatars?: Partial<Record<'leader' | 'follower', { name: string; fitDeg: number; feetCm: number }>>;
+  /** The possible reactions drawn now: each one's hip on the floor (x, z), metres (read when asked). */
+  ghostHips?: [number, number][];
+  /** Whether the help is open (the dance holds still behind it, `paused` or not). */
+  helpOpen?: boolean;
 }
 
 declare global {

@@ -13,6 +13,8 @@ export const PAIR_SPACING = 2.2;
 const HALF_WIDTH = PAIR_SPACING / 2 + 1.1;
 /** Labels sit this high over the floor (above the heads). */
 const LABEL_HEIGHT = 2.05;
+/** Pixels kept between the two labels, and between a label and the screen's edge. */
+const LABEL_GAP = 8;
 
 const LABELS: [string, string][] = [
   ['pair-label pair-label-partner', 'reads your intention'],
@@ -100,23 +102,51 @@ export class CompareLayout {
     return out;
   }
 
-  /** Put each label over its pair (the first pair's midpoint is x, z), or hide it off screen. */
-  placeLabels(stage: Stage, x: number, z: number): void {
+  /**
+   * Put each label over its pair (the first pair's midpoint is x, z), or hide it off screen.
+   * Zoomed out, or on a narrow screen, the pairs stand closer on screen than the labels are wide:
+   * the labels then move apart around their midpoint, and where the screen has no room for both
+   * side by side the second goes above the first. They never cover each other, and stay clear of
+   * the screen's edges and of an open panel card (`freeWidth`: where it begins).
+   */
+  placeLabels(stage: Stage, x: number, z: number, freeWidth = Infinity): void {
     if (!this.active) return;
     const canvas = stage.canvas;
     const width = canvas.clientWidth, height = canvas.clientHeight;
-    this.labels.forEach((label, i) => {
+    // Labels stay left of an open panel card (freeWidth), where they would be hidden under it.
+    const edge = Math.min(width, freeWidth);
+    const spots: ({ x: number; y: number; half: number; height: number } | null)[] = this.labels.map((label, i) => {
       this.point.set(x + i * this.offset.x, LABEL_HEIGHT, z + i * this.offset.z).project(stage.camera);
       const visible = this.point.z < 1 && Math.abs(this.point.x) < 1.2 && Math.abs(this.point.y) < 1.2;
       label.hidden = !visible;
-      if (!visible) return;
-      // Kept on screen and below the title card (the labels' widths are read once, when shown).
+      if (!visible) return null;
+      // The labels' sizes are read once, when first shown (not per frame).
       this.widths[i] ||= label.offsetWidth;
       this.heights[i] ||= label.offsetHeight;
-      const half = this.widths[i] / 2 + 4;
-      const left = Math.min(Math.max(((this.point.x + 1) / 2) * width, half), width - half);
-      const top = Math.max(((1 - this.point.y) / 2) * height, this.overlayBottom + this.heights[i] + 4);
-      label.style.transform = `translate(${left.toFixed(1)}px, ${top.toFixed(1)}px) translate(-50%, -100%)`;
+      // y is the label's bottom edge, kept below the title card.
+      const y = Math.max(((1 - this.point.y) / 2) * height, this.overlayBottom + this.heights[i] + 4);
+      return { x: ((this.point.x + 1) / 2) * width, y, half: this.widths[i] / 2 + LABEL_GAP / 2, height: this.heights[i] };
+    });
+    const [a, b] = spots;
+    if (a && b) {
+      const [left, right] = a.x <= b.x ? [a, b] : [b, a];
+      const need = left.half + right.half - (right.x - left.x);
+      if (need > 0) {
+        left.x -= need / 2;
+        right.x += need / 2;
+      }
+      // Kept on screen; if that pushed them together again, there is no room side by side.
+      for (const spot of spots) keepOnScreen(spot!, edge);
+      if (right.x - left.x < left.half + right.half) {
+        // Above the first label, or below it where that would reach under the title card.
+        const above = Math.min(a.y, b.y) - a.height - LABEL_GAP;
+        b.y = above - b.height >= this.overlayBottom ? above : Math.max(a.y, b.y) + b.height + LABEL_GAP;
+      }
+    } else {
+      for (const spot of spots) if (spot) keepOnScreen(spot, edge);
+    }
+    spots.forEach((spot, i) => {
+      if (spot) this.labels[i].style.transform = `translate(${spot.x.toFixed(1)}px, ${spot.y.toFixed(1)}px) translate(-50%, -100%)`;
     });
   }
 
@@ -126,4 +156,9 @@ export class CompareLayout {
     if (!out) this.scratch.set(key, (out = new Float32Array(length)));
     return out;
   }
+}
+
+/** A label's centre moved so that the label lies between the screen's left edge and `right`. */
+function keepOnScreen(spot: { x: number; half: number }, right: number): void {
+  spot.x = Math.min(Math.max(spot.x, spot.half), right - spot.half);
 }

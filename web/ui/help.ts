@@ -1,28 +1,41 @@
-// The "?" button next to the title and the help overlay it opens: what the page does in three
-// sentences, one sentence per control, and an "about / details" fold for the research names and
-// the engine's figures (a visitor never needs them; a researcher wants them one click away).
+// The "?" button next to the title and the help overlay it opens. What shows at once must fit one
+// screen without scrolling, on a phone (390x844) as on a desktop (1280x800): the method in three
+// sentences, then each control and each mark on the picture in one short sentence. The rest (the
+// longer explanation of every control, the keys, the research names and the engine's live
+// figures) waits behind "more", a fold a visitor never needs and a researcher finds in one click.
+// The dance holds still while the help is open (main.ts): it is read, not watched.
 // Text only (textContent), built once.
 
 export interface HelpOptions {
-  /** [label, explanation] per control, in panel order. */
+  /** [label, one short sentence] per control or mark on the picture: shown at once. */
+  brief: readonly (readonly [string, string])[];
+  /** [label, explanation] per control, in panel order: inside "more". */
   controls: readonly (readonly [string, string])[];
   /** The measured comparison of the two partners (research terms allowed: it sits in the fold). */
   note: string;
   /** Live engine figures, moved into the fold. */
   details?: HTMLElement;
+  /** The help opened (true) or closed (false). */
+  onToggle?(open: boolean): void;
 }
 
 const METHOD = [
-  'You lead the blue dancer with the arrow keys or your thumb; the red partner is a small neural network that, thirty times a second, looks at the last second of both dancers and chooses its next pose.',
-  'Before it moves, it guesses where your head, hands and feet will be over the next second (your intention) and dances toward that guess; the baseline partner moves without such a guess.',
-  'Both were trained on recorded salsa couples and run entirely in this page: nothing you do leaves your device.',
+  'You lead the blue dancer; the red partner is a small neural network that picks her next pose thirty times a second from the last second of both dancers.',
+  'Before each move she guesses where your head, hands and feet are going (your intention) and reacts to that guess, as a follower reads her leader.',
+  'She learned from recorded salsa couples, and everything runs in this page.',
 ];
+
+const KEYS =
+  'Keys: arrows or WASD lead · T lead her turn to her right, Shift+T to her left · Space pause · R start again (the camera too) · ' +
+  '“● clip” saves a 6 s video, the corners button goes full screen · drag to turn the camera, wheel to zoom. Phone: drag one finger ' +
+  'to lead, two fingers to turn and zoom; “pause” and the two “turn” buttons by the title.';
 
 const RESEARCH =
   'Research names: "reads your intention" is this project\'s follower (ours), which predicts the leader\'s ' +
   'future key joints and conditions its pose on them; "baseline, no intention" is CCM, the same network ' +
   'without that step; "variety" is the partner\'s sampling temperature (the leader model keeps 0.5); ' +
-  '"possible reactions" are ghost samples (the follower run again with fresh noise); an "upright choice" ' +
+  '"possible reactions" are ghost samples (the follower run again with fresh noise, each drawn a few ' +
+  'steps along its own sampled motion so that they part); an "upright choice" ' +
   'is a step in which the partner\'s sampled pose would have left the recorded dancers\' range (hips low, ' +
   'torso tipping) and the page took the most upright of 8 fresh samples instead.';
 
@@ -33,12 +46,24 @@ function element<K extends keyof HTMLElementTagNameMap>(tag: K, className = '', 
   return e;
 }
 
+/** A definition list, one <div> per [term, sentence] (the terms can then run in with their text). */
+function list(className: string, entries: HelpOptions['brief']): HTMLDListElement {
+  const dl = element('dl', className);
+  for (const [name, text] of entries) {
+    const row = element('div');
+    row.append(element('dt', '', name), element('dd', '', text));
+    dl.append(row);
+  }
+  return dl;
+}
+
 export class Help {
   readonly button: HTMLButtonElement;
   readonly overlay: HTMLElement;
+  readonly card: HTMLElement;
   readonly details: HTMLDetailsElement;
 
-  constructor(options: HelpOptions) {
+  constructor(private readonly options: HelpOptions) {
     this.button = element('button', 'help-button', '?');
     this.button.type = 'button';
     this.button.title = 'how it works';
@@ -54,7 +79,7 @@ export class Help {
     this.overlay.setAttribute('role', 'dialog');
     this.overlay.setAttribute('aria-modal', 'true');
     this.overlay.setAttribute('aria-labelledby', 'help-heading');
-    const card = element('div', 'help-card');
+    const card = (this.card = element('div', 'help-card'));
     const close = element('button', 'help-close', '×');
     close.type = 'button';
     close.setAttribute('aria-label', 'close');
@@ -63,15 +88,17 @@ export class Help {
     heading.id = 'help-heading';
     card.append(close, heading);
     for (const sentence of METHOD) card.append(element('p', 'help-method', sentence));
+    card.append(list('help-brief', options.brief));
 
-    card.append(element('h3', '', 'Controls'));
-    const list = element('dl', 'help-controls');
-    for (const [name, text] of options.controls) list.append(element('dt', '', name), element('dd', '', text));
-    card.append(list);
-    card.append(element('p', 'help-keys-line', 'Keys: arrows or WASD lead · T lead her turn to her right, Shift+T to her left · Space pause · R start again (the camera too) · “● clip” saves a 6 s video, the corners button goes full screen · drag to turn the camera, wheel to zoom. Phone: drag one finger to lead, two fingers to turn and zoom; “pause” and the two “turn” buttons by the title.'));
-
+    // Class about-details: tests treat what is inside as the fold where research terms may stand.
     this.details = element('details', 'about-details');
-    this.details.append(element('summary', '', 'about / details'), element('p', '', RESEARCH), element('p', '', options.note));
+    this.details.append(
+      element('summary', '', 'more: every control in full, the keys, research names, live figures'),
+      list('help-controls', options.controls),
+      element('p', 'help-keys-line', KEYS),
+      element('p', '', RESEARCH),
+      element('p', '', options.note),
+    );
     if (options.details) this.details.append(options.details);
     card.append(this.details);
     this.overlay.append(card);
@@ -90,7 +117,13 @@ export class Help {
   }
 
   toggle(show = !this.open): void {
+    if (show === this.open) return;
     this.overlay.hidden = !show;
     this.button.setAttribute('aria-expanded', String(show));
+    if (show) {
+      this.details.open = false; // each opening starts short: the part that fits the screen
+      this.card.scrollTop = 0;
+    }
+    this.options.onToggle?.(show);
   }
 }

@@ -119,7 +119,11 @@ class Page {
   private readonly recordPanel: RecordPanel;
 
   private simulation: Simulation | null = null;
+  /** The visitor's pause (Space, the pause button). */
   private paused = false;
+  /** The help is open: the dance holds still behind it, apart from the visitor's own pause, so
+   *  that closing the help leaves the dance as it was (paused stays paused). */
+  private helpOpen = false;
   private accumulator = 0;
   private stepping = false;
   private drawMs = 0; // smoothed wall time per animation frame not spent stepping
@@ -177,6 +181,7 @@ class Page {
       Object.defineProperty(hook[dancer], 'screen', { enumerable: true, get: () => stage.screenPoint(dancer) });
     }
     Object.defineProperty(hook, 'camera', { enumerable: true, get: () => this.stage.getOrbit() });
+    Object.defineProperty(hook, 'ghostHips', { enumerable: true, get: () => this.ghostPoses.slice(0, this.settings.ghosts).map((p) => [p[0], p[2]]) });
     if (this.settings.camera) this.stage.setOrbit(this.settings.camera);
     this.still = standingViews(manifest);
     this.leader.capture(this.still.leader, true);
@@ -257,6 +262,7 @@ class Page {
       onSkeleton: this.stage.bodies === 'skinned' ? (on) => (this.stage.skeleton = on) : undefined,
       onSettingsChange: () => this.writeAddress(),
       details: this.hud.details,
+      onHelp: (open) => (this.helpOpen = hook.helpOpen = open),
     });
   }
 
@@ -475,6 +481,8 @@ class Page {
       this.accumulator -= DT;
       steps++;
       this.capture(false);
+      // The possible reactions dance on one step per step (simulation.ts ghosts()).
+      if (this.settings.ghosts > 0) await this.refreshGhosts();
       const duet = this.simulation?.duet;
       if (this.recorder.recording && duet) this.recorder.capture(duet);
       hook.frame++;
@@ -486,7 +494,6 @@ class Page {
       // Draw between steps when stepping is slow (software rendering, big models, high speed).
       if (performance.now() - began > Math.max(MIN_STEP_BUDGET_MS, this.drawMs)) break;
     }
-    if (steps > 0 && this.settings.ghosts > 0) await this.refreshGhosts();
     if (steps > 0) this.recordPanel.update();
     this.steppedMs += performance.now() - began;
   }
@@ -538,7 +545,7 @@ class Page {
 
     // A device that cannot keep up runs the dance in slow motion rather than piling up work.
     const { settings } = this;
-    if (this.simulation && !this.paused) this.accumulator = Math.min(this.accumulator + elapsed * settings.speed, MAX_BACKLOG_SECONDS * settings.speed);
+    if (this.simulation && !this.paused && !this.helpOpen) this.accumulator = Math.min(this.accumulator + elapsed * settings.speed, MAX_BACKLOG_SECONDS * settings.speed);
     if (this.simulation && !this.stepping && this.accumulator >= DT) {
       this.stepping = true;
       // The steps run in a task of their own, after this frame is on screen. Started from here
@@ -598,7 +605,7 @@ class Page {
     const midX = 0.5 * (leader.rootX(alpha) + followers[0].rootX(alpha)), midZ = 0.5 * (leader.rootZ(alpha) + followers[0].rootZ(alpha));
     // In compare mode the camera looks between the two pairs.
     if (simulation) stage.follow(midX + 0.5 * compare.offset.x, midZ + 0.5 * compare.offset.z, elapsed);
-    compare.placeLabels(stage, midX, midZ);
+    compare.placeLabels(stage, midX, midZ, this.viewCentre.freeWidth);
     stage.render();
     hook.drawn = (hook.drawn ?? 0) + 1;
     if (hook.frame > 0 && !('first-drawn' in bootTimings)) {
@@ -655,9 +662,9 @@ async function start(): Promise<void> {
   const fetcher = new Fetcher();
   const runtime = loadRuntime();
   const loading = new LoadingBar();
-  fetcher.onProgress = (loaded, total) => {
-    hook.download = { loaded, total };
-    loading.update(loaded, total);
+  fetcher.onProgress = (loaded, total, sized) => {
+    hook.download = { loaded, total, sized };
+    loading.update(loaded, total, sized);
   };
   const manifest = await bootSpan('manifest', () => loadManifest());
   registerOffline(assetVersion(manifest));

@@ -22,8 +22,10 @@ export interface PanelOptions {
   onSkeleton?(on: boolean): void;
   /** A setting has its new value (a slider let go, a number typed, a box ticked, a menu chosen). */
   onSettingsChange(): void;
-  /** Live engine figures (the HUD's details line): shown inside the help's "about / details" fold. */
+  /** Live engine figures (the HUD's details line): shown inside the help's "more" fold. */
   details?: HTMLElement;
+  /** The help opened or closed (the dance holds still while it is open). */
+  onHelp?(open: boolean): void;
 }
 
 /** What the intention adds on this data, as measured (docs/results.md, "The paper's claim,
@@ -65,6 +67,28 @@ export const CONTROLS = {
 
 const [label, help] = [(k: keyof typeof CONTROLS) => CONTROLS[k][0], (k: keyof typeof CONTROLS) => CONTROLS[k][1]];
 
+/** What the help shows at once: one short sentence per control and per mark on the picture, few
+ * enough words that the whole list and the method fit a phone's screen (help.ts). The full
+ * sentences above are in the help's "more" fold. */
+export const BRIEF: readonly (readonly [string, string])[] = [
+  ['arrows · WASD · finger', 'Lead the blue dancer.'],
+  ['drag · wheel · 2 fingers', 'Move the camera.'],
+  ['pause (Space)', 'Holds the dance, or lets it go on.'],
+  ['↻ turn ↺ (T, Shift+T)', 'Your dancer leads her turn; she only reads his motion.'],
+  ['● clip · corners', 'Save a 6 s video · full screen.'],
+  ['partner', 'Reads your intention, a baseline that does not, or both side by side.'],
+  ['variety', 'Low: her likeliest move; high: wilder ones.'],
+  ['speed', 'The whole dance slower or faster.'],
+  ['possible reactions', 'Faint partners, a colour each: other moves she could make now.'],
+  ['floor paths', 'Each dancer’s path, a second ahead.'],
+  ['show what the partner expects', 'Purple: where she expects your head, hands and feet.'],
+  ['skeleton', 'The bones inside each body.'],
+  ['start again (R) · reset view', 'Dancers and camera to the start · only the camera.'],
+  ['copy link to this view', 'A link that opens the page as you see it.'],
+  ['record · play a file', 'Save the dance as BVH, play a file as your dancer, wear a VRM avatar.'],
+  ['orange glow', 'Where hands hold or bodies touch.'],
+];
+
 export class Panel {
   readonly gui: GUI;
   readonly help: Help;
@@ -99,9 +123,11 @@ export class Panel {
     this.gui.onFinishChange(() => options.onSettingsChange());
 
     this.help = new Help({
+      brief: BRIEF,
       controls: Object.values(CONTROLS),
       note: INTENTION_NOTE,
       details: options.details,
+      onToggle: options.onHelp,
     });
   }
 
