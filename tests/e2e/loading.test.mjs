@@ -89,6 +89,46 @@ test('before the models arrive: floor, standing pair and a loading bar; then it 
   }
 });
 
+test('the loading bar counts the bytes that travel (compressed), not the decoded 15 MB', async () => {
+  // A fresh browser: nothing cached, every byte over the wire (brotli from serve.mjs).
+  const fresh = await launch();
+  try {
+    const { page } = fresh;
+    // Every text the bar showed, as it changed.
+    await page.addInitScript(() => {
+      window.loadingLabels = [];
+      new MutationObserver(() => {
+        const text = document.querySelector('#loading .loading-label')?.textContent;
+        if (text && window.loadingLabels.at(-1) !== text) window.loadingLabels.push(text);
+      }).observe(document, { subtree: true, childList: true, characterData: true });
+    });
+    await page.goto(`${server.url}?seed=1`);
+    await waitReady(page, 90_000);
+    const { download, workerFiles } = await duet(page);
+    // What the worker fetched for the first dance: the wasm and the two models, as they came.
+    const files = workerFiles.filter((f) => /\.(wasm|onnx)$/.test(new URL(f.url).pathname));
+    assert.equal(files.length, 3, JSON.stringify(workerFiles.map((f) => f.url)));
+    const travelled = files.reduce((sum, f) => sum + f.encodedBodySize, 0);
+    const decoded = statSync(join(DIST, 'models', 'leader.onnx')).size + statSync(join(DIST, 'models', 'follower.onnx')).size
+      + statSync(join(DIST, 'assets', readdirSync(join(DIST, 'assets')).find((f) => f.endsWith('.wasm')))).size;
+    console.log(`loading bar ${download.total} bytes, travelled ${travelled}, decoded ${decoded}`);
+    assert.equal(download.sized, true);
+    assert.ok(Math.abs(download.total - travelled) <= 0.03 * travelled, `the bar counted ${download.total} bytes, ${travelled} travelled (decoded: ${decoded})`);
+    assert.equal(download.loaded, download.total);
+    const labels = await page.evaluate(() => window.loadingLabels);
+    const last = labels.filter((l) => /MB/.test(l)).at(-1);
+    assert.equal(last, `loading the dancers · ${(travelled / 1e6).toFixed(1)} of ${(travelled / 1e6).toFixed(1)} MB`, labels.join(' | '));
+    // The total never showed more than travelled (no decoded sizes, no jumps down).
+    for (const label of labels) {
+      const total = Number(label.match(/of ([\d.]+) MB/)?.[1] ?? 0);
+      assert.ok(total * 1e6 <= travelled * 1.03 + 0.05e6, `the bar said "${label}"`);
+    }
+    assert.deepEqual(fresh.consoleErrors, []);
+  } finally {
+    await fresh.close();
+  }
+});
+
 // The picture must be what the live scene then draws, or the start jumps. Measured when this was
 // written (screens scaled down 4×, largest channel difference per pixel, of 255): matching
 // pictures 1.2-2.0 on average with at most 0.8 % of pixels off by more than 32; the wide picture

@@ -1,22 +1,40 @@
 // Downloads the first dance waits for (onnxruntime's wasm, the leader and follower models), read
 // as streams so the loading screen can show a byte count instead of an empty floor.
 
-/** Bytes of each download, so far and expected; totals go to `onChange` on every chunk. */
+/**
+ * Bytes of each download, so far and expected; totals go to `onChange` on every chunk.
+ *
+ * A reader sees a file's bytes decoded, but what travels (and what a visitor waits for) is the
+ * compressed body: onnxruntime's wasm is 11.2 MB decoded and 1.8 MB as brotli, so counting
+ * decoded bytes said 15.1 MB where 4.3 MB came. So each file's compressed size is taken from its
+ * response (`wire`), and its decoded bytes count in proportion. A file whose response has not
+ * come yet (the downloads share two slots: slots.ts) is estimated from the files of its kind
+ * that have (the models compress alike; the wasm far better); until every kind has one, the
+ * byte counts are not `sized` and the bar shows no megabytes.
+ */
 export class DownloadProgress {
-  private readonly parts = new Map<string, { loaded: number; total: number }>();
+  private readonly parts = new Map<string, { loaded: number; total: number; kind: string; wire: number | null }>();
 
-  constructor(private readonly onChange: (loaded: number, total: number) => void = () => undefined) {}
+  constructor(private readonly onChange: (loaded: number, total: number, sized: boolean) => void = () => undefined) {}
 
-  /** Announce a download before it starts, so the total is right from the first chunk. */
-  expect(name: string, total: number): void {
+  /** Announce a download (its decoded size) before it starts, so the total is right from the
+   *  first chunk. `kind` groups files that compress alike. */
+  expect(name: string, total: number, kind = name): void {
     const part = this.parts.get(name);
     if (part) part.total = Math.max(part.total, total);
-    else this.parts.set(name, { loaded: 0, total });
+    else this.parts.set(name, { loaded: 0, total, kind, wire: null });
+    this.report();
+  }
+
+  /** The bytes that travel for this file (its compressed size), once its response is in. */
+  wire(name: string, bytes: number): void {
+    const part = this.parts.get(name);
+    if (part) part.wire = bytes;
     this.report();
   }
 
   add(name: string, bytes: number): void {
-    const part = this.parts.get(name) ?? { loaded: 0, total: 0 };
+    const part = this.parts.get(name) ?? { loaded: 0, total: 0, kind: name, wire: null };
     part.loaded += bytes;
     part.total = Math.max(part.total, part.loaded);
     this.parts.set(name, part);
@@ -30,21 +48,51 @@ export class DownloadProgress {
     this.report();
   }
 
+  /** Decoded bytes so far. */
   get loaded(): number {
     let sum = 0;
     for (const part of this.parts.values()) sum += part.loaded;
     return sum;
   }
 
+  /** Decoded bytes expected. */
   get total(): number {
     let sum = 0;
     for (const part of this.parts.values()) sum += part.total;
     return sum;
   }
 
-  private report(): void {
-    this.onChange(this.loaded, this.total);
+  /** Compressed bytes so far and expected, or null while a kind has no response yet. */
+  get travelled(): { loaded: number; total: number } | null {
+    const ratios = new Map<string, [number, number]>(); // kind: [wire, decoded] of the sized files
+    for (const part of this.parts.values()) {
+      if (part.wire === null || part.total <= 0) continue;
+      const sum = ratios.get(part.kind) ?? [0, 0];
+      ratios.set(part.kind, [sum[0] + part.wire, sum[1] + part.total]);
+    }
+    let loaded = 0, total = 0;
+    for (const part of this.parts.values()) {
+      const sum = ratios.get(part.kind);
+      if (part.wire === null && !sum) return null;
+      const wire = part.wire ?? (part.total * sum![0]) / sum![1];
+      total += wire;
+      loaded += part.total > 0 ? Math.min(wire, (part.loaded * wire) / part.total) : 0;
+    }
+    return { loaded: Math.round(loaded), total: Math.round(total) };
   }
+
+  private report(): void {
+    const travelled = this.travelled;
+    if (travelled) this.onChange(travelled.loaded, travelled.total, true);
+    else this.onChange(this.loaded, this.total, false);
+  }
+}
+
+/** The bytes a response's body takes on the wire: its Content-Length, which counts the body as
+ *  sent (compressed where Content-Encoding says so); `decoded` where the header is missing. */
+export function wireSize(response: Response, decoded: number): number {
+  const length = Number(response.headers.get('content-length'));
+  return length > 0 ? length : decoded;
 }
 
 /**

@@ -37,8 +37,8 @@ export class Fetcher {
   private readonly running = deferred<void>();
   private readonly models = new Map<string, Deferred<Uint8Array>>();
   private readonly asked = new Set<string>();
-  private progress: ((loaded: number, total: number) => void) | null = null;
-  private lastProgress: [number, number] | null = null;
+  private progress: ((loaded: number, total: number, sized: boolean) => void) | null = null;
+  private lastProgress: [number, number, boolean] | null = null;
 
   constructor() {
     this.wasm = this.compiled.promise;
@@ -58,8 +58,9 @@ export class Fetcher {
     };
   }
 
-  /** Bytes of the downloads so far and expected, on every whole percent (the latest at once). */
-  set onProgress(listener: (loaded: number, total: number) => void) {
+  /** Bytes of the downloads so far and expected, on every whole percent (the latest at once):
+   *  compressed, as they travel, once `sized` (download.ts DownloadProgress). */
+  set onProgress(listener: (loaded: number, total: number, sized: boolean) => void) {
     this.progress = listener;
     if (this.lastProgress) listener(...this.lastProgress);
   }
@@ -86,9 +87,9 @@ export class Fetcher {
     this.running.resolve();
     switch (message.type) {
       case 'progress':
-        this.lastProgress = [message.loaded, message.total];
+        this.lastProgress = [message.loaded, message.total, message.sized];
         this.done = message.total > 0 && message.loaded >= message.total;
-        this.progress?.(message.loaded, message.total);
+        this.progress?.(message.loaded, message.total, message.sized);
         break;
       case 'mark':
         bootMark(message.stage, message.at - performance.timeOrigin);

@@ -37,11 +37,13 @@ function failure(name: string, error: unknown): FromWorker {
 
 /** The loading bar moves in whole percents: one message per percent is enough. */
 let shownPercent = -1;
-const progress = new DownloadProgress((loaded, total) => {
+let shownSized = false;
+const progress = new DownloadProgress((loaded, total, sized) => {
   const percent = total > 0 ? Math.floor((100 * loaded) / total) : 0;
-  if (percent === shownPercent && loaded < total) return;
+  if (percent === shownPercent && sized === shownSized && loaded < total) return;
   shownPercent = percent;
-  post({ type: 'progress', loaded, total });
+  shownSized = sized;
+  post({ type: 'progress', loaded, total, sized });
 });
 const slots = new DownloadSlots();
 
@@ -66,10 +68,10 @@ function load(name: string): void {
     .then((loaded) => {
       const entry = loaded.models[name];
       if (!entry) throw new DuetError('Model not found', `"${name}" is not in manifest.json`);
-      progress.expect(name, entry.bytes);
+      progress.expect(name, entry.bytes, 'model');
       const version = assetVersion(loaded);
       return slots.run(entry.bytes, () =>
-        bootSpan(`download:${name}`, () => fetchModelBytes(loaded, name, (n) => progress.add(name, n), version, page.href)),
+        bootSpan(`download:${name}`, () => fetchModelBytes(loaded, name, (n) => progress.add(name, n), version, page.href, (n) => progress.wire(name, n))),
       );
     })
     .then(

@@ -4,7 +4,7 @@
 
 import type { Manifest } from './types';
 import { DuetError } from '../ui/errors';
-import { VERSION_HEADER, readBody } from './download';
+import { VERSION_HEADER, readBody, wireSize } from './download';
 import {
   FOLLOWER_INPUT_LAYOUT, INPUT_SIZE, INTENTION_SIZE, LEADER_INPUT_LAYOUT, type Layout, N_JOINTS, OUTPUT_LAYOUT, OUTPUT_SIZE,
 } from '../mirror/features';
@@ -79,14 +79,16 @@ export function firstDifference(blocks: unknown, expected: Layout): string | nul
 
 /** Download one model's bytes and check them against the manifest. Independent of ORT, so the
  *  downloads run while onnxruntime itself is still loading. `onBytes` sees each chunk as it
- *  arrives (the progress bar); `version` goes to the service worker (download.ts); `base` is the
- *  page's address (models/ is relative to the page, also when a worker fetches). */
+ *  arrives (the progress bar), `onWire` the bytes its body takes on the wire (compressed), once the
+ *  response is in; `version` goes to the service worker (download.ts); `base` is the page's
+ *  address (models/ is relative to the page, also when a worker fetches). */
 export async function fetchModelBytes(
   manifest: Manifest,
   name: string,
   onBytes?: (bytes: number) => void,
   version = '',
   base = location.href,
+  onWire?: (bytes: number) => void,
 ): Promise<Uint8Array> {
   const entry = manifest.models[name];
   if (!entry) throw new DuetError('Model not found', `"${name}" is not in manifest.json`);
@@ -95,6 +97,7 @@ export async function fetchModelBytes(
   try {
     const response = await fetch(new URL(url, base), version ? { headers: { [VERSION_HEADER]: version } } : undefined);
     if (!response.ok) throw new Error(`answered ${response.status}`);
+    onWire?.(wireSize(response, entry.bytes));
     bytes = await readBody(response, onBytes, entry.bytes);
   } catch (error) {
     throw new DuetError('A model file is missing', `${url}: ${(error as Error).message}`);

@@ -21,8 +21,9 @@ export interface FetchedFile {
 }
 
 export type FromWorker =
-  /** Bytes of all downloads so far and expected (the loading bar). */
-  | { type: 'progress'; loaded: number; total: number }
+  /** Bytes of all downloads so far and expected (the loading bar): as they travel (compressed)
+   *  once `sized`, decoded before (download.ts DownloadProgress). */
+  | { type: 'progress'; loaded: number; total: number; sized: boolean }
   /** A boot stage (boot.ts) reached in the worker; `at`: ms since the epoch (timeOrigin + now). */
   | { type: 'mark'; stage: string; at: number }
   /** onnxruntime's wasm, compiled. */

@@ -14,7 +14,7 @@
 
 import wasmUrl from 'onnxruntime-web-dist/ort-wasm-simd-threaded.wasm?url';
 import glueUrl from 'onnxruntime-web-dist/ort-wasm-simd-threaded.mjs?url';
-import { type DownloadProgress, VERSION_HEADER, countBody, readBody } from './download';
+import { type DownloadProgress, VERSION_HEADER, countBody, readBody, wireSize } from './download';
 import { DuetError } from '../ui/errors';
 import type { DownloadSlots } from './slots';
 
@@ -51,6 +51,7 @@ export function loadWasm(progress: DownloadProgress, slots: DownloadSlots, versi
   const download = slots.run(WASM_BYTES, async (): Promise<{ compiled: Promise<WebAssembly.Module> }> => {
     const response = await fetch(WASM_URL, version ? { headers: { [VERSION_HEADER]: version } } : undefined);
     if (!response.ok) throw new Error(`answered ${response.status}`);
+    progress.wire('wasm', wireSize(response, WASM_BYTES));
     if (typeof WebAssembly.compileStreaming === 'function' && /^application\/wasm\b/.test(response.headers.get('content-type') ?? '')) {
       const copy = response.clone();
       const compiled = WebAssembly.compileStreaming(response);

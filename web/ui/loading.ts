@@ -1,5 +1,6 @@
 // The loading bar: #loading in index.html (styled inline there, so it shows from the first paint),
-// filled from the bytes of onnxruntime's wasm and the models as they stream in.
+// filled from the bytes of onnxruntime's wasm and the models as they stream in, counted as they
+// travel (compressed: engine/download.ts); without megabytes until those sizes are known.
 
 const mb = (bytes: number) => (bytes / 1e6).toFixed(1);
 
@@ -10,14 +11,15 @@ export class LoadingBar {
   private shown = -1;
 
   /** Called on every chunk: writes the DOM only when the shown percentage changes. */
-  update(loaded: number, total: number): void {
+  update(loaded: number, total: number, sized = true): void {
     const fraction = total > 0 ? Math.min(1, loaded / total) : 0;
     const percent = Math.floor(fraction * 100);
-    if (percent === this.shown || !this.element) return;
-    this.shown = percent;
+    const shown = sized ? percent : -2 - percent;
+    if (shown === this.shown || !this.element) return;
+    this.shown = shown;
     this.element.setAttribute('aria-valuenow', String(percent));
     if (this.bar) this.bar.style.transform = `scaleX(${fraction})`;
-    if (this.label) this.label.textContent = total > 0 ? `loading the dancers · ${mb(loaded)} of ${mb(total)} MB` : 'loading the dancers';
+    if (this.label) this.label.textContent = total > 0 && sized ? `loading the dancers · ${mb(loaded)} of ${mb(total)} MB` : 'loading the dancers';
   }
 
   /** The downloads are in and compiling: the bar stays full until the dance starts. */
