@@ -15,7 +15,14 @@
 
 import { after, before, describe, test } from 'node:test';
 import assert from 'node:assert/strict';
-import { duet, launch, sleep, startServer, waitReady, waitSteps } from './harness.mjs';
+import { writeFileSync } from 'node:fs';
+import { join } from 'node:path';
+import { ROOT, duet, launch, sleep, startServer, waitReady, waitSteps } from './harness.mjs';
+
+/** Pictures a visitor would see, for docs/ (the latest test run's). */
+const shot = async (page, name) => writeFileSync(join(ROOT, 'docs', `${name}.png`), await page.screenshot());
+/** The screens whose compare mode, zoomed out, goes to docs/ (the issue's cases). */
+const SHOTS = new Set(['844x390', '1280x500']);
 
 const PHONE = { deviceScaleFactor: 1, isMobile: true, hasTouch: true };
 /** [width, height, phone] */
@@ -117,6 +124,7 @@ for (const phone of [true, false]) {
         const far = await labelBoxes(page);
         assert.ok((await duet(page)).camera.distance > 9, `${where}: zoomed out`);
         checkLabels(far, `${where}, zoomed out`);
+        if (SHOTS.has(where)) await shot(page, `layout-compare-${where}`);
       });
     });
 
@@ -180,6 +188,7 @@ test('phone: the open settings sheet shows every control, and the dancers stay i
       return { sheetTop: sheet.top, titleBottom: title.bottom, recordBottom: record.bottom, leader: window.duet.leader.screen, follower: window.duet.follower.screen };
     });
     assert.ok(seen.recordBottom <= height, `${where}: "● record" reachable without scrolling ${JSON.stringify(seen)}`);
+    if (where === '390x844') await shot(page, 'layout-phone-sheet');
     for (const dancer of ['leader', 'follower']) {
       const [, y] = seen[dancer];
       assert.ok(y > seen.titleBottom - 40 && y < seen.sheetTop, `${where}: the ${dancer} (hip at y ${y.toFixed(0)}) between the title card and the sheet ${JSON.stringify(seen)}`);
@@ -204,6 +213,7 @@ for (const [width, height, phone] of [[390, 844, true], [1280, 800, false]]) {
       });
       assert.ok(seen.scroll <= seen.client, `the help needs scrolling: ${seen.scroll} px in ${seen.client}`);
       assert.equal(seen.foldOpen, false, 'the rest waits behind "more"');
+      await shot(page, phone ? 'help-phone' : 'help-desktop');
       assert.equal(seen.text.match(/\.(\s|$)/g).length >= 3, true);
       for (const words of ['orange glow', 'possible reactions', 'partner', 'variety', 'record · play a file', 'more']) assert.match(seen.text, new RegExp(words), `the help says "${words}"`);
       // Held while open: not a step in a second.
@@ -239,7 +249,7 @@ test('the eight possible reactions stand apart, not on top of each other', async
     await waitSteps(page, 60);
     await page.keyboard.up('ArrowUp');
     // Mean distance between two ghosts' hips over a second of dance (one step apart from the
-    // same pose, as they were drawn before, they were millimetres apart).
+    // same pose, as they were drawn before: 2.9 cm; branched and danced on: 29-32 cm).
     let sum = 0;
     let count = 0;
     for (let i = 0; i < 10; i++) {
@@ -248,6 +258,9 @@ test('the eight possible reactions stand apart, not on top of each other', async
       for (let a = 0; a < 8; a++) for (let b = a + 1; b < 8; b++) (sum += Math.hypot(hips[a][0] - hips[b][0], hips[a][1] - hips[b][1])), count++;
       await waitSteps(page, 3);
     }
+    await page.keyboard.press('Space'); // a still picture of them
+    await sleep(300);
+    await shot(page, 'layout-possible-reactions');
     const mean = sum / count;
     assert.ok(mean > 0.05, `mean distance between the possible reactions' hips ${mean.toFixed(3)} m`);
     console.log(`possible reactions: mean hip distance ${(mean * 100).toFixed(1)} cm`);

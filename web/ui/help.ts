@@ -34,8 +34,8 @@ const RESEARCH =
   'Research names: "reads your intention" is this project\'s follower (ours), which predicts the leader\'s ' +
   'future key joints and conditions its pose on them; "baseline, no intention" is CCM, the same network ' +
   'without that step; "variety" is the partner\'s sampling temperature (the leader model keeps 0.5); ' +
-  '"possible reactions" are ghost samples (the follower run again with fresh noise, each drawn a few ' +
-  'steps along its own sampled motion so that they part); an "upright choice" ' +
+  '"possible reactions" are ghost rollouts (copies of the follower branched off at staggered steps ' +
+  'within the last second, each run on by her model with fresh noise); an "upright choice" ' +
   'is a step in which the partner\'s sampled pose would have left the recorded dancers\' range (hips low, ' +
   'torso tipping) and the page took the most upright of 8 fresh samples instead.';
 

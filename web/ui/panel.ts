@@ -49,7 +49,7 @@ export const CONTROLS = {
   model: ['partner', 'Which network dances with you: one that first guesses where your body is going (your intention), a baseline that does not, or both side by side with a copy of you each.'],
   temperature: ['variety', 'Low: the partner always makes its most likely move; high: it picks more varied, sometimes wilder moves.'],
   speed: ['speed', 'Plays the whole dance slower or faster.'],
-  ghosts: ['possible reactions', 'Faint extra partners, each another move the partner could have made right now.'],
+  ghosts: ['possible reactions', 'Up to 8 faint partners, one colour each: copies of her that branched off within the last second and dance on with moves of their own.'],
   trajectories: ['floor paths', "Each dancer's path on the floor, a second ahead."],
   intentions: ['show what the partner expects', "Purple lines: where the partner expects your head, hands and feet to go over the next second."],
   reset: ['start again (R)', 'Both dancers go back to the opening pose, and the camera to its first view.'],
