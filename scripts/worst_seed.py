@@ -54,7 +54,7 @@ def noted(x, temperature, rng):
 
 
 noted.frame = 0
-soak_one(manifest, load_onnx(leader), noted, args.seed, int(args.seconds * FPS), args.temperature, rec)
+soak_one(manifest, O.leader_policy(load_onnx(leader), manifest, args), noted, args.seed, int(args.seconds * FPS), args.temperature, rec)
 L, F = rec["leader_shown"], rec["follower_shown"]
 flags = P.frame_flags(F, manifest["plausibility"])
 flags["guarded"] = np.isin(np.arange(len(F)), chosen)

@@ -11,7 +11,7 @@ import torch
 from training.evaluation import metrics as M
 from training.learning import partner_losses as P
 from training.mirror.contact import SEPARATION, ContactLayer, separate, spine_gap
-from training.mirror.footik import ANKLE_FLOOR, FootLock, two_bone_ik
+from training.mirror.footik import ANKLE_FLOOR, MAX_STANCE, FootLock, cap_stance, two_bone_ik
 from training.mirror.skeleton import FEET, PARENTS
 
 
@@ -104,6 +104,23 @@ def test_foot_lock_holds_a_planted_foot_and_never_sinks():
     low[FEET[1], 1] = 0.0
     FootLock().apply(low, [0, 0], 0.0)
     assert low[FEET[1], 1] >= ANKLE_FLOOR - 1e-9
+
+
+def test_a_lock_never_holds_the_feet_wider_than_max_stance():
+    """A lock trailing 1.5 m from the other foot comes back along the line to the model's foot until
+    the stance is MAX_STANCE (0.4 of the way: the distance is 0.5 at the foot); a foot already wider
+    locks where it is. web/mirror/footik.test.ts checks capStance on the same numbers."""
+    target, foot, other = np.array([1.0, 0.1, 0.0]), np.array([0.0, 0.1, 0.0]), np.array([-0.5, 0.1, 0.0])
+    cap_stance(target, foot, other)
+    assert MAX_STANCE == 0.9
+    np.testing.assert_allclose(target, [0.4, 0.1, 0.0], atol=1e-12)
+    assert np.linalg.norm(target - other) == pytest.approx(MAX_STANCE)
+    wide = np.array([2.0, 0.1, 0.0])
+    cap_stance(wide, np.array([1.5, 0.1, 0.0]), other)
+    np.testing.assert_allclose(wide, [1.5, 0.1, 0.0], atol=1e-12)
+    near = np.array([0.2, 0.1, 0.0])
+    cap_stance(near, foot, other)                      # within the stance: untouched
+    np.testing.assert_allclose(near, [0.2, 0.1, 0.0])
 
 
 def test_separate_pushes_overlapping_spines_apart_horizontally():

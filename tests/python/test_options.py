@@ -19,7 +19,7 @@ def parse(*argv):
 
 def manifest(**extra):
     return {"defaultTemperature": 1.0, "plausibility": RANGES,
-            "skeleton": {"offsets": {"follower": OFFSETS}}, **extra}
+            "skeleton": {"offsets": {"follower": OFFSETS, "leader": OFFSETS}}, **extra}
 
 
 def policy(x, temperature, rng):
@@ -47,8 +47,22 @@ def test_options_override_the_manifest_and_an_old_manifest_has_no_guard():
     assert O.follower_policy(policy, manifest(), old, old.temperature) is policy
 
 
+def test_the_leader_is_guarded_as_the_manifest_says():
+    m = manifest(leaderTemperature=0.5, leaderGuard={"samples": 8, "margin": 0.1})
+    args = parse()
+    assert O.resolve(args, m) is None and args.leader_guard == 8
+    lead = O.leader_policy(policy, m, args)
+    # His own variety stays the duet's (the leader's temperature); the margin is the manifest's.
+    assert isinstance(lead, UprightGuard) and lead.samples == 8 and lead.temperature is None and lead.margin == 0.1
+    off = parse("--leader-guard", "0")
+    assert O.resolve(off, m) is None and O.leader_policy(policy, m, off) is policy
+    old = parse()
+    assert O.resolve(old, manifest()) is None and O.leader_policy(policy, manifest(), old) is policy
+
+
 @pytest.mark.parametrize("argv,m,words", [
     (("--guard", "1"), manifest(), "at least 2 samples"),
+    (("--leader-guard", "1"), manifest(), "at least 2 samples"),
     (("--temperature", "-1"), manifest(), "negative"),
     (("--guard", "8"), {"defaultTemperature": 1.0}, "plausibility range"),
 ])

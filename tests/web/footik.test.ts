@@ -2,7 +2,7 @@
 // planted foot still, slides a lock that trails too far, and holds ankles above the floor.
 
 import { describe, expect, it } from 'vitest';
-import { ANKLE_FLOOR, FootLock, MAX_LOCK_DISTANCE, twoBoneIk } from '../../web/mirror/footik';
+import { ANKLE_FLOOR, FootLock, MAX_LOCK_DISTANCE, MAX_STANCE, capStance, twoBoneIk } from '../../web/mirror/footik';
 
 /** A left leg: thigh (11) at hip height, knee (12) forward (bent 0.46 rad, more than the least
  *  bend the foot lock keeps), foot (13) below. */
@@ -108,5 +108,21 @@ describe('twoBoneIk with a least bend', () => {
     const vx = p[39] - p[36], vy = p[40] - p[37], vz = p[41] - p[38];
     const bend = Math.acos((ux * vx + uy * vy + uz * vz) / (Math.hypot(ux, uy, uz) * Math.hypot(vx, vy, vz)));
     expect(bend).toBeCloseTo(0.2, 6);
+  });
+});
+
+describe('capStance', () => {
+  it('brings a lock back along the line to the foot until the stance is MAX_STANCE (as test_contact.py)', () => {
+    expect(MAX_STANCE).toBe(0.9);
+    const other = new Float64Array([-0.5, 0.1, 0]);
+    const t = new Float64Array([0, 0, 0, 1, 0.1, 0]); // the second foot's lock, 1.5 m from the other foot
+    capStance(t, 3, 0, 0.1, 0, other, 0);
+    expect(Array.from(t.subarray(3)).map((v, i) => Math.abs(v - [0.4, 0.1, 0][i]) < 1e-12)).toEqual([true, true, true]);
+    const wide = new Float64Array([2, 0.1, 0]);
+    capStance(wide, 0, 1.5, 0.1, 0, other, 0);
+    expect(Array.from(wide)).toEqual([1.5, 0.1, 0]);
+    const near = new Float64Array([0.2, 0.1, 0]);
+    capStance(near, 0, 0, 0.1, 0, other, 0);
+    expect(Array.from(near)).toEqual([0.2, 0.1, 0]);
   });
 });

@@ -144,6 +144,23 @@ describe('createSimulation', () => {
     expect(q[4 * 3 + 1] - q[1]).toBeLessThan(0.2);
   });
 
+  it('the leader guard (leaderGuard) picks a standing sample of a tipping leader, at his own variety', async () => {
+    const ranges = { hip_low: 0.7, head_above_hip_low: 0.4, feet_wide: 1.07, angle_high: [2.5, 0.59] };
+    const guarded = { leaderTemperature: 0.5, leaderGuard: { samples: 4, margin: 0.1 }, plausibility: ranges };
+    const { sim, lead } = simulation([{ role: 'follower' }], { role: 'leader', tipped: [0, 1] }, guarded);
+    await sim.step(steer, 1);
+    expect(lead.temperatures).toEqual([0.5, 0.5]); // his own run, then the guard's batch of 4
+    expect(sim.guards().upright).toBe(1);
+    const p = sim.leader.positions;
+    expect(p[4 * 3 + 1] - p[1]).toBeGreaterThan(0.4);
+    // The followers' guard alone leaves him tipped over.
+    const only = simulation([{ role: 'follower' }], { role: 'leader', tipped: [0, 1] },
+      { leaderTemperature: 0.5, guard: { samples: 4, margin: 0.05 }, plausibility: ranges });
+    await only.sim.step(steer, 1);
+    const q = only.sim.leader.positions;
+    expect(q[4 * 3 + 1] - q[1]).toBeLessThan(0.2);
+  });
+
   it('starts both dancers in world space: leader at the origin, follower 0.8 m ahead facing it', () => {
     const sim = createSimulation({ manifest, leader: policy({ role: 'leader' }), followers: [policy({ role: 'follower' })], seed: 1 });
     expect(sim.leader.root).toEqual([0, 0]);

@@ -167,10 +167,10 @@ def run(args) -> dict:
         raise EvalError(f"{args.models}/manifest.json has no plausibility range: re-export it "
                         f"(python -m training.learning.export, after training.data.prepare)")
     ranges = manifest["plausibility"]
-    leader = load_onnx(leader_onnx)
     error = O.resolve(args, manifest)
     if error:
         raise EvalError(f"{args.models}/manifest.json: {error}")
+    leader = O.leader_policy(load_onnx(leader_onnx), manifest, args)
     temperature = args.temperature   # the leader's; each follower runs at its own (options.py)
     frames = int(args.seconds * feat.FPS)
     res = {"takes": names, "recording": recording_row(takes, ranges), "methods": {}}

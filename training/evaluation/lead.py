@@ -149,7 +149,7 @@ def run(args) -> dict:
     error = O.resolve(args, manifest)
     if error:
         raise EvalError(f"{args.models}/manifest.json: {error}")
-    leader = load_onnx(leader_path)
+    leader = O.leader_policy(load_onnx(leader_path), manifest, args)
     follower = O.follower_policy(load_onnx(onnx[args.method]), manifest, args, args.temperature)
     takes = [t for t in args.takes.split(",") if t]
     ref = recording(args.data, takes)

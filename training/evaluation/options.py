@@ -28,6 +28,9 @@ def add_options(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--guard-margin", type=float, default=None, metavar="M",
                     help="the guard acts once the drawn pose is within M metres of the range's edge "
                          "(default: the manifest's)")
+    ap.add_argument("--leader-guard", type=int, default=None, metavar="K",
+                    help="the leader's upright guard with K samples (0: off; default: the manifest's "
+                         "leaderGuard, acting at its margin)")
 
 
 def resolve(args, manifest: dict) -> str | None:
@@ -41,6 +44,10 @@ def resolve(args, manifest: dict) -> str | None:
         args.guard = int(guard.get("samples", 0))
     if args.guard_margin is None:
         args.guard_margin = float(guard.get("margin", 0.0))
+    if getattr(args, "leader_guard", None) is None:
+        args.leader_guard = int((manifest.get("leaderGuard") or {}).get("samples", 0))
+    if args.leader_guard < 0 or args.leader_guard == 1:
+        return f"--leader-guard {args.leader_guard}: 0 (off) or at least 2 samples to choose from"
     if args.guard < 0 or args.guard == 1:
         return f"--guard {args.guard}: 0 (off) or at least 2 samples to choose from"
     if min(args.temperature, args.follower_temperature) < 0:
@@ -58,6 +65,17 @@ def follower_policy(policy, manifest: dict, args, leader_temperature: float):
         return UprightGuard(policy, manifest["plausibility"], args.guard, temperature, args.guard_margin,
                             manifest["skeleton"]["offsets"]["follower"])
     return policy if temperature is None else Variety(policy, temperature)
+
+
+def leader_policy(policy, manifest: dict, args):
+    """The leader's policy as the (resolved) options ask: guarded like the follower (at the
+    manifest's leaderGuard margin, judging the body his bones draw), or as it is."""
+    samples = getattr(args, "leader_guard", 0) or 0
+    if samples and manifest.get("plausibility"):
+        margin = float((manifest.get("leaderGuard") or {}).get("margin", 0.0))
+        return UprightGuard(policy, manifest["plausibility"], samples, None, margin,
+                            manifest["skeleton"]["offsets"]["leader"])
+    return policy
 
 
 def restart_count(policy) -> None:

@@ -87,7 +87,8 @@ def _init(models: str, method: str, data: str, test: list[str], r: dict, options
     else:
         follower = O.follower_policy(load_onnx(onnx[method]), manifest, argparse.Namespace(**options),
                                      options["temperature"])
-    _WORKER.update(manifest=manifest, leader=load_onnx(leader), follower=follower, ranges=r)
+    leader = O.leader_policy(load_onnx(leader), manifest, argparse.Namespace(**options))
+    _WORKER.update(manifest=manifest, leader=leader, follower=follower, ranges=r)
 
 
 def _one(job: tuple[int, int, float]) -> dict:
@@ -95,8 +96,10 @@ def _one(job: tuple[int, int, float]) -> dict:
     w = _WORKER
     rec: dict = {}
     O.restart_count(w["follower"])
+    O.restart_count(w["leader"])
     soak = soak_one(w["manifest"], w["leader"], w["follower"], seed, frames, temperature, rec)
     out = {"seed": seed, "resets": soak["resets"], "guarded": getattr(w["follower"], "guarded", 0),
+           "leader_guarded": getattr(w["leader"], "guarded", 0),
            "figures": {"leader": dancer_figures(rec["leader"]), "follower": dancer_figures(rec["follower"])}}
     for kind, suffix in (("alone", ""), ("layer", "_shown")):
         lead, follow = rec["leader" + suffix], rec["follower" + suffix]
@@ -108,7 +111,8 @@ def _one(job: tuple[int, int, float]) -> dict:
 def run_method(args, method: str, r: dict, test: list[str], bar) -> dict:
     frames = int(args.seconds * FPS)
     jobs = [(seed, frames, args.temperature) for seed in range(args.first_seed, args.first_seed + args.seeds)]
-    options = {k: getattr(args, k) for k in ("temperature", "follower_temperature", "guard", "guard_margin")}
+    options = {k: getattr(args, k) for k in ("temperature", "follower_temperature", "guard", "guard_margin",
+                                             "leader_guard")}
     init = (args.models, method, args.data, test, r, options)
 
     def counted(results):

@@ -189,6 +189,7 @@ def main(argv=None) -> int:
     temperature = args.temperature
     ranges = manifest.get("plausibility")
     follower = O.follower_policy(follower, manifest, args, temperature)
+    leader = O.leader_policy(leader, manifest, args)
     t0 = time.time()
     results = []
     print(f"{args.rollouts} rollouts x {frames} frames ({args.minutes:g} min at {FPS} Hz), "

@@ -29,6 +29,10 @@ MAX_LOCK_DISTANCE = 0.25
 # the recorded dancers' knees bend at least 0.19-0.30 rad in 99.5 % of frames, and a leg pulled
 # fully straight read as out of the recorded range in 2-6 % of the shown frames.
 MIN_KNEE_BEND = 0.2
+# The locks never hold the feet further apart than this (ankle to ankle): a lock trailing behind a
+# dancer that travels on spread his stance past the recording's widest (1.07 m, plausibility's
+# feet_wide) in 1-7 % of a dancing leader's steered frames, with his own feet never that wide.
+MAX_STANCE = 0.9
 # After a contact ends, the lock's pull decays by this factor per step (no pop on release).
 RELEASE_DECAY = 0.5
 # A foot locks while the model's contact for it is above this. The follower's network, sampled at
@@ -77,6 +81,19 @@ def two_bone_ik(positions: np.ndarray, a: int, b: int, c: int, target, pole, min
     positions[c] = pa + d * n
 
 
+def cap_stance(target: np.ndarray, foot: np.ndarray, other: np.ndarray) -> None:
+    """Move a lock `target` (in place) along the line to the model's `foot` until it is within
+    MAX_STANCE of the `other` foot (as shown now); at the foot itself if even that is further.
+    The distance to a point is convex along a line, so the linear share below never overshoots."""
+    near = float(np.linalg.norm(foot - other))
+    far = float(np.linalg.norm(target - other))
+    if far <= MAX_STANCE:
+        return
+    share = 0.0 if near >= MAX_STANCE else (MAX_STANCE - near) / (far - near)
+    target[:] = foot + (target - foot) * share
+    target[1] = max(target[1], ANKLE_FLOOR)
+
+
 class FootLock:
     """The lock state of one dancer's two feet, kept between steps."""
 
@@ -114,6 +131,8 @@ class FootLock:
                 w = self.weight[i] * RELEASE_DECAY
                 self.weight[i] = 0.0 if w < 0.01 else w
             w = self.weight[i]
+            if w > 0:
+                cap_stance(t, f, positions[FEET[1 - i]])
             goal = f + (t - f) * w
             goal[1] = max(goal[1], ANKLE_FLOOR)
             if w > 0 or f[1] < ANKLE_FLOOR:

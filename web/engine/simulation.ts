@@ -70,9 +70,11 @@ export class DuetSimulation implements Simulation {
   // Own copies of each model's result: two roles may never share a policy's result arrays.
   private readonly leaderOutput = new Float32Array(OUTPUT_SIZE);
   private readonly guardCounts = { resets: 0, leashed: 0, upright: 0 };
-  /** Steps in which the upright guard took another of the follower's samples. */
+  /** Steps in which an upright guard took another of a dancer's samples (follower or leader). */
   private upright = 0;
   private readonly uprightGuard: { settings: GuardSettings; ranges: Ranges } | null;
+  /** The leader's guard (the same test at the manifest's leaderGuard margin). */
+  private readonly leaderGuard: { settings: GuardSettings; ranges: Ranges } | null;
   /** The leader model's own variety (the manifest's); the slider sets the followers'. */
   private readonly leaderTemperature: number | null;
   private readonly followerOutputs: Float32Array[];
@@ -98,6 +100,8 @@ export class DuetSimulation implements Simulation {
     this.leaderTemperature = manifest.leaderTemperature ?? null;
     const g = manifest.guard;
     this.uprightGuard = g && g.samples >= 2 && manifest.plausibility ? { settings: g, ranges: manifest.plausibility } : null;
+    const lg = manifest.leaderGuard;
+    this.leaderGuard = lg && lg.samples >= 2 && manifest.plausibility ? { settings: lg, ranges: manifest.plausibility } : null;
     this.duet = startDuet(manifest, followers.length);
     this.leaderView = new View(false);
     this.followerViews = followers.map((p) => new View(p.hasIntention));
@@ -148,6 +152,7 @@ export class DuetSimulation implements Simulation {
     if (!playing) {
       const result = await this.leaderPolicy.run(this.leaderTemperature ?? temperature);
       this.leaderOutput.set(result.output);
+      await this.keepLeaderUpright(this.leaderTemperature ?? temperature);
     }
     for (let i = 0; i < this.followerPolicies.length; i++) {
       const result = await this.followerPolicies[i].run(temperature);
@@ -179,6 +184,22 @@ export class DuetSimulation implements Simulation {
     const best = mostUpright(output, k, OUTPUT_SIZE, guard.ranges, offsets);
     this.followerOutputs[i].set(output.subarray(best * OUTPUT_SIZE, (best + 1) * OUTPUT_SIZE));
     if (intention) this.followerIntentions[i]?.set(intention.subarray(best * INTENTION_SIZE, (best + 1) * INTENTION_SIZE));
+    this.upright++;
+  }
+
+  /** The same guard on the leader's output (mirror/guard.py's UprightGuard wraps his policy alike). */
+  private async keepLeaderUpright(temperature: number): Promise<void> {
+    const guard = this.leaderGuard;
+    if (!guard) return;
+    const offsets = this.duet.leader.offsets;
+    if (uprightMargin(this.leaderOutput, 0, guard.ranges, offsets) >= guard.settings.margin) return;
+    const k = guard.settings.samples;
+    const policy = this.leaderPolicy;
+    const input = policy.batchInput(k);
+    for (let n = 0; n < k; n++) input.set(policy.input, n * policy.input.length);
+    const { output } = await policy.runBatch(k, temperature);
+    const best = mostUpright(output, k, OUTPUT_SIZE, guard.ranges, offsets);
+    this.leaderOutput.set(output.subarray(best * OUTPUT_SIZE, (best + 1) * OUTPUT_SIZE));
     this.upright++;
   }
 

@@ -142,6 +142,8 @@ export interface Manifest {
   leaderTemperature?: number;
   /** The followers' upright guard (web/mirror/guard.ts); absent: no guard. */
   guard?: GuardSettings;
+  /** The leader's upright guard, the same with its own margin; absent: no guard. */
+  leaderGuard?: GuardSettings;
   /** The recording's range (training/evaluation/plausibility.py); the guard judges against it. */
   plausibility?: Ranges;
   credit: string;

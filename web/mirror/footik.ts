@@ -19,6 +19,9 @@ export const MAX_LOCK_DISTANCE = 0.25;
 export const MIN_KNEE_BEND = 0.2;
 /** After a contact ends, the lock's pull decays by this factor per step (no pop on release). */
 export const RELEASE_DECAY = 0.5;
+/** The locks never hold the feet further apart than this (ankle to ankle): a lock trailing behind
+ *  a dancer that travels on spread his stance past the recording's widest (1.07 m). */
+export const MAX_STANCE = 0.9;
 /** A foot locks while the model's contact for it is above this (the follower's layer locks from a
  *  lower one: contact.ts FOLLOWER_CONTACT). */
 export const CONTACT_THRESHOLD = 0.5;
@@ -85,6 +88,26 @@ export function twoBoneIk(
   positions[3 * c + 2] = az + d * nz;
 }
 
+/**
+ * Move the lock target t[o..o+2] (in place) along the line to the model's foot (fx, fy, fz) until
+ * it is within MAX_STANCE of the other foot (positions[q..q+2], as shown now); at the foot itself
+ * if even that is further. The distance to a point is convex along a line, so the linear share
+ * never overshoots.
+ */
+export function capStance(
+  t: Float64Array, o: number, fx: number, fy: number, fz: number,
+  positions: Float32Array | Float64Array, q: number,
+): void {
+  const ox = positions[q], oy = positions[q + 1], oz = positions[q + 2];
+  const near = Math.hypot(fx - ox, fy - oy, fz - oz);
+  const far = Math.hypot(t[o] - ox, t[o + 1] - oy, t[o + 2] - oz);
+  if (far <= MAX_STANCE) return;
+  const share = near >= MAX_STANCE ? 0 : (MAX_STANCE - near) / (far - near);
+  t[o] = fx + (t[o] - fx) * share;
+  t[o + 1] = Math.max(fy + (t[o + 1] - fy) * share, ANKLE_FLOOR);
+  t[o + 2] = fz + (t[o + 2] - fz) * share;
+}
+
 /** The lock state of one dancer's two feet, kept between steps. */
 export class FootLock {
   constructor(readonly threshold: number = CONTACT_THRESHOLD) {}
@@ -133,6 +156,7 @@ export class FootLock {
         this.weight[i] = this.weight[i] * RELEASE_DECAY < 0.01 ? 0 : this.weight[i] * RELEASE_DECAY;
       }
       const w = this.weight[i];
+      if (w > 0) capStance(t, o, fx, fy, fz, positions, 3 * FEET[1 - i]);
       const tx = fx + (t[o] - fx) * w;
       const ty = Math.max(fy + (t[o + 1] - fy) * w, ANKLE_FLOOR);
       const tz = fz + (t[o + 2] - fz) * w;
