@@ -220,7 +220,7 @@ MODELS = {
     # Since 2026-11-25 his decoder sees its own state in half the samples, as the followers', and he
     # trains on his own rollouts (his plan the recorded path laid from where he stands): he dances
     # (steered, body motion 0.52 m/s against 0.33, the recording 0.83) and the page's upright guard,
-    # the follower's with a 0.1 m margin (training/mirror/guard.py), keeps him up: 0 of 20 steered
+    # the follower's with a 0.07 m margin (training/mirror/guard.py), keeps him up: 0 of 20 steered
     # seeds with a bad second. Beside him our follower turns 25 times a minute, steered (recording 23).
     "leader": replace(steady(LEADER_STOP_MOTION), figure_dropout=0.5, state_dropout=0.5, own_rollouts_from=10, seed=2),
     # The leader shipped until then (state always seen, no own rollouts).
