@@ -14,9 +14,11 @@ import { distance, duet, launch, sleep, startServer, waitReady, waitSteps } from
 
 /** 1.5 s of dance. */
 const STEER_STEPS = 45;
-/** Held for STEER_STEPS, ArrowUp walked the leader 1.7-2.6 m when writing this test; a key the
- *  page never saw left it within 0.1 m. */
-const MIN_STEER_M = 1;
+/** Held for STEER_STEPS, ArrowUp carries the spot the leader dances around (window.duet.anchor,
+ *  which moves only while he is steered) about 0.9 m; a key the page never saw leaves it where it
+ *  was. (The leader's own root walked 1.7-2.6 m when the leader only walked; the leader that dances
+ *  covers 0.4-2.5 m of it, in whatever figure he dances.) */
+const MIN_STEER_M = 0.6;
 /** DEFAULT_ORBIT in web/draw/scene.ts. */
 const DEFAULT_CAMERA = { azimuth: 35, polar: 70, distance: 5.2 };
 
@@ -30,7 +32,7 @@ after(async () => {
   await server?.stop();
 });
 
-/** How far ArrowUp, held for STEER_STEPS steps, walks the leader (m), from wherever it is. */
+/** How far ArrowUp, held for STEER_STEPS steps, carries the leader's spot (m), from wherever it is. */
 async function steerUp(page) {
   const start = await duet(page);
   await page.keyboard.down('ArrowUp');
@@ -39,7 +41,7 @@ async function steerUp(page) {
   } finally {
     await page.keyboard.up('ArrowUp');
   }
-  return distance(start.leader.root, (await duet(page)).leader.root);
+  return distance(start.anchor, (await duet(page)).anchor);
 }
 
 /** What has focus, for messages. */
@@ -91,7 +93,7 @@ describe('desktop: a click in the panel leaves the keys steering', () => {
     await browser?.close();
   });
 
-  test('after a click on any panel control (or the buttons by the title), ArrowUp walks the leader ≥ 1 m in 1.5 s of dance', async () => {
+  test('after a click on any panel control (or the buttons by the title), ArrowUp carries the leader spot ≥ 0.6 m in 1.5 s of dance', async () => {
     const results = [];
     const check = async (what) => {
       const moved = await steerUp(page);

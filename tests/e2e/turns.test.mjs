@@ -15,9 +15,10 @@
 // - the page keeps dancing through the turn: a step every 1/30 s of dance, both hips above 0.5 m,
 //   no error; the phone dances the same steps as the desktop;
 // - the strips' frames are not blank.
-// Whether the follower completes a turn is printed, not asserted: over seeds 1-10 she does in 2 of
-// 10 asked runs, 5 of 10 with the directions swapped, and with nobody asking in 2 of the 10 seeds
-// (5 and 10: already spinning at 4 s) (scripts/turns_probe.mjs measures it). In seed 6 she does: 488° to her right in 2.5 s, 257° unasked.
+// Whether the follower completes a turn is printed, not asserted: with the models trained on their
+// own rollouts (second change of 25 Nov), over seeds 1-10 she completes the asked turn in 2 of 10
+// asked runs and in 0 of 10 unasked (2 of 10 either way) (scripts/turns_probe.mjs measures it). In
+// seed 6 she turns 219° to her right within 3 s asked, 203° unasked.
 // Run: node --test tests/e2e/turns.test.mjs
 
 import { after, before, describe, test } from 'node:test';

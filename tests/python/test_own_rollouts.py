@@ -61,11 +61,11 @@ def test_replaying_the_recording_makes_the_recorded_samples(prepared3, role):
 
 def test_a_network_drifts_from_the_recording_and_trains_on_it(prepared3, tmp_path, capsys):
     """The smoke recipe with own rollouts: samples made at its epochs, and they are not the recording."""
-    cfg = T.smoke(T.MODELS["follower_own"])
+    cfg = T.smoke(T.MODELS["follower"])
     cfg = T.replace(cfg, epochs=3, own_rollouts_from=1, own_rollouts_every=1, own_rollouts_stride=20,
                     own_rollouts_horizon=8)
-    r = T.train_model("follower_own", cfg, str(prepared3), str(tmp_path))
-    h = json.loads((tmp_path / "follower_own" / "history.json").read_text())
+    r = T.train_model("follower", cfg, str(prepared3), str(tmp_path))
+    h = json.loads((tmp_path / "follower" / "history.json").read_text())
     assert len(h["own_rollout_samples"]) == 2 and min(h["own_rollout_samples"]) > 0
     assert "own rollouts at epoch 1" in capsys.readouterr().out
     assert np.isfinite(r["val_mse"])

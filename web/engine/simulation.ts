@@ -133,6 +133,10 @@ export class DuetSimulation implements Simulation {
     return true;
   }
 
+  get anchor(): [number, number] {
+    return [this.duet.steering.anchor[0], this.duet.steering.anchor[1]];
+  }
+
   /** Whether a turn the visitor asked for is being led, and its direction (0: none). */
   get turnAsked(): number {
     return this.duet.request?.direction ?? 0;

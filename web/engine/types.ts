@@ -44,6 +44,8 @@ export interface Simulation {
   askTurn(direction: number): boolean;
   /** The turn being led: -1, +1, or 0 when none. */
   readonly turnAsked: number;
+  /** The spot the leader dances around (world x, z): it moves only while the visitor steers. */
+  readonly anchor: [number, number];
   /** Advance one 1/30 s step. */
   step(steer: Steer, temperature: number): Promise<void>;
   leader: DancerView;
@@ -171,6 +173,8 @@ export interface DuetHook {
   askTurn?: (direction: number) => boolean;
   /** The turn being led: -1, +1, or 0 when none. */
   turnAsked?: number;
+  /** The spot the leader dances around (world x, z): it moves only while the visitor steers. */
+  anchor?: [number, number];
   /** The contact layer's hand hold between the leader and the (first) follower, 0..1
    *  (web/mirror/contact.ts): 1 when the closest hands meet. */
   hold: number;

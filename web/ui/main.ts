@@ -296,6 +296,7 @@ class Page {
     hook.stepMs.median = stats.median;
     hook.stepMs.p95 = stats.p95;
     hook.turnAsked = simulation.turnAsked;
+    hook.anchor = simulation.anchor;
     this.turnButtons.show(simulation.turnAsked);
   }
 
