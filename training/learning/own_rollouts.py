@@ -26,6 +26,8 @@ import torch
 from ..data.prepared import TrainError
 from ..mirror import features as feat
 from ..mirror.features import HISTORY, Track
+from ..evaluation.evaluate_inputs import window
+from ..evaluation.evaluate_rollouts import steer_along_recording
 from ..mirror.rollout import NOW, Dancer, apply_output, output_is_absurd
 
 FIELDS = ("positions", "rotations", "root", "heading")
@@ -56,25 +58,6 @@ def load_couples(prepared: str) -> list[Couple]:
     return out
 
 
-def window(track: Track, t: int) -> Track:
-    """A copy of the 61 frames around t (the rollout's layout, t at NOW)."""
-    sl = slice(t - HISTORY, t + HISTORY + 1)
-    return Track(*(getattr(track, k)[sl].copy() for k in FIELDS))
-
-
-def lay_recorded_plan(me: Dancer, recorded: Track, t: int) -> None:
-    """A leader's plan: the recorded future path at t, relative to the recorded root, laid down
-    from where he stands now (what evaluation's steer_along_recording does)."""
-    keys = t + feat.FUTURE_OFFSETS
-    local = feat.trajectory_block(recorded.root[keys], recorded.heading[keys], recorded.root[t],
-                                  recorded.heading[t]).reshape(-1, 4)
-    tr = me.track
-    pos = feat.from_root_space_points(np.stack([local[:, 0], np.zeros(len(local)), local[:, 1]], -1),
-                                      tr.root[NOW], tr.heading[NOW])
-    tr.root[NOW + feat.FUTURE_OFFSETS] = pos[:, [0, 2]]
-    tr.heading[NOW + feat.FUTURE_OFFSETS] = tr.heading[NOW] + np.arctan2(local[:, 2], local[:, 3])
-
-
 @dataclass
 class Run:
     couple: Couple
@@ -92,7 +75,7 @@ def inputs_at(run: Run, role: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         x = feat.follower_input(partner, run.me.track, now)[0]
     else:
         partner, recorded = window(c.follower, t), c.leader
-        lay_recorded_plan(run.me, recorded, t)
+        steer_along_recording(run.me, recorded, t)   # his plan: the recorded path, laid from where he stands
         x = feat.leader_input(partner, run.me.track, now, feat.figure_block(c.partner_turn[t][None], 1))[0]
     y = feat.output_features(recorded, np.array([t]))[0]
     j = feat.intention_target(partner, run.me.track, now)[0]

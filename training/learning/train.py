@@ -219,9 +219,9 @@ MODELS = {
     # none but 1 of the CCM follower; seed 3 leader 8, our follower 7, CCM 37).
     # Since 2026-11-25 his decoder sees its own state in half the samples, as the followers', and he
     # trains on his own rollouts (his plan the recorded path laid from where he stands): he dances
-    # (steered, body motion 0.52 m/s against 0.33, the recording 0.83) and the page's upright guard,
-    # the follower's with a 0.07 m margin (training/mirror/guard.py), keeps him up: 0 of 20 steered
-    # seeds with a bad second. Beside him our follower turns 25 times a minute, steered (recording 23).
+    # (steered, body motion 0.54 m/s against 0.33, the recording 0.83) and the page's upright guard,
+    # the follower's with a 0.07 m margin (training/mirror/guard.py), keeps him up: 0 of 100 steered
+    # seeds with a bad second. Beside him our follower turns 26.0 times a minute, steered (recording 23.0).
     "leader": replace(steady(LEADER_STOP_MOTION), figure_dropout=0.5, state_dropout=0.5, own_rollouts_from=10, seed=2),
     # The leader shipped until then (state always seen, no own rollouts).
     "leader_before_own": replace(steady(LEADER_STOP_MOTION), figure_dropout=0.5, seed=2),

@@ -133,8 +133,8 @@ export class DuetSimulation implements Simulation {
     return true;
   }
 
-  get anchor(): [number, number] {
-    return [this.duet.steering.anchor[0], this.duet.steering.anchor[1]];
+  get anchor(): ArrayLike<number> {
+    return this.duet.steering.anchor;
   }
 
   /** Whether a turn the visitor asked for is being led, and its direction (0: none). */

@@ -44,8 +44,9 @@ export interface Simulation {
   askTurn(direction: number): boolean;
   /** The turn being led: -1, +1, or 0 when none. */
   readonly turnAsked: number;
-  /** The spot the leader dances around (world x, z): it moves only while the visitor steers. */
-  readonly anchor: [number, number];
+  /** The spot the leader dances around (world x, z): it moves only while the visitor steers.
+   *  The simulation's own array (read it, do not keep or change it). */
+  readonly anchor: ArrayLike<number>;
   /** Advance one 1/30 s step. */
   step(steer: Steer, temperature: number): Promise<void>;
   leader: DancerView;

@@ -296,7 +296,11 @@ class Page {
     hook.stepMs.median = stats.median;
     hook.stepMs.p95 = stats.p95;
     hook.turnAsked = simulation.turnAsked;
-    hook.anchor = simulation.anchor;
+    // Copied into the hook's own pair: no array made per frame.
+    const anchor = simulation.anchor;
+    hook.anchor ??= [0, 0];
+    hook.anchor[0] = anchor[0];
+    hook.anchor[1] = anchor[1];
     this.turnButtons.show(simulation.turnAsked);
   }
 
