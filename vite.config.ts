@@ -5,6 +5,7 @@ import { join, relative, resolve } from 'node:path';
 import { promisify } from 'node:util';
 import { brotliCompress, constants, gzip } from 'node:zlib';
 import { type Plugin, defineConfig } from 'vite';
+import { shortHash } from './web/engine/download.ts';
 
 // Cross-origin isolation (COOP + COEP) is what lets onnxruntime-web use SharedArrayBuffer and
 // therefore more than one WASM thread. Any static host serving dist/ needs the same two headers;
@@ -85,6 +86,28 @@ function precompress(): Plugin {
   };
 }
 
+/**
+ * The version of the models this build ships (__DUET_MODELS__: the same hash of the manifest's
+ * models that web/engine/offline.ts computes), so that a page can tell a manifest of another
+ * deployment from its own (a page of one version never dances the models of another). Read from
+ * the public folder actually used, which a build may replace (tests/e2e/deploy.mjs does).
+ */
+function modelsStamp(): Plugin {
+  return {
+    name: 'duet-models-stamp',
+    config(config) {
+      const publicDir = resolve(config.root ?? process.cwd(), typeof config.publicDir === 'string' ? config.publicDir : 'public');
+      let stamp = '';
+      try {
+        stamp = shortHash(JSON.stringify(JSON.parse(readFileSync(join(publicDir, 'models', 'manifest.json'), 'utf8')).models));
+      } catch {
+        // no manifest (yet): the page does not check
+      }
+      return { define: { __DUET_MODELS__: JSON.stringify(stamp) } };
+    },
+  };
+}
+
 export default defineConfig({
   // Relative asset URLs so dist/ works from any sub-path (GitHub Pages, a folder on a server).
   base: './',
@@ -102,7 +125,7 @@ export default defineConfig({
   define: { __ORT_WASM_BYTES__: JSON.stringify(statSync(ORT_WASM).size) },
   resolve: { alias: { 'onnxruntime-web-dist': ORT_DIST } },
   build: { target: 'es2022' },
-  plugins: [precompress()],
+  plugins: [precompress(), modelsStamp()],
   test: {
     include: ['tests/web/**/*.test.ts'],
   },

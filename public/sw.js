@@ -8,6 +8,14 @@
 //   deletes the old caches when it activates.
 // The first visit is not controlled by this worker: the page posts the URLs it downloaded
 // ({type: 'keep'}) and the worker stores them.
+//
+// A new version waits until the page of that version dances and says so ({type: 'keep',
+// activate: true}); only then does it take over and delete the old caches. Taking over at once
+// (skipWaiting on install) changed the worker under a page that was still starting onnxruntime:
+// its thread's script, asked for in that moment, never came, and the start hung for good in 6 of
+// 72 visits after a deploy (scripts/deploy_trials.mjs; docs/reliability.md). While the new one
+// waits, the old worker answers the new page's requests for models of another version from the
+// network (the x-duet-version header), and everything else by its hashed name or network first.
 
 const VERSION = new URL(self.location.href).searchParams.get('v') || 'dev';
 const CACHE = `duet-${VERSION}`;
@@ -15,10 +23,6 @@ const VERSION_HEADER = 'x-duet-version';
 
 const immutable = (url) => /\.(onnx|wasm)$/.test(url.pathname) || /\/assets\/[^/]+-[\w-]{8,}\.\w+$/.test(url.pathname);
 
-self.addEventListener('install', () => {
-  // A new version takes over at the next navigation; the page still works under the old one.
-  self.skipWaiting();
-});
 
 self.addEventListener('activate', (event) => {
   event.waitUntil(
@@ -29,6 +33,8 @@ self.addEventListener('activate', (event) => {
 self.addEventListener('message', (event) => {
   const data = event.data;
   if (!data || data.type !== 'keep' || !Array.isArray(data.urls)) return;
+  // The page of this version dances: take over (a waiting worker), now that nothing is starting.
+  if (data.activate) self.skipWaiting();
   event.waitUntil(
     caches.open(CACHE).then((cache) =>
       Promise.all(

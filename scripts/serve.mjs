@@ -84,7 +84,9 @@ export function handler({ dir = 'dist', base = '/', isolation = true } = {}) {
     let size = info.size;
     for (const encoding of accepted(request.headers['accept-encoding'])) {
       const variant = stat(`${file}.${encoding === 'br' ? 'br' : 'gz'}`);
-      if (variant) {
+      // A compressed copy older than the file is of an earlier version of it (the file was
+      // rebuilt or edited without compressing again): never send it in the file's place.
+      if (variant && variant.mtimeMs >= info.mtimeMs) {
         body = `${file}.${encoding === 'br' ? 'br' : 'gz'}`;
         size = variant.size;
         headers['Content-Encoding'] = encoding;

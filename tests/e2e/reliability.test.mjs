@@ -231,6 +231,20 @@ describe('bad inputs show a clear message, not a blank canvas', () => {
     await page.close();
   });
 
+  test("onnxruntime's loader served as text/plain: the message names the host's MIME type, not a model", async (t) => {
+    const { page } = await openPage(browser);
+    // The loader itself, not the dev server's `?url` module that only names it.
+    const loader = (url) => /ort-wasm-simd-threaded[^/]*\.mjs$/.test(url.pathname) && !url.searchParams.has('url');
+    await page.route(loader, async (route) => {
+      const response = await route.fetch();
+      await route.fulfill({ response, headers: { ...response.headers(), 'content-type': 'text/plain' } });
+    });
+    await page.goto(`${server.url}?seed=1`);
+    const { text } = await expectMessage(t, page, /wrong type/i, /ort-wasm-simd-threaded.*\.mjs comes as "text\/plain".*text\/javascript/);
+    assert.doesNotMatch(text, /corrupt/i);
+    await page.close();
+  });
+
   test('WebGL unavailable (getContext returns null)', async (t) => {
     const { page } = await openPage(browser);
     await page.addInitScript(() => {

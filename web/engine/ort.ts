@@ -71,3 +71,20 @@ export function configureThreads(requested: number | null, module?: WebAssembly.
   ort.env.logLevel = 'error';
   return threads;
 }
+
+/**
+ * Why onnxruntime could not start, where its host tells: the Emscripten loader (a module script)
+ * served with a type that is not JavaScript, which browsers refuse to run. Without this the
+ * failure reads as a corrupt model (policy.ts). Null when the type is right or cannot be read.
+ */
+export async function loaderTypeProblem(): Promise<string | null> {
+  try {
+    const url = new URL(GLUE_URL, location.href);
+    const response = await fetch(url, { method: 'HEAD' });
+    const type = response.headers.get('content-type') ?? '';
+    if (!response.ok || /javascript|ecmascript/i.test(type)) return null;
+    return `${url.pathname} comes as "${type || 'no type'}", and browsers run a module script only when it comes as JavaScript: the host must serve .mjs files as text/javascript.`;
+  } catch {
+    return null;
+  }
+}

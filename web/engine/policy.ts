@@ -5,7 +5,7 @@
 // predictor), `code` [B, C]. Everything here is allocated once: callers write into `input`, call
 // run(), and read `result`, so stepping at 30 Hz creates no garbage of ours.
 
-import { ort } from './ort';
+import { loaderTypeProblem, ort } from './ort';
 import type { Manifest, ModelEntry, PolicyResult, StepPolicy } from './types';
 import { DuetError } from '../ui/errors';
 import { createUniform, fillUniform } from './random';
@@ -129,6 +129,9 @@ export async function createPolicy(manifest: Manifest, name: string, bytes: Uint
   try {
     session = await ort.InferenceSession.create(bytes, SESSION_OPTIONS);
   } catch (error) {
+    // A host that sends onnxruntime's loader with another type than JavaScript stops every model.
+    const served = await loaderTypeProblem();
+    if (served) throw new DuetError('The host sends a script with the wrong type', served);
     // onnxruntime's own message can be empty ("ERROR_MESSAGE: "): say what it means in any case.
     const detail = String((error as Error)?.message ?? error).trim();
     throw new DuetError(

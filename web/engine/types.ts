@@ -212,6 +212,14 @@ export interface DuetHook {
   ghostHips?: [number, number][];
   /** Whether the help is open (the dance holds still behind it, `paused` or not). */
   helpOpen?: boolean;
+  /** The version of the models and wasm this page runs (the service worker's cache is named by
+   *  it), of the models its manifest names, and of the models the page's build shipped with ('' in
+   *  development): the last two differ only on a page and manifest of two deployments. */
+  version?: string;
+  modelsVersion?: string;
+  buildVersion?: string;
+  /** How many times the start's watchdog restarted this visit before it danced (watchdog.ts). */
+  recovered?: number;
 }
 
 declare global {

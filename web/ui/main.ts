@@ -13,7 +13,9 @@ import { loadManifest } from '../engine/manifest';
 import { Fetcher } from '../engine/fetcher';
 import { FOLLOWER_MODELS } from '../engine/firstdance';
 import { standingViews } from '../engine/standing';
-import { assetVersion, keepForOffline, registerOffline } from '../engine/offline';
+import { BUILD_MODELS, assetVersion, keepForOffline, modelsVersion, registerOffline } from '../engine/offline';
+import { BootWatchdog, clearRestarts, restartsSoFar, takeRestart } from '../engine/watchdog';
+import { restart, restarting, siteReplaced, siteUpdated, stalled } from './updates';
 import { GLUE_URL } from '../engine/wasm';
 import { LoadingBar } from './loading';
 import { DEFAULT_ORBIT, Stage } from '../draw/scene';
@@ -73,6 +75,7 @@ const hook: DuetHook = {
   firstFrameMs: null,
   hold: 0,
   bootTimings,
+  recovered: restartsSoFar(),
 };
 window.duet = hook;
 
@@ -109,6 +112,7 @@ class Page {
   private readonly settings: Settings;
   private readonly hasCcm: boolean;
   private readonly stage: Stage;
+  private readonly panel: Panel;
   private readonly hud: Hud;
   private readonly controls: Controls;
   private readonly pauseButton: PauseButton;
@@ -200,7 +204,7 @@ class Page {
       onReset: () => this.reset(),
       onTurn: (direction) => this.askTurn(direction),
     });
-    const panel = this.createPanel();
+    const panel = (this.panel = this.createPanel());
     this.pauseButton = new PauseButton(() => this.togglePause());
     this.turnButtons = new TurnButtons((direction) => this.askTurn(direction));
     // Save a clip of the canvas, and full screen (clip.ts): beside the turn buttons.
@@ -254,7 +258,7 @@ class Page {
     return new Panel({
       settings: this.settings,
       models: this.hasCcm ? ['ours', 'ccm', 'compare'] : ['ours'],
-      onModel: (choice) => this.useModel(choice).catch(this.fail),
+      onModel: (choice) => this.useModel(choice).catch(this.keepDancingIfUpdated),
       onGhosts: () => this.exclusive(() => this.refreshGhosts()).catch(this.fail),
       onReset: () => this.reset(),
       onResetView: () => this.resetView(),
@@ -272,6 +276,16 @@ class Page {
     this.queue = run.catch(() => undefined);
     return run;
   }
+
+  /** A partner this page cannot load since a newer site went up (policy()): say so, and the
+   *  partner already dancing dances on. Any other failure is fatal. */
+  private readonly keepDancingIfUpdated = (error: unknown): void => {
+    if (!(siteReplaced() && error instanceof DuetError && this.simulation)) return this.fail(error);
+    showToast(error.title, error.detail, 'error', 15_000);
+    this.settings.model = hook.model as FollowerChoice;
+    this.panel.refresh();
+    this.writeAddress();
+  };
 
   private readonly fail = (error: unknown): void => {
     this.simulation = null; // stop stepping; the overlay explains
@@ -377,6 +391,11 @@ class Page {
   /** One model's policy, created once. */
   private policy(name: string): Promise<Policy> {
     let loading = this.policies.get(name);
+    if (!loading && siteReplaced()) {
+      // The server has a newer site now: its models are not this page's (a mix), so none is
+      // fetched; what this page has loaded dances on.
+      return Promise.reject(new DuetError('duet was updated', `A newer version of the site went up while this page was open, so "${name}" cannot be loaded for this one: reload the page.`));
+    }
     if (!loading) {
       const seed = (this.settings.seed + MODEL_NAMES.indexOf(name) * 0x9e3779b9) >>> 0;
       // The downloads run side by side, the sessions are made one after another: with two made at
@@ -654,13 +673,26 @@ class Page {
     this.loading.hide();
     const since = (epoch: number) => epoch - performance.timeOrigin;
     hook.workerFiles = this.fetcher.files.map((f) => ({ ...f, start: since(f.start), firstByte: since(f.firstByte), end: since(f.end) }));
-    // The worker's downloads are not in this page's resource timing: name them.
-    keepForOffline([this.fetcher.scriptUrl.href, ...this.fetcher.files.map((file) => file.url)]);
+    // The worker's downloads are not in this page's resource timing: name them. A new version's
+    // worker takes over with this message, now that onnxruntime has started (offline.ts).
+    keepForOffline(assetVersion(this.manifest), [this.fetcher.scriptUrl.href, ...this.fetcher.files.map((file) => file.url)]);
   }
 }
 
 async function start(): Promise<void> {
   checkBrowserSupport();
+  // Progress is a new boot stage (the fetcher worker's included) or more bytes downloaded.
+  const watchdog = new BootWatchdog(() => `${Object.keys(bootTimings).length} ${hook.download?.loaded ?? 0}`, stalled);
+  watchdog.start();
+  try {
+    await boot();
+  } finally {
+    watchdog.stop();
+  }
+  if (!restarting()) clearRestarts();
+}
+
+async function boot(): Promise<void> {
   // Start every download at once: the fetcher worker downloads onnxruntime's wasm (compiling it),
   // the manifest and the first dance's models by itself; onnxruntime's and the simulation's code
   // now; the floor is drawn meanwhile.
@@ -672,7 +704,16 @@ async function start(): Promise<void> {
     loading.update(loaded, total, sized);
   };
   const manifest = await bootSpan('manifest', () => loadManifest());
-  registerOffline(assetVersion(manifest));
+  hook.version = assetVersion(manifest);
+  hook.modelsVersion = modelsVersion(manifest);
+  hook.buildVersion = BUILD_MODELS;
+  if (BUILD_MODELS && hook.modelsVersion !== BUILD_MODELS) {
+    // This page is of one deployment and the manifest of another (the site changed between the
+    // two requests, or the page came from a cache): never dance that mix.
+    if (takeRestart()) return restart('The site was being updated as this page loaded: starting again.');
+    throw new DuetError('duet is being updated', `This page is from one version of the site and its models from another (page ${BUILD_MODELS}, models ${hook.modelsVersion}). Reload in a moment.`);
+  }
+  registerOffline(hook.version, siteUpdated);
   // Building the page is one long task, and a worker only gets going once this thread has taken
   // note of its start: let it start first (it usually has; at most WORKER_START_WAIT_MS of the
   // loading scene's time), or its downloads wait for the whole task.
@@ -683,4 +724,7 @@ async function start(): Promise<void> {
   await page.attach(modules, wasmModule);
 }
 
-start().catch(showError);
+start().catch((error) => {
+  clearRestarts();
+  showError(error);
+});
