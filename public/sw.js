@@ -12,8 +12,8 @@
 // A new version waits until the page of that version dances and says so ({type: 'keep',
 // activate: true}); only then does it take over and delete the old caches. Taking over at once
 // (skipWaiting on install) changed the worker under a page that was still starting onnxruntime:
-// its thread's script, asked for in that moment, never came, and the start hung for good in 6 of
-// 72 visits after a deploy (scripts/deploy_trials.mjs; docs/reliability.md). While the new one
+// its thread's script, asked for in that moment, never came, and the start hung for good in 4 of
+// 52 visits after a deploy (scripts/deploy_trials.mjs; docs/reliability.md). While the new one
 // waits, the old worker answers the new page's requests for models of another version from the
 // network (the x-duet-version header), and everything else by its hashed name or network first.
 
@@ -22,7 +22,6 @@ const CACHE = `duet-${VERSION}`;
 const VERSION_HEADER = 'x-duet-version';
 
 const immutable = (url) => /\.(onnx|wasm)$/.test(url.pathname) || /\/assets\/[^/]+-[\w-]{8,}\.\w+$/.test(url.pathname);
-
 
 self.addEventListener('activate', (event) => {
   event.waitUntil(
