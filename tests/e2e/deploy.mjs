@@ -27,7 +27,7 @@ async function buildInto(outDir, publicDir) {
 
 /**
  * Build A (the site as it is) and B (the same with another follower fingerprint in its manifest)
- * under `dir`; returns { a, b, url, deploy(name), up(), stop() } with a server on `current`.
+ * under `dir`; returns { url, deploy(name), up(), stop() } with a server on `current`.
  */
 export async function twoBuilds(dir) {
   rmSync(dir, { recursive: true, force: true });
@@ -54,7 +54,7 @@ export async function twoBuilds(dir) {
   };
   deploy('a');
   const server = await serve({ dir: current, base: '/duet/' });
-  return { a, b, url: server.url, deploy, up: () => up, stop: () => server.stop() };
+  return { url: server.url, deploy, up: () => up, stop: () => server.stop() };
 }
 
 /** Wait until this origin's service worker has stored the wasm and the first two models of `version`. */

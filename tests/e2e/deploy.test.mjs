@@ -59,13 +59,13 @@ test('every visit after a deploy dances the version that is up, on one thread or
 test('a tab left open across a deploy dances on and says to reload; another partner is refused', async () => {
   const { context } = browser;
   const old = browser.page;
-  const before = await old.evaluate(() => window.duet.version);
+  const oldVersion = await old.evaluate(() => window.duet.version);
   // The other build goes up, and a second tab visits it: its worker takes over both tabs.
   site.deploy(site.up() === 'a' ? 'b' : 'a');
   const fresh = await context.newPage();
   const result = await visit(fresh, `${site.url}?seed=7`);
   assert.equal(result.outcome, 'danced', JSON.stringify(result));
-  assert.notEqual(result.version, before, 'the second tab runs the new version');
+  assert.notEqual(result.version, oldVersion, 'the second tab runs the new version');
   await old.bringToFront(); // the visitor goes back to the tab left open
   await old.waitForFunction(() => [...document.querySelectorAll('.toast')].some((t) => t.textContent.includes('duet was updated')), null, { timeout: 15_000 });
   const frame = await old.evaluate(() => window.duet.frame);

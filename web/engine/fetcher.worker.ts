@@ -16,7 +16,7 @@ import { bootMark, bootSpan, onBootMark } from './boot';
 import { DownloadProgress } from './download';
 import { firstDanceModels } from './firstdance';
 import { fetchModelBytes, loadManifest } from './manifest';
-import { BUILD_MODELS, assetVersion, modelsVersion } from './offline';
+import { assetVersion, otherDeployment } from './offline';
 import { type FetchedFile, type FromWorker, type ToWorker, WORKER_NAME } from './protocol';
 import { DownloadSlots } from './slots';
 import { loadWasm } from './wasm';
@@ -67,9 +67,8 @@ function load(name: string): void {
   manifest
     .then((loaded) => {
       // The manifest came by its own request: of this build's deployment, or no models at all.
-      if (BUILD_MODELS && modelsVersion(loaded) !== BUILD_MODELS) {
-        throw new DuetError('duet is being updated', `The site changed while this page loaded (page ${BUILD_MODELS}, models ${modelsVersion(loaded)}): reload in a moment.`);
-      }
+      const other = otherDeployment(loaded);
+      if (other) throw new DuetError('duet is being updated', other);
       const entry = loaded.models[name];
       if (!entry) throw new DuetError('Model not found', `"${name}" is not in manifest.json`);
       progress.expect(name, entry.bytes, 'model');

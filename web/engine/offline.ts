@@ -21,6 +21,14 @@ export function modelsVersion(manifest: Manifest): string {
   return shortHash(JSON.stringify(manifest.models));
 }
 
+/** Why `manifest` is not of this build's deployment (the site changed between the page's request
+ *  and the manifest's), or null when it is, or when the build has no stamp. */
+export function otherDeployment(manifest: Manifest): string | null {
+  const models = modelsVersion(manifest);
+  if (!BUILD_MODELS || models === BUILD_MODELS) return null;
+  return `This page is from one version of the site and its models from another (page ${BUILD_MODELS}, models ${models}): reload in a moment.`;
+}
+
 /** The version of what the page downloads: the models and the wasm. */
 export function assetVersion(manifest: Manifest): string {
   return shortHash(JSON.stringify(manifest.models) + WASM_URL);

@@ -13,9 +13,9 @@ import { loadManifest } from '../engine/manifest';
 import { Fetcher } from '../engine/fetcher';
 import { FOLLOWER_MODELS } from '../engine/firstdance';
 import { standingViews } from '../engine/standing';
-import { BUILD_MODELS, assetVersion, keepForOffline, modelsVersion, registerOffline } from '../engine/offline';
+import { BUILD_MODELS, assetVersion, keepForOffline, modelsVersion, otherDeployment, registerOffline } from '../engine/offline';
 import { BootWatchdog, clearRestarts, restartsSoFar, takeRestart } from '../engine/watchdog';
-import { restart, restarting, siteReplaced, siteUpdated, stalled } from './updates';
+import { SiteUpdatedError, restart, restarting, siteReplaced, siteUpdated, stalled } from './updates';
 import { GLUE_URL } from '../engine/wasm';
 import { LoadingBar } from './loading';
 import { DEFAULT_ORBIT, Stage } from '../draw/scene';
@@ -280,7 +280,7 @@ class Page {
   /** A partner this page cannot load since a newer site went up (policy()): say so, and the
    *  partner already dancing dances on. Any other failure is fatal. */
   private readonly keepDancingIfUpdated = (error: unknown): void => {
-    if (!(siteReplaced() && error instanceof DuetError && this.simulation)) return this.fail(error);
+    if (!(error instanceof SiteUpdatedError && this.simulation)) return this.fail(error);
     showToast(error.title, error.detail, 'error', 15_000);
     this.settings.model = hook.model as FollowerChoice;
     this.panel.refresh();
@@ -394,7 +394,7 @@ class Page {
     if (!loading && siteReplaced()) {
       // The server has a newer site now: its models are not this page's (a mix), so none is
       // fetched; what this page has loaded dances on.
-      return Promise.reject(new DuetError('duet was updated', `A newer version of the site went up while this page was open, so "${name}" cannot be loaded for this one: reload the page.`));
+      return Promise.reject(new SiteUpdatedError(name));
     }
     if (!loading) {
       const seed = (this.settings.seed + MODEL_NAMES.indexOf(name) * 0x9e3779b9) >>> 0;
@@ -675,7 +675,7 @@ class Page {
     hook.workerFiles = this.fetcher.files.map((f) => ({ ...f, start: since(f.start), firstByte: since(f.firstByte), end: since(f.end) }));
     // The worker's downloads are not in this page's resource timing: name them. A new version's
     // worker takes over with this message, now that onnxruntime has started (offline.ts).
-    keepForOffline(assetVersion(this.manifest), [this.fetcher.scriptUrl.href, ...this.fetcher.files.map((file) => file.url)]);
+    keepForOffline(hook.version ?? assetVersion(this.manifest), [this.fetcher.scriptUrl.href, ...this.fetcher.files.map((file) => file.url)]);
   }
 }
 
@@ -707,11 +707,12 @@ async function boot(): Promise<void> {
   hook.version = assetVersion(manifest);
   hook.modelsVersion = modelsVersion(manifest);
   hook.buildVersion = BUILD_MODELS;
-  if (BUILD_MODELS && hook.modelsVersion !== BUILD_MODELS) {
+  const other = otherDeployment(manifest);
+  if (other) {
     // This page is of one deployment and the manifest of another (the site changed between the
     // two requests, or the page came from a cache): never dance that mix.
     if (takeRestart()) return restart('The site was being updated as this page loaded: starting again.');
-    throw new DuetError('duet is being updated', `This page is from one version of the site and its models from another (page ${BUILD_MODELS}, models ${hook.modelsVersion}). Reload in a moment.`);
+    throw new DuetError('duet is being updated', other);
   }
   registerOffline(hook.version, siteUpdated);
   // Building the page is one long task, and a worker only gets going once this thread has taken

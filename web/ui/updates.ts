@@ -16,6 +16,14 @@ export function siteReplaced(): boolean {
   return replaced;
 }
 
+/** A model this page never loaded, asked for after a newer site went up: the server's file is
+ *  another version's now, so it is not fetched (the partner already dancing dances on). */
+export class SiteUpdatedError extends DuetError {
+  constructor(model: string) {
+    super('duet was updated', `A newer version of the site went up while this page was open, so "${model}" cannot be loaded for this one: reload the page.`);
+  }
+}
+
 /** A newer site went up while this page was open: say so, once. */
 export function siteUpdated(): void {
   if (replaced) return;
