@@ -87,8 +87,12 @@ test('a tab left open across a deploy dances on and says to reload; another part
 test('a start that stands still restarts by itself and dances', async () => {
   const { page } = browser;
   // The wasm and the models never come on this visit (a link that stopped answering): no progress.
+  // Once the page says it starts again, requests go through: the held ones stay held (so the
+  // stalled page cannot finish in the moment before its reload), the reloaded page's are answered.
   let held = 0;
-  const hold = () => {
+  let holding = true;
+  const hold = (route) => {
+    if (!holding) return route.continue();
     held++;
     return new Promise(() => {}); // never answered
   };
@@ -101,9 +105,9 @@ test('a start that stands still restarts by itself and dances', async () => {
   await page.goto(`${site.url}?seed=3`);
   // The watchdog waits 20 s without progress, then reloads; the second start is let through.
   await page.waitForEvent('console', { predicate: (m) => m.text().includes('starting again'), timeout: 40_000 });
-  await browser.context.unroute('**/*.onnx', hold);
-  await browser.context.unroute('**/*.wasm', hold);
-  await page.waitForFunction(() => window.duet?.ready || window.duet?.error, null, { timeout: 60_000, polling: 100 });
+  holding = false;
+  // The restarted page (it counts its restart) dances, or says why not.
+  await page.waitForFunction(() => window.duet?.recovered > 0 && (window.duet.ready || window.duet.error), null, { timeout: 60_000, polling: 100 });
   const state = await page.evaluate(() => ({ error: window.duet.error, recovered: window.duet.recovered }));
   assert.ok(held >= 1, 'the first start was held');
   assert.equal(state.error, null);
@@ -111,4 +115,6 @@ test('a start that stands still restarts by itself and dances', async () => {
   assert.ok(Date.now() - started < 60_000);
   await waitReady(page, 5000);
   assert.equal(await page.evaluate(() => sessionStorage.getItem('duet:restarts')), null, 'the count is cleared once it dances');
+  await browser.context.unroute('**/*.onnx', hold);
+  await browser.context.unroute('**/*.wasm', hold);
 });
