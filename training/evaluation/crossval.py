@@ -54,6 +54,8 @@ METHODS = {
     "ccm_steady": ("follower_ccm_steady", "follower_ccm", False),
     "ours_turns": ("follower_turns", "follower_turns", False),
     "ccm_turns": ("follower_ccm_turns", "follower_ccm_turns", False),
+    # The shipped recipe whose intention also forecasts the turn the leader leads (turn_keys).
+    "ours_led_turn": ("follower_led_turn", "follower_led_turn", False),
 }
 # implausible / worst second: the free-running follower's frames with its body low, folded or split,
 # against the fold's own training range (evaluate's plausibility; n/a for evaluations without it).
@@ -245,7 +247,8 @@ def report(out: Path, plan: dict, seconds: float, name: str = "crossval") -> dic
     comparisons = {}
     pairs = [(a, b) for a, b in (("ours", "ccm"), ("ours_tempo", "ours"), ("ccm_tempo", "ccm"), ("ours_tempo", "ccm_tempo"),
                                  ("ours_steady", "ccm_steady"), ("ours_steady", "ours"), ("ccm_steady", "ccm"),
-                                 ("ours_turns", "ccm_turns"), ("ours_turns", "ours_steady"), ("ccm_turns", "ccm_steady"))
+                                 ("ours_turns", "ccm_turns"), ("ours_turns", "ours_steady"), ("ccm_turns", "ccm_steady"),
+                                 ("ours_led_turn", "ccm_steady"), ("ours_led_turn", "ours_steady"))
              if a in methods and b in methods]
     for a, b in pairs:
         comparisons[f"{a} - {b}"] = {k: paired(values[a], values[b], fold_ids, seeds, k) for k in METRICS}

@@ -66,9 +66,10 @@ class Run:
     steps: int      # steps left
 
 
-def inputs_at(run: Run, role: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def inputs_at(run: Run, role: str, led_turn: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(input, recorded output, intention target) of a rollout at its frame: the input from its own
-    track beside the recorded partner; the targets the recording's."""
+    track beside the recorded partner; the targets the recording's (with `led_turn`, the
+    intention target is followed by the recorded turn he leads, prepared.load_split)."""
     c, t, now = run.couple, run.t, np.array([NOW])
     if role == "follower":
         partner, recorded = window(c.leader, t), c.follower
@@ -79,12 +80,15 @@ def inputs_at(run: Run, role: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         x = feat.leader_input(partner, run.me.track, now, feat.figure_block(c.partner_turn[t][None], 1))[0]
     y = feat.output_features(recorded, np.array([t]))[0]
     j = feat.intention_target(partner, run.me.track, now)[0]
+    if led_turn:
+        j = np.concatenate([j, c.partner_turn[t]])
     return x, y, j
 
 
 @torch.no_grad()
 def own_rollout_samples(step, couples: list[Couple], offsets: np.ndarray, role: str, every: int,
-                        horizon: int, temperatures: tuple[float, ...], gen: torch.Generator) -> dict[str, np.ndarray]:
+                        horizon: int, temperatures: tuple[float, ...], gen: torch.Generator,
+                        led_turn: bool = False) -> dict[str, np.ndarray]:
     """Roll `step` (a StepModel on raw features) out for `horizon` frames from every `every`-th
     frame of each couple, all rollouts as one batch per step, at temperatures taken in turn. The
     first frame of each is the recording itself and is skipped; a rollout that produces absurd
@@ -102,7 +106,7 @@ def own_rollout_samples(step, couples: list[Couple], offsets: np.ndarray, role: 
         live = [i for i, r in enumerate(runs) if r.steps > 0]
         if not live:
             break
-        batch = [inputs_at(runs[i], role) for i in live]
+        batch = [inputs_at(runs[i], role, led_turn) for i in live]
         x = np.stack([b[0] for b in batch])
         if k > 0:
             xs.append(x); ys.append(np.stack([b[1] for b in batch])); js.append(np.stack([b[2] for b in batch]))
@@ -125,6 +129,6 @@ def own_rollout_samples(step, couples: list[Couple], offsets: np.ndarray, role: 
     if not xs:
         size = feat.INPUT_SIZES[role]
         return {"input": np.zeros((0, size), np.float32), "output": np.zeros((0, feat.OUTPUT_SIZE), np.float32),
-                "intention": np.zeros((0, feat.INTENTION_SIZE), np.float32), "mirror": np.zeros(0, bool)}
+                "intention": np.zeros((0, feat.INTENTION_SIZE + (feat.KEYS if led_turn else 0)), np.float32), "mirror": np.zeros(0, bool)}
     return {"input": np.concatenate(xs).astype(np.float32), "output": np.concatenate(ys).astype(np.float32),
             "intention": np.concatenate(js).astype(np.float32), "mirror": np.concatenate(ms)}
