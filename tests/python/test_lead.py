@@ -93,7 +93,10 @@ def test_lead_runs_on_freshly_exported_models(exported, data3, tmp_path, capsys)
     assert rc == 0
     res = json.loads((out / "lead.json").read_text())
     assert res["summary"]["requests"] == 2                          # one at 3 s in each 9 s duet
-    assert "Requests" in capsys.readouterr().out
+    # The lead detector read both branches of every request (fitted on the 3 takes of data3).
+    assert all(isinstance(r[k], bool) for s in res["per_seed"] for r in s["requests"]
+               for k in ("lead_seen", "lead_seen_unasked"))
+    assert "Does he lead?" in capsys.readouterr().out
 
 
 def test_lead_names_missing_models(tmp_path, capsys):

@@ -29,32 +29,51 @@ from tqdm import tqdm
 
 from ..data.dataset import DataError, TEST_TAKES
 from ..data.folders import add_folder
+from ..mirror import features as feat
 from ..mirror.rollout import NOW, REQUEST_SECONDS, ask_turn, start_duet, step
 from ..mirror.skeleton import FPS
 from . import figures as Fg
+from . import turn_cues as C
 from . import options as O
 from .evaluate_inputs import EvalError, find_models, load_eval_takes, load_onnx
 
+# The lead detector (turn_cues) says a turn will complete this long after what it reads: he has
+# led it by then (a linear reader of the recorded leader finds 57 % of her turns at 0.5 s).
+LEGIBILITY_LEAD = 0.5
 REQUEST_EVERY = 6.0      # s between requests in one duet (a turn and the time to settle after it)
 WARM_UP = 3.0            # s of dancing before the first request
 
 
 def branch(duet, leader, follower, temperature: float, rng: np.random.Generator, direction: int | None,
-           frames: int) -> np.ndarray:
+           frames: int) -> tuple[np.ndarray, np.ndarray]:
     """Dance a copy of the duet `frames` steps on (asked for a turn in `direction` first, or not):
-    the follower's world positions [frames + 1, 17, 3], the request's frame first."""
+    the follower's world positions [frames + 1, 17, 3], the request's frame first, and what she
+    reads of him at each of those frames (her input [frames + 1, 660], his plan as his future)."""
     d = copy.deepcopy(duet)
     if direction is not None:
         ask_turn(d, direction)
-    out = np.zeros((frames + 1, 17, 3))
-    out[0] = d.follower.track.positions[NOW]
+    out, reads = np.zeros((frames + 1, 17, 3)), np.zeros((frames + 1, feat.INPUT_SIZE))
+    now = np.array([NOW])
+    out[0], reads[0] = d.follower.track.positions[NOW], feat.follower_input(d.leader.track, d.follower.track, now)[0]
     for f in range(frames):
         step(d, leader, follower, np.zeros(2), temperature, rng)
         out[f + 1] = d.follower.track.positions[NOW]
-    return out
+        reads[f + 1] = feat.follower_input(d.leader.track, d.follower.track, now)[0]
+    return out, reads
 
 
-def one_duet(manifest, leader, follower, temperature: float, seed: int, seconds: float) -> dict:
+def lead_seen(detector: C.Detector | None, reads: np.ndarray, direction: int) -> bool | None:
+    """Does a detector of the recorded leads (turn_cues, reading only the leader) see him lead a
+    turn of `direction` in these frames? Tells a leader who does not lead from a follower who
+    does not follow."""
+    if detector is None:
+        return None
+    s = {"frames": np.arange(len(reads)), "input": reads}
+    return any(d == direction for _, d in detector.turns(s))
+
+
+def one_duet(manifest, leader, follower, temperature: float, seed: int, seconds: float,
+             detector: C.Detector | None = None) -> dict:
     rng = np.random.default_rng(seed)
     duet = start_duet(manifest)
     frames = int(seconds * FPS)
@@ -66,14 +85,18 @@ def one_duet(manifest, leader, follower, temperature: float, seed: int, seconds:
         if f in ask_at:
             direction = int(rng.choice([-1, 1]))
             state = rng.bit_generator.state
-            asked = branch(duet, leader, follower, temperature, np.random.default_rng(seed * 1000 + f), direction, window)
-            unasked = branch(duet, leader, follower, temperature, np.random.default_rng(seed * 1000 + f), None, window)
+            asked, reads_asked = branch(duet, leader, follower, temperature, np.random.default_rng(seed * 1000 + f),
+                                        direction, window)
+            unasked, reads_unasked = branch(duet, leader, follower, temperature,
+                                            np.random.default_rng(seed * 1000 + f), None, window)
             rng.bit_generator.state = state
             turns_asked, turns_unasked = Fg.turns(Fg.facing(asked)), Fg.turns(Fg.facing(unasked))
             requests.append({"frame": f, "direction": direction,
                              "turned": bool(turns_asked), "turned_that_way": any(d == direction for _, d in turns_asked),
                              "seconds": turns_asked[0][0] / FPS if turns_asked else None,
-                             "turned_unasked": bool(turns_unasked)})
+                             "turned_unasked": bool(turns_unasked),
+                             "lead_seen": lead_seen(detector, reads_asked, direction),
+                             "lead_seen_unasked": lead_seen(detector, reads_unasked, direction)})
         step(duet, leader, follower, np.zeros(2), temperature, rng)
         lead[f], follow[f] = duet.leader.track.positions[NOW], duet.follower.track.positions[NOW]
     strip = lambda d: {k: v for k, v in d.items() if not isinstance(v, list)}
@@ -89,6 +112,8 @@ def summary(per_seed: list[dict], ref: dict) -> dict:
            "turned_unasked": share("turned_unasked"),
            "median_seconds": float(np.median([r["seconds"] for r in req if r["seconds"] is not None]))
            if any(r["turned"] for r in req) else None}
+    if n and req[0]["lead_seen"] is not None:
+        out["lead_seen"], out["lead_seen_unasked"] = share("lead_seen"), share("lead_seen_unasked")
     for who in ("leader", "follower"):
         items = [s[who] for s in per_seed]
         worst = min(range(len(items)), key=lambda i: items[i]["turns_per_min"])
@@ -122,6 +147,10 @@ def write_markdown(path: Path, res: dict) -> None:
          f"| the same moments, unasked | {100 * s['turned_unasked']:.0f} % |",
          f"| ratio asked / unasked | {s['turned'] / s['turned_unasked']:.1f}× |" if s["turned_unasked"] else
          "| ratio asked / unasked | – (no turn unasked) |", "",
+         *([f"Does he lead? A detector of the recorded leads (training.evaluation.turn_cues: reads only the "
+            f"leader, as she does; a turn completing {LEGIBILITY_LEAD:g} s later) sees him lead the asked "
+            f"way in {100 * s['lead_seen']:.0f} % of the requests and in {100 * s['lead_seen_unasked']:.0f} % "
+            f"of the same moments unasked.", ""] if "lead_seen" in s else []),
          f"Median time from the request to the turn's 300 degrees: {s['median_seconds']:.2f} s. "
          f"Seed whose requests worked least often: {s['worst_request_seed']}." if s["median_seconds"] is not None else
          "No request was followed by a turn.", "",
@@ -153,10 +182,15 @@ def run(args) -> dict:
     follower = O.follower_policy(load_onnx(onnx[args.method]), manifest, args, args.temperature)
     takes = [t for t in args.takes.split(",") if t]
     ref = recording(args.data, takes)
+    detector = None
+    if args.legibility:
+        cues = C.load(args.data)
+        detector = C.fit_detector(cues, sorted(cues), "leader", int(round(LEGIBILITY_LEAD * FPS)),
+                                  argparse.Namespace(classifier="logistic", c=0.01))
     per_seed = []
     for seed in tqdm(range(args.first_seed, args.first_seed + args.seeds), desc="duets", unit="duet",
                      file=sys.stderr, disable=args.quiet):
-        per_seed.append(one_duet(manifest, leader, follower, args.temperature, seed, args.seconds))
+        per_seed.append(one_duet(manifest, leader, follower, args.temperature, seed, args.seconds, detector))
     return {"takes": takes, "recording": ref, "per_seed": per_seed, "summary": summary(per_seed, ref),
             "config": {"models": str(args.models), "method": args.method, "seeds": args.seeds,
                        "seconds": args.seconds, "temperature": args.temperature,
@@ -174,6 +208,8 @@ def main(argv=None) -> int:
     ap.add_argument("--seeds", type=int, default=100)
     ap.add_argument("--first-seed", type=int, default=0)
     ap.add_argument("--seconds", type=float, default=30.0, help="per duet (a request every 6 s after 3 s)")
+    ap.add_argument("--no-legibility", dest="legibility", action="store_false",
+                    help="skip the lead detector (fitted on every take of --data, about 30 s)")
     O.add_options(ap)
     ap.add_argument("--out", default="runs/lead")
     ap.add_argument("--quiet", action="store_true")

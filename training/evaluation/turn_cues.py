@@ -16,7 +16,8 @@ What the detector reads (feature sets, columns of the follower's input, docs/fea
 - leader+own:        plus her own recorded past (a turn already started shows there);
 - hand:              one number, the leader's higher hand's height (the lead a dancer names).
 
-Each fold fits a logistic regression (3 classes: left, none, right; standardized features) on
+Each fold fits a logistic regression (or, with --classifier mlp, a network of two hidden layers;
+3 classes: left, none, right; standardized features) on
 the training takes (4 phase offsets, mirrored too). A detection is a local maximum of a
 direction's probability over +-MATCH_SECONDS above a threshold; the threshold is set on the
 training takes so that the detector finds as many turns as were recorded there. "chance" is the
@@ -31,10 +32,12 @@ import argparse
 import json
 import sys
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 from sklearn.linear_model import LogisticRegression
+from sklearn.neural_network import MLPClassifier
 from tqdm import tqdm
 
 from ..data.dataset import DataError, discover_takes, load_pair, pair_tracks, phases
@@ -134,8 +137,46 @@ def load(data: str) -> dict[str, list[dict]]:
     return out
 
 
+def classifier(args):
+    """A linear detector, or a small network (two hidden layers) to see what a non-linear one adds."""
+    if args.classifier == "mlp":
+        return MLPClassifier((128, 64), alpha=args.alpha, early_stopping=True, max_iter=60, random_state=0)
+    return LogisticRegression(C=args.c, max_iter=300)
+
+
 def folds(names: list[str], k: int) -> list[list[str]]:
     return [list(a) for a in np.array_split(np.array(names), k)]
+
+
+@dataclass
+class Detector:
+    """A fitted detector: the follower's input (and the leader's recorded next second, for
+    leader+intention) at frames t -> [N, 3] probabilities of no turn / a left / a right turn
+    completing `lead` frames later; `threshold` finds as many turns as its training takes had."""
+    features: str
+    lead: int
+    model: object
+    mean: np.ndarray
+    std: np.ndarray
+    threshold: float = 0.5
+
+    def probabilities(self, s: dict) -> np.ndarray:
+        return self.model.predict_proba((design(s, self.features) - self.mean) / self.std)
+
+    def turns(self, s: dict) -> list[tuple[int, int]]:
+        return detections(self.probabilities(s), s["frames"], self.lead, self.threshold)
+
+
+def fit_detector(data: dict[str, list[dict]], takes: list[str], features: str, lead: int, args) -> Detector:
+    """Fit on every copy of `takes`; the threshold on their as-recorded copies (phase 0)."""
+    xs = np.concatenate([design(s, features) for t in takes for s in data[t]])
+    ys = np.concatenate([labels(s, lead) for t in takes for s in data[t]])
+    mu, sd = xs.mean(0), xs.std(0) + 1e-6
+    det = Detector(features, lead, classifier(args).fit((xs - mu) / sd, ys), mu, sd)
+    base = [data[t][0] for t in takes]
+    det.threshold = threshold_for([det.probabilities(s) for s in base], [s["frames"] for s in base], lead,
+                                  sum(len(s["turns"]) for s in base))
+    return det
 
 
 def run(args) -> dict:
@@ -152,22 +193,13 @@ def run(args) -> dict:
     jobs = [(name, lead) for name in sets for lead in leads]
     for name, lead in tqdm(jobs, desc="feature sets x leads"):
         m = f_ = r = 0
-        cm = []
-        per_fold = []
+        cm, per_fold = [], []
         for test in folds(names, args.folds):
-            train = [t for t in names if t not in test]
-            xs = np.concatenate([design(s, name) for t in train for s in data[t]])
-            ys = np.concatenate([labels(s, lead) for t in train for s in data[t]])
-            mu, sd = xs.mean(0), xs.std(0) + 1e-6
-            clf = LogisticRegression(C=args.c, max_iter=300).fit((xs - mu) / sd, ys)
-            # The threshold: as many turns as recorded on the training takes (phase 0, as recorded).
-            base = [data[t][0] for t in train]
-            ps = [clf.predict_proba((design(s, name) - mu) / sd) for s in base]
-            th = threshold_for(ps, [s["frames"] for s in base], lead, sum(len(s["turns"]) for s in base))
+            det = fit_detector(data, [t for t in names if t not in test], name, lead, args)
             fm = ff = fr = 0
             for t in test:
                 s = data[t][0]
-                found = detections(clf.predict_proba((design(s, name) - mu) / sd), s["frames"], lead, th)
+                found = det.turns(s)
                 a, b, c = score(found, s["turns"])
                 fm, ff, fr = fm + a, ff + b, fr + c
                 cm.append(chance(found, s["turns"], int(s["frames"][-1]) + 1, rng)[0])
@@ -181,7 +213,8 @@ def run(args) -> dict:
         tqdm.write(f"{name:17s} lead {lead / FPS:.2f} s: recall {row['recall']:.0%} precision "
                    f"{row['precision']:.0%} ({m} of {r} recorded, {f_} found; chance {row['chance_recall']:.0%} "
                    f"/ {row['chance_precision']:.0%})")
-    return {"results": results, "takes": names, "folds": args.folds, "seconds": time.time() - t0}
+    return {"results": results, "takes": names, "folds": args.folds, "classifier": args.classifier,
+            "seconds": time.time() - t0}
 
 
 def markdown(rep: dict) -> str:
@@ -201,6 +234,8 @@ def main(argv=None) -> int:
     ap.add_argument("--features", default=",".join(FEATURE_SETS), help=f"of {', '.join(FEATURE_SETS)}")
     ap.add_argument("--folds", type=int, default=6)
     ap.add_argument("--c", type=float, default=0.01, help="inverse L2 strength of the logistic regression")
+    ap.add_argument("--classifier", choices=("logistic", "mlp"), default="logistic")
+    ap.add_argument("--alpha", type=float, default=1e-2, help="L2 strength of the mlp")
     ap.add_argument("--out", default="runs/turn_cues", help="writes OUT/turn_cues.json and .md")
     args = ap.parse_args(argv)
     try:
