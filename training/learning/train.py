@@ -239,6 +239,12 @@ MODELS = {
     # more often, with the samples where she starts a turn weighed 4x: a request works no better.
     "leader_state_dropout": replace(steady(LEADER_STOP_MOTION), figure_dropout=0.5, state_dropout=0.5),
     "leader_lead": replace(steady(LEADER_STOP_MOTION), figure_dropout=0.3, state_dropout=0.5, turn_weight=4.0),
+    # The shipped leader with the samples where he leads her turn (figure shown, her turn ahead)
+    # weighed 4x and 8x, the first also with the figure shown more often.
+    "leader_lead_own": replace(steady(LEADER_STOP_MOTION), figure_dropout=0.3, state_dropout=0.5, own_rollouts_from=10,
+                               turn_weight=4.0, seed=2),
+    "leader_lead_own_8": replace(steady(LEADER_STOP_MOTION), figure_dropout=0.5, state_dropout=0.5, own_rollouts_from=10,
+                                 turn_weight=8.0, seed=2),
     # The dancing leader on rollouts of 30 frames: steered, 5 of 20 seeds with a bad second (11 with the layer).
     "leader_own_30": replace(steady(LEADER_STOP_MOTION), figure_dropout=0.5, state_dropout=0.5, own_rollouts_from=10,
                              own_rollouts_horizon=30, own_rollouts_stride=10, seed=2),
