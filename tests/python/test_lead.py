@@ -68,6 +68,23 @@ def test_training_hides_the_figure_in_a_share_of_samples():
     assert torch.equal(hidden[:, :fig.start], x[:, :fig.start])   # nothing else is touched
 
 
+def test_the_partner_is_hidden_only_where_the_figure_is_shown():
+    sl = feat.block_slices(feat.LEADER_INPUT_LAYOUT)
+    x = torch.randn(4000, feat.LEADER_INPUT_SIZE)
+    x[:2000, sl["figure"].start] = 1.0      # figure shown
+    x[2000:, sl["figure"]] = 0.0            # nobody asks
+    mean = torch.full((feat.LEADER_INPUT_SIZE,), 7.0)
+    out = T.hide_partner_when_figure(x, 0.5, mean, torch.Generator().manual_seed(0))
+    partner = torch.cat([torch.arange(feat.LEADER_INPUT_SIZE)[sl[b]] for b in
+                         ("partner_trajectory_past", "partner_key_joints_past", "partner_pose")])
+    hidden = (out[:, partner] == 7.0).all(1)
+    assert 0.45 < hidden[:2000].float().mean().item() < 0.55
+    assert not hidden[2000:].any()
+    rest = torch.ones(feat.LEADER_INPUT_SIZE, dtype=torch.bool)
+    rest[partner] = False
+    assert torch.equal(out[:, rest], x[:, rest])       # his own blocks, control and figure untouched
+
+
 def test_turn_onsets_need_a_turn_ahead_and_none_behind():
     si, so = feat.block_slices(feat.FOLLOWER_INPUT_LAYOUT), feat.block_slices(feat.OUTPUT_LAYOUT)
 

@@ -37,8 +37,9 @@ from . import turn_cues as C
 from . import options as O
 from .evaluate_inputs import EvalError, find_models, load_eval_takes, load_onnx
 
-# The lead detector (turn_cues) says a turn will complete this long after what it reads: he has
-# led it by then (a linear reader of the recorded leader finds 57 % of her turns at 0.5 s).
+# The lead detector (turn_cues, his body alone) says a turn will complete this long after what it
+# reads: he leads it by then (it finds 52 % of the recorded turns at 0.5 s, chance 18 %; 1.5 s
+# ahead, before her turn has begun, 25 %: the recorded lead comes with her turn).
 LEGIBILITY_LEAD = 0.5
 REQUEST_EVERY = 6.0      # s between requests in one duet (a turn and the time to settle after it)
 WARM_UP = 3.0            # s of dancing before the first request
@@ -47,28 +48,29 @@ WARM_UP = 3.0            # s of dancing before the first request
 def branch(duet, leader, follower, temperature: float, rng: np.random.Generator, direction: int | None,
            frames: int) -> tuple[np.ndarray, np.ndarray]:
     """Dance a copy of the duet `frames` steps on (asked for a turn in `direction` first, or not):
-    the follower's world positions [frames + 1, 17, 3], the request's frame first, and what she
-    reads of him at each of those frames (her input [frames + 1, 660], his plan as his future)."""
+    the follower's world positions [frames + 1, 17, 3], the request's frame first, and his body at
+    each of those frames (turn_cues' leader_body: his past, pose and plan in his own root space)."""
     d = copy.deepcopy(duet)
     if direction is not None:
         ask_turn(d, direction)
-    out, reads = np.zeros((frames + 1, 17, 3)), np.zeros((frames + 1, feat.INPUT_SIZE))
+    out, body = np.zeros((frames + 1, 17, 3)), []
     now = np.array([NOW])
-    out[0], reads[0] = d.follower.track.positions[NOW], feat.follower_input(d.leader.track, d.follower.track, now)[0]
+    out[0] = d.follower.track.positions[NOW]
+    body.append(C.leader_body(d.follower.track, d.leader.track, now)[0])
     for f in range(frames):
         step(d, leader, follower, np.zeros(2), temperature, rng)
         out[f + 1] = d.follower.track.positions[NOW]
-        reads[f + 1] = feat.follower_input(d.leader.track, d.follower.track, now)[0]
-    return out, reads
+        body.append(C.leader_body(d.follower.track, d.leader.track, now)[0])
+    return out, np.stack(body)
 
 
-def lead_seen(detector: C.Detector | None, reads: np.ndarray, direction: int) -> bool | None:
-    """Does a detector of the recorded leads (turn_cues, reading only the leader) see him lead a
+def lead_seen(detector: C.Detector | None, body: np.ndarray, direction: int) -> bool | None:
+    """Does a detector of the recorded leads (turn_cues, reading only his body) see him lead a
     turn of `direction` in these frames? Tells a leader who does not lead from a follower who
     does not follow."""
     if detector is None:
         return None
-    s = {"frames": np.arange(len(reads)), "input": reads}
+    s = {"frames": np.arange(len(body)), "body": body}
     return any(d == direction for _, d in detector.turns(s))
 
 
@@ -147,8 +149,8 @@ def write_markdown(path: Path, res: dict) -> None:
          f"| the same moments, unasked | {100 * s['turned_unasked']:.0f} % |",
          f"| ratio asked / unasked | {s['turned'] / s['turned_unasked']:.1f}× |" if s["turned_unasked"] else
          "| ratio asked / unasked | – (no turn unasked) |", "",
-         *([f"Does he lead? A detector of the recorded leads (training.evaluation.turn_cues: reads only the "
-            f"leader, as she does; a turn completing {LEGIBILITY_LEAD:g} s later) sees him lead the asked "
+         *([f"Does he lead? A detector of the recorded leads (training.evaluation.turn_cues, leader_body: his "
+            f"own body and plan, not where she is; a turn completing {LEGIBILITY_LEAD:g} s later) sees him lead the asked "
             f"way in {100 * s['lead_seen']:.0f} % of the requests and in {100 * s['lead_seen_unasked']:.0f} % "
             f"of the same moments unasked.", ""] if "lead_seen" in s else []),
          f"Median time from the request to the turn's 300 degrees: {s['median_seconds']:.2f} s. "
@@ -185,7 +187,7 @@ def run(args) -> dict:
     detector = None
     if args.legibility:
         cues = C.load(args.data)
-        detector = C.fit_detector(cues, sorted(cues), "leader", int(round(LEGIBILITY_LEAD * FPS)),
+        detector = C.fit_detector(cues, sorted(cues), "leader_body", int(round(LEGIBILITY_LEAD * FPS)),
                                   argparse.Namespace(classifier="logistic", c=0.01))
     per_seed = []
     for seed in tqdm(range(args.first_seed, args.first_seed + args.seeds), desc="duets", unit="duet",

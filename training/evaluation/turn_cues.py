@@ -14,6 +14,9 @@ What the detector reads (feature sets, columns of the follower's input, docs/fea
 - leader+intention:  plus the leader's recorded key joints over the next second: a perfect
                      intention predictor (the paper's intention, given exactly);
 - leader+own:        plus her own recorded past (a turn already started shows there);
+- leader_body:       his own past, pose and planned path in his own root space: what his body
+                     does, without where she is (her input holds him in her root space, which
+                     turns with her, so "leader" also sees a turn she has already begun);
 - hand:              one number, the leader's higher hand's height (the lead a dancer names).
 
 Each fold fits a logistic regression (or, with --classifier mlp, a network of two hidden layers;
@@ -48,7 +51,7 @@ from . import figures as F
 
 TOLERANCE = 3          # frames: a sample's label is a turn completing within this of t + LEAD
 HANDS = [JOINT_NAMES.index("lHand"), JOINT_NAMES.index("rHand")]
-FEATURE_SETS = ("hand", "leader", "leader+intention", "leader+own")
+FEATURE_SETS = ("hand", "leader", "leader_body", "leader+intention", "leader+own")
 
 
 def columns(name: str) -> slice | None:
@@ -56,7 +59,7 @@ def columns(name: str) -> slice | None:
     blocks = feat.block_slices(feat.FOLLOWER_INPUT_LAYOUT)
     leader_end = blocks["partner_pose"].stop
     return {"leader": slice(0, leader_end), "leader+intention": slice(0, leader_end),
-            "leader+own": slice(0, None), "hand": None}[name]
+            "leader+own": slice(0, None), "hand": None, "leader_body": None}[name]
 
 
 def take_samples(lead, follow) -> dict:
@@ -65,8 +68,18 @@ def take_samples(lead, follow) -> dict:
     x = feat.follower_input(lead, follow, frames)
     # The leader's higher hand's height (world y), the one cue a dancer would name.
     hand = lead.positions[frames][:, HANDS, 1].max(-1, keepdims=True)
+    # His own body and path in his own root space (his past, pose and planned path): what he does,
+    # without where she stands or faces. Her input holds him in her root space, which turns with
+    # her: read there, a turn she has already begun shows in every block of his.
+    body = leader_body(follow, lead, frames)
     return {"frames": frames, "input": x, "intention": feat.intention_target(lead, follow, frames),
-            "hand": hand, "turns": F.turns(F.facing(follow.positions))}
+            "hand": hand, "body": body, "turns": F.turns(F.facing(follow.positions))}
+
+
+def leader_body(follow, lead, frames: np.ndarray) -> np.ndarray:
+    """[N, 342] the leader's own past path, key joints, pose and planned path, in his root space."""
+    ls = feat.block_slices(feat.LEADER_INPUT_LAYOUT)
+    return feat.leader_input(follow, lead, frames)[:, ls["self_trajectory_past"].start:ls["control"].stop]
 
 
 def labels(s: dict, lead: int) -> np.ndarray:
@@ -79,8 +92,8 @@ def labels(s: dict, lead: int) -> np.ndarray:
 
 
 def design(s: dict, name: str) -> np.ndarray:
-    if name == "hand":
-        return s["hand"]
+    if name in ("hand", "leader_body"):
+        return s["hand" if name == "hand" else "body"]
     x = s["input"][:, columns(name)]
     return np.concatenate([x, s["intention"]], -1) if name == "leader+intention" else x
 
