@@ -29,7 +29,6 @@ from tqdm import tqdm
 
 from ..data.dataset import DataError, TEST_TAKES
 from ..data.folders import add_folder
-from ..mirror import features as feat
 from ..mirror.rollout import NOW, REQUEST_SECONDS, ask_turn, start_duet, step
 from ..mirror.skeleton import FPS
 from . import figures as Fg
@@ -46,25 +45,27 @@ WARM_UP = 3.0            # s of dancing before the first request
 
 
 def branch(duet, leader, follower, temperature: float, rng: np.random.Generator, direction: int | None,
-           frames: int) -> tuple[np.ndarray, np.ndarray]:
+           frames: int, with_body: bool = False) -> tuple[np.ndarray, np.ndarray | None]:
     """Dance a copy of the duet `frames` steps on (asked for a turn in `direction` first, or not):
-    the follower's world positions [frames + 1, 17, 3], the request's frame first, and his body at
-    each of those frames (turn_cues' leader_body: his past, pose and plan in his own root space)."""
+    the follower's world positions [frames + 1, 17, 3], the request's frame first, and (with_body)
+    his body at each of those frames (turn_cues.leader_body: his past, pose and plan in his own
+    root space; None without)."""
     d = copy.deepcopy(duet)
     if direction is not None:
         ask_turn(d, direction)
-    out, body = np.zeros((frames + 1, 17, 3)), []
+    out = np.zeros((frames + 1, 17, 3))
+    body = np.zeros((frames + 1, C.LEADER_BODY_SIZE)) if with_body else None
     now = np.array([NOW])
-    out[0] = d.follower.track.positions[NOW]
-    body.append(C.leader_body(d.follower.track, d.leader.track, now)[0])
-    for f in range(frames):
-        step(d, leader, follower, np.zeros(2), temperature, rng)
-        out[f + 1] = d.follower.track.positions[NOW]
-        body.append(C.leader_body(d.follower.track, d.leader.track, now)[0])
-    return out, np.stack(body)
+    for f in range(frames + 1):
+        if f > 0:
+            step(d, leader, follower, np.zeros(2), temperature, rng)
+        out[f] = d.follower.track.positions[NOW]
+        if with_body:
+            body[f] = C.leader_body(d.follower.track, d.leader.track, now)[0]
+    return out, body
 
 
-def lead_seen(detector: C.Detector | None, body: np.ndarray, direction: int) -> bool | None:
+def lead_seen(detector: C.Detector | None, body: np.ndarray | None, direction: int) -> bool | None:
     """Does a detector of the recorded leads (turn_cues, reading only his body) see him lead a
     turn of `direction` in these frames? Tells a leader who does not lead from a follower who
     does not follow."""
@@ -87,18 +88,18 @@ def one_duet(manifest, leader, follower, temperature: float, seed: int, seconds:
         if f in ask_at:
             direction = int(rng.choice([-1, 1]))
             state = rng.bit_generator.state
-            asked, reads_asked = branch(duet, leader, follower, temperature, np.random.default_rng(seed * 1000 + f),
-                                        direction, window)
-            unasked, reads_unasked = branch(duet, leader, follower, temperature,
-                                            np.random.default_rng(seed * 1000 + f), None, window)
+            asked, body_asked = branch(duet, leader, follower, temperature, np.random.default_rng(seed * 1000 + f),
+                                       direction, window, detector is not None)
+            unasked, body_unasked = branch(duet, leader, follower, temperature,
+                                           np.random.default_rng(seed * 1000 + f), None, window, detector is not None)
             rng.bit_generator.state = state
             turns_asked, turns_unasked = Fg.turns(Fg.facing(asked)), Fg.turns(Fg.facing(unasked))
             requests.append({"frame": f, "direction": direction,
                              "turned": bool(turns_asked), "turned_that_way": any(d == direction for _, d in turns_asked),
                              "seconds": turns_asked[0][0] / FPS if turns_asked else None,
                              "turned_unasked": bool(turns_unasked),
-                             "lead_seen": lead_seen(detector, reads_asked, direction),
-                             "lead_seen_unasked": lead_seen(detector, reads_unasked, direction)})
+                             "lead_seen": lead_seen(detector, body_asked, direction),
+                             "lead_seen_unasked": lead_seen(detector, body_unasked, direction)})
         step(duet, leader, follower, np.zeros(2), temperature, rng)
         lead[f], follow[f] = duet.leader.track.positions[NOW], duet.follower.track.positions[NOW]
     strip = lambda d: {k: v for k, v in d.items() if not isinstance(v, list)}
@@ -211,7 +212,7 @@ def main(argv=None) -> int:
     ap.add_argument("--first-seed", type=int, default=0)
     ap.add_argument("--seconds", type=float, default=30.0, help="per duet (a request every 6 s after 3 s)")
     ap.add_argument("--no-legibility", dest="legibility", action="store_false",
-                    help="skip the lead detector (fitted on every take of --data, about 30 s)")
+                    help="skip the lead detector (fitted on every take of --data, about 20 s here)")
     O.add_options(ap)
     ap.add_argument("--out", default="runs/lead")
     ap.add_argument("--quiet", action="store_true")

@@ -46,20 +46,12 @@ from tqdm import tqdm
 from ..data.dataset import DataError, discover_takes, load_pair, pair_tracks, phases
 from ..data.folders import add_folder
 from ..mirror import features as feat
-from ..mirror.skeleton import FPS, JOINT_NAMES
+from ..mirror.skeleton import FPS, HANDS
 from . import figures as F
 
 TOLERANCE = 3          # frames: a sample's label is a turn completing within this of t + LEAD
-HANDS = [JOINT_NAMES.index("lHand"), JOINT_NAMES.index("rHand")]
 FEATURE_SETS = ("hand", "leader", "leader_body", "leader+intention", "leader+own")
-
-
-def columns(name: str) -> slice | None:
-    """The follower-input columns a feature set reads (None: hand, computed apart)."""
-    blocks = feat.block_slices(feat.FOLLOWER_INPUT_LAYOUT)
-    leader_end = blocks["partner_pose"].stop
-    return {"leader": slice(0, leader_end), "leader+intention": slice(0, leader_end),
-            "leader+own": slice(0, None), "hand": None, "leader_body": None}[name]
+LEADER_END = feat.block_slices(feat.FOLLOWER_INPUT_LAYOUT)["partner_pose"].stop   # her input's leader blocks end here
 
 
 def take_samples(lead, follow) -> dict:
@@ -76,10 +68,15 @@ def take_samples(lead, follow) -> dict:
             "hand": hand, "body": body, "turns": F.turns(F.facing(follow.positions))}
 
 
+_LEADER = feat.block_slices(feat.LEADER_INPUT_LAYOUT)
+LEADER_BODY = slice(_LEADER["self_trajectory_past"].start, _LEADER["control"].stop)
+LEADER_BODY_SIZE = LEADER_BODY.stop - LEADER_BODY.start   # 342
+
+
 def leader_body(follow, lead, frames: np.ndarray) -> np.ndarray:
-    """[N, 342] the leader's own past path, key joints, pose and planned path, in his root space."""
-    ls = feat.block_slices(feat.LEADER_INPUT_LAYOUT)
-    return feat.leader_input(follow, lead, frames)[:, ls["self_trajectory_past"].start:ls["control"].stop]
+    """[N, 342] the leader's own past path, key joints, pose and planned path, in his root space
+    (the leader's input from his own past block to his control)."""
+    return feat.leader_input(follow, lead, frames)[:, LEADER_BODY]
 
 
 def labels(s: dict, lead: int) -> np.ndarray:
@@ -92,9 +89,14 @@ def labels(s: dict, lead: int) -> np.ndarray:
 
 
 def design(s: dict, name: str) -> np.ndarray:
-    if name in ("hand", "leader_body"):
-        return s["hand" if name == "hand" else "body"]
-    x = s["input"][:, columns(name)]
+    """The columns a feature set reads (FEATURE_SETS, the module's docstring) of one take's samples."""
+    if name == "hand":
+        return s["hand"]
+    if name == "leader_body":
+        return s["body"]
+    if name == "leader+own":
+        return s["input"]
+    x = s["input"][:, :LEADER_END]
     return np.concatenate([x, s["intention"]], -1) if name == "leader+intention" else x
 
 
@@ -125,15 +127,15 @@ def score(found: list, recorded: list) -> tuple[int, int, int]:
     return F.match(found, recorded), len(found), len(recorded)
 
 
-def chance(found: list, recorded: list, n: int, rng: np.random.Generator, shifts: int = 200) -> tuple[float, float]:
-    """Matched count of the same detections shifted in time (circularly over the take)."""
+def chance(found: list, recorded: list, n: int, rng: np.random.Generator, shifts: int = 200) -> float:
+    """Mean matched count of the same detections shifted in time (circularly over the take of n frames)."""
     if not found:
-        return 0.0, 0.0
+        return 0.0
     m = []
     for _ in range(shifts):
         k = int(rng.integers(3 * FPS, n - 3 * FPS))
         m.append(F.match([((f + k) % n, d) for f, d in found], recorded))
-    return float(np.mean(m)), float(np.std(m))
+    return float(np.mean(m))
 
 
 def load(data: str) -> dict[str, list[dict]]:
@@ -215,7 +217,7 @@ def run(args) -> dict:
                 found = det.turns(s)
                 a, b, c = score(found, s["turns"])
                 fm, ff, fr = fm + a, ff + b, fr + c
-                cm.append(chance(found, s["turns"], int(s["frames"][-1]) + 1, rng)[0])
+                cm.append(chance(found, s["turns"], int(s["frames"][-1]) + 1, rng))
             per_fold.append({"test": test, "matched": fm, "found": ff, "recorded": fr})
             m, f_, r = m + fm, f_ + ff, r + fr
         row = {"features": name, "lead_s": lead / FPS, "matched": m, "found": f_, "recorded": r,

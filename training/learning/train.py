@@ -194,8 +194,8 @@ MODELS = {
     "follower": replace(steady(OURS), state_dropout=0.5, turn_weight=4.0, own_rollouts_from=10),
     "follower_ccm": replace(steady(CCM), state_dropout=0.5, turn_weight=4.0, own_rollouts_from=10),
     # Measured, not shipped: the intention also forecasts the turn the leader leads her into over
-    # the next second (ModelConfig.turn_keys). A detector reading only the leader's motion finds
-    # 57-66 % of the recorded turns (training.evaluation.turn_cues); cross-validated this follower
+    # the next second (ModelConfig.turn_keys). A detector reading his body alone finds 52 % of the
+    # recorded turns half a second ahead (training.evaluation.turn_cues); cross-validated this follower
     # matches 36 % with precision 40 % (the shipped recipe 35 % and 43 %, CCM 34 % and 48 %):
     # no difference the 6 folds can show (docs/results.md, "Turn timing").
     "follower_led_turn": replace(steady(OURS), model=replace(steady(OURS).model, turn_keys=feat.KEYS),
