@@ -13,7 +13,7 @@
 import { readFileSync, writeFileSync } from 'node:fs';
 import { join } from 'node:path';
 import { ROOT, launch, startServer, waitReady } from '../tests/e2e/harness.mjs';
-import { FPS, Reloaded, armProbe, followerTurn, leaderDivergence, readProbe, unwrap } from '../tests/e2e/turns.mjs';
+import { FPS, Reloaded, armProbe, followerTurn, leaderDivergence, leaderHand, readProbe, unwrap } from '../tests/e2e/turns.mjs';
 
 const SEEDS = (process.argv[2] ?? '1,2,3,4,5,6,7,8,9,10').split(',').map(Number);
 const SPEED = Number(process.env.DUET_TURN_SPEED ?? 2);
@@ -73,7 +73,11 @@ try {
     const within1s = Math.max(0, ...divergence.filter((d) => d.frame > ASK_AT && d.frame <= ASK_AT + FPS).map((d) => d.distance));
     const askedSteps = asked.steps.filter((s) => s.frame > ASK_AT);
     const leadingFor = askedSteps.filter((s) => s.turnAsked !== 0).length / FPS;
-    rows.push({ seed, direction, a, c, cAny, before, within1s, firstApart: firstApart ? (firstApart.frame - ASK_AT) / FPS : null, took: asked.took, leadingFor });
+    // His higher hand, highest within the 2.5 s, asked and not (a raised hand leads her turn).
+    const hand = Math.max(...leaderHand(asked.steps, ASK_AT));
+    const handUnasked = Math.max(...leaderHand(control.steps, ASK_AT));
+    const aAny = Math.max(a.best, followerTurn(asked.steps, ASK_AT, -direction).best);
+    rows.push({ seed, direction, a, c, aAny, cAny, before, within1s, hand, handUnasked, firstApart: firstApart ? (firstApart.frame - ASK_AT) / FPS : null, took: asked.took, leadingFor });
     const headingDeltas = (probe) => {
       const h = unwrap(probe.steps.filter((s) => s.frame >= ASK_AT).map((s) => s.followerHeading));
       return h.map((v) => ((v - h[0]) * 180) / Math.PI);
@@ -83,7 +87,8 @@ try {
     console.log(
       `seed ${seed} dir ${direction > 0 ? '+1 ccw' : '-1 cw '}: asked ${a.turned ? `yes ${a.at.toFixed(2)} s` : 'no'} (best ${a.best.toFixed(0)}°, net ${a.net.toFixed(0)}°), ` +
         `unasked ${c.turned ? `yes ${c.at.toFixed(2)} s` : 'no'} (best ${c.best.toFixed(0)}° that way, ${cAny.toFixed(0)}° any way, net ${c.net.toFixed(0)}°); ` +
-        `leader apart before ${r.before.toFixed(4)} m, within 1 s ${within1s.toFixed(2)} m, > 5 cm after ${r.firstApart ?? '-'} s; took ${asked.took} via ${asked.via}, request held ${leadingFor.toFixed(2)} s`,
+        `leader apart before ${r.before.toFixed(4)} m, within 1 s ${within1s.toFixed(2)} m, > 5 cm after ${r.firstApart ?? '-'} s; ` +
+        `his hand up to ${hand.toFixed(2)} m (unasked ${handUnasked.toFixed(2)} m); took ${asked.took} via ${asked.via}, request held ${leadingFor.toFixed(2)} s`,
     );
   }
 } finally {
@@ -92,18 +97,19 @@ try {
 }
 
 const yn = (t) => (t.turned ? `yes, ${t.at.toFixed(2)} s` : 'no');
-console.log('\n| seed | direction | turned asked | asked: most / net that way | turned unasked | unasked: most / net that way | unasked, most either way | leader apart within 1 s |');
-console.log('|---|---|---|---|---|---|---|---|');
+console.log('\n| seed | direction | turned asked | asked: most / net that way | asked, most either way | turned unasked | unasked: most / net that way | unasked, most either way | his hand highest, asked / unasked |');
+console.log('|---|---|---|---|---|---|---|---|---|');
 for (const r of rows) {
   const d = r.direction;
   console.log(
-    `| ${r.seed} | ${d > 0 ? '+1 (ccw)' : '−1 (cw)'} | ${yn(r.a)} | ${r.a.best.toFixed(0)}° / ${(d * r.a.net).toFixed(0)}° | ${yn(r.c)} | ${r.c.best.toFixed(0)}° / ${(d * r.c.net).toFixed(0)}° | ${r.cAny.toFixed(0)}° | ${r.within1s.toFixed(2)} m |`,
+    `| ${r.seed} | ${d > 0 ? '+1 (ccw)' : '−1 (cw)'} | ${yn(r.a)} | ${r.a.best.toFixed(0)}° / ${(d * r.a.net).toFixed(0)}° | ${r.aAny.toFixed(0)}° | ${yn(r.c)} | ${r.c.best.toFixed(0)}° / ${(d * r.c.net).toFixed(0)}° | ${r.cAny.toFixed(0)}° | ${r.hand.toFixed(2)} / ${r.handUnasked.toFixed(2)} m |`,
   );
 }
 const askedTurned = rows.filter((r) => r.a.turned).length;
 const unaskedTurned = rows.filter((r) => r.c.turned).length;
 console.log(`\nasked: turned ${askedTurned} of ${rows.length}; unasked: turned ${unaskedTurned} of ${rows.length} (≥ 300° in the asked direction within 2.5 s)`);
-console.log(`unasked, either direction: ${rows.filter((r) => r.cAny >= 300).length} of ${rows.length}`);
+console.log(`either direction: asked ${rows.filter((r) => r.aAny >= 300).length} of ${rows.length}, unasked ${rows.filter((r) => r.cAny >= 300).length} of ${rows.length}`);
+console.log(`his hand above 1.6 m: asked ${rows.filter((r) => r.hand > 1.6).length} of ${rows.length}, unasked ${rows.filter((r) => r.handUnasked > 1.6).length} of ${rows.length}`);
 const modelsAfter = fingerprints();
 if (modelsAfter !== modelsBefore) console.log(`the models changed during the run: now ${modelsAfter}`);
 if (consoleErrors.length) console.log('console errors:', consoleErrors);

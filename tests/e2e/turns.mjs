@@ -52,8 +52,10 @@ export function armProbe(page, { askAt, direction, until }) {
               leaderHeading: this.leader.heading,
               followerHeading: this.followers[0].heading,
               turnAsked: this.turnAsked,
-              // The leader model's figure block as it read it this step (the last 7 inputs).
-              figure: Array.from(this.leaderPolicy?.input?.slice(-7) ?? []),
+              // The leader model's figure block as it read it this step (inputs 660-666), and
+              // the first numbers of his hands plan (667: shown, then the left hand's first move).
+              figure: Array.from(this.leaderPolicy?.input?.slice(660, 667) ?? []),
+              handsPlan: Array.from(this.leaderPolicy?.input?.slice(667, 671) ?? []),
               steerActive: steer.active,
               t: performance.now(),
             });
@@ -127,6 +129,11 @@ export function followerTurn(steps, from, direction, full = 300) {
   }
   const absolute = Math.max(...deltas.map(Math.abs));
   return { deltas, net: deltas[deltas.length - 1], best, at, turned: at !== null, absolute };
+}
+
+/** The height (m) of the leader's higher hand at each recorded step from `from` on. */
+export function leaderHand(steps, from) {
+  return steps.filter((s) => s.frame >= from).map((s) => Math.max(s.leader[3 * J.lHand + 1], s.leader[3 * J.rHand + 1]));
 }
 
 /** Largest distance (m) between the same joint of two 17×3 position arrays. */

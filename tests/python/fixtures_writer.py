@@ -353,8 +353,11 @@ def features_fixture(rng: np.random.Generator, lead: Track, follow: Track) -> di
         "leaderInput": out7(feat.leader_input(follow, lead, frames)),
         # The figure block asked for: the follower's own turn ahead, as the leader's samples carry it.
         "partnerTurn": out7(feat.partner_turn(follow, frames)),
+        # ... and the hands plan of the leader's samples: his own hands' moves over the next second.
+        "handsMoves": out7(feat.hands_moves(lead, frames)),
         "leaderInputAsked": out7(feat.leader_input(follow, lead, frames,
-                                                   feat.figure_block(feat.partner_turn(follow, frames), len(frames)))),
+                                                   feat.figure_block(feat.partner_turn(follow, frames), len(frames)),
+                                                   feat.hands_plan_block(feat.hands_moves(lead, frames), len(frames)))),
         "followerOutput": out7(feat.output_features(follow, frames)),
         "leaderOutput": out7(feat.output_features(lead, frames)),
         "followerIntention": out7(feat.intention_target(lead, follow, frames)),
@@ -389,6 +392,7 @@ def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_o
     manifest = {"skeleton": {"offsets": {"leader": lead_offsets.tolist(), "follower": follow_offsets.tolist()}},
                 "startPose": start_pose}
     started = ro.start_duet(manifest)
+    request_hands = np.round(np.random.default_rng(30).normal([0.0, 1.3, 0.25], 0.15, size=(2, 2, 3)), 5)
 
     def window(track: Track) -> Track:   # frames 0..60 of a procedural track: NOW is its frame 30
         n = ro.TRACK_FRAMES
@@ -480,6 +484,12 @@ def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_o
         "figureInputs": [{"frame": f, "direction": d,
                           "keys": out7(ro.figure_input(ro.TurnRequest(d, f)))}
                          for f, d in ((0, 1), (7, -1), (30, 1), (59, -1), (74, 1))],
+        # ... and its hands plan, for the leader standing at frame 30 of the procedural track, his
+        # hands at the request given.
+        "handsInputs": [{"frame": f, "direction": d, "hands": exact(h),
+                         "moves": out7(ro.hands_input(ro.TurnRequest(d, f, h), ro.Dancer(lead_offsets, window(lead))))}
+                        for f, d, h in ((0, 1, request_hands[0]), (9, -1, request_hands[1]),
+                                        (30, 1, request_hands[0]), (59, -1, request_hands[1]), (74, 1, request_hands[1]))],
     }
 
 

@@ -14,7 +14,7 @@ from training.learning import train as T
 from training.mirror import features as feat
 from training.mirror import rollout as ro
 from training.mirror.features import FUTURE_OFFSETS, KEYS, Track
-from training.mirror.skeleton import FPS
+from training.mirror.skeleton import FPS, HANDS
 
 
 def spinning_track(frames: int, degrees_per_second: float) -> Track:
@@ -35,7 +35,7 @@ def test_the_figure_block_says_whether_anyone_asked():
     assert np.all(feat.figure_block(None, 3) == 0)
     asked = feat.figure_block(np.full((2, KEYS), 0.25), 2)
     assert asked.shape == (2, feat.FIGURE_SIZE) and np.all(asked[:, 0] == 1) and np.all(asked[:, 1:] == 0.25)
-    assert feat.LEADER_INPUT_SIZE == feat.INPUT_SIZE + feat.FIGURE_SIZE
+    assert feat.LEADER_INPUT_SIZE == feat.INPUT_SIZE + feat.FIGURE_SIZE + feat.HANDS_PLAN_SIZE
 
 
 def test_a_request_plans_one_full_turn_and_ends():
@@ -59,13 +59,57 @@ START_POSE = {r: {"hip": [0.0, 0.9, 0.0], "forward": [[0.0, 0.0, 1.0]] * 17, "up
               for r in ("leader", "follower")}
 
 
-def test_training_hides_the_figure_in_a_share_of_samples():
+def test_hands_moves_are_where_his_hands_go_less_where_they_are():
+    frames = 120
+    t = np.arange(frames) / FPS
+    positions = np.zeros((frames, 17, 3))
+    positions[:, :, 1] = 1.0
+    positions[:, HANDS[0], 1] = 1.0 + 0.5 * t            # his left hand rises 0.5 m a second
+    heading = np.full(frames, np.pi / 2)                  # facing +x: world +x is his +z (ahead)
+    root = np.stack([0.3 * t, np.zeros(frames)], -1)      # walking ahead at 0.3 m/s
+    positions[:, :, 0] += root[:, :1]
+    me = Track(positions, np.zeros((frames, 17, 3, 3)), root, heading)
+    moves = feat.hands_moves(me, np.array([40]))[0]       # [KEYS, 2, 3]
+    ahead = FUTURE_OFFSETS / FPS
+    assert np.allclose(moves[:, 0, 1], 0.5 * ahead) and np.allclose(moves[:, 1, 1], 0.0)
+    assert np.allclose(moves[:, :, 2], 0.3 * ahead[:, None]) and np.allclose(moves[:, :, 0], 0.0, atol=1e-12)
+    block = feat.hands_plan_block(moves[None], 1)[0]
+    assert block[0] == 1 and np.allclose(block[1:], moves.ravel())
+    assert np.all(feat.hands_plan_block(None, 2) == 0)
+
+
+def test_a_request_raises_his_lead_hand_and_lowers_it():
+    assert ro.raised(0.0) == 0 and ro.raised(ro.RAISE[1]) == 1 and ro.raised(ro.RAISE[3]) == 0
+    offsets = np.zeros((17, 3)).tolist()
+    duet = ro.start_duet({"skeleton": {"offsets": {"leader": offsets, "follower": offsets}}, "startPose": START_POSE})
+    ro.ask_turn(duet, -1)                                  # her turn to the right: his right hand leads
+    request, leader = duet.request, duet.leader
+    hands = feat.to_root_space_points(leader.positions[HANDS], leader.root, leader.heading)
+    assert np.allclose(request.hands, hands)
+    tops = []
+    for f in range(int(ro.REQUEST_SECONDS * FPS)):
+        request.frame = f
+        moves = ro.hands_input(request, leader)
+        assert np.allclose(moves[:, 0], 0.0)               # the other hand stays where it was
+        tops.append(hands[1] + moves[-1, 1])              # where the lead hand is to be 1 s ahead
+    tops = np.array(tops)
+    top = np.array(ro.LEAD_HAND_RAISED) * [-1, 1, 1]
+    raised = tops[int(0.2 * FPS):int(0.8 * FPS)]          # keys 1 s ahead: 1.2-1.8 s, held up
+    assert np.allclose(raised, top)
+    assert np.allclose(tops[-1], hands[1], atol=1e-9)      # and down again where it was by the end
+    assert ro.hands_input(None, leader) is None
+    x_leader, _ = ro.step_inputs(duet)
+    assert x_leader[feat.block_slices(feat.LEADER_INPUT_LAYOUT)["hands_plan"]][0] == 1
+
+
+@pytest.mark.parametrize("block", ["figure", "hands_plan"])
+def test_training_hides_a_block_in_a_share_of_samples(block):
     x = torch.ones(4000, feat.LEADER_INPUT_SIZE)
-    hidden = T.hide_figure(x, 0.5, torch.Generator().manual_seed(0))
-    fig = feat.block_slices(feat.LEADER_INPUT_LAYOUT)["figure"]
-    share = (hidden[:, fig] == 0).all(1).float().mean().item()
+    hidden = T.hide_block(x, block, 0.5, torch.Generator().manual_seed(0))
+    sl = feat.block_slices(feat.LEADER_INPUT_LAYOUT)[block]
+    share = (hidden[:, sl] == 0).all(1).float().mean().item()
     assert 0.45 < share < 0.55
-    assert torch.equal(hidden[:, :fig.start], x[:, :fig.start])   # nothing else is touched
+    assert torch.equal(hidden[:, :sl.start], x[:, :sl.start]) and torch.equal(hidden[:, sl.stop:], x[:, sl.stop:])
 
 
 def test_the_partner_is_hidden_only_where_the_figure_is_shown():

@@ -118,11 +118,13 @@ describe('model inputs, outputs and intention', () => {
   it('leaderInput (partner = follower, control = own future)', () => {
     expectClose(perFrame(F.LEADER_INPUT_SIZE, (t, o, at) => F.leaderInput(follower, leader, t, o, at)), data.leaderInput, 'leader input');
   });
-  it('leaderInput with a figure asked for (the partner\'s turn ahead)', () => {
+  it('leaderInput with a figure asked for (the partner\'s turn ahead) and a hands plan (his hands\' moves)', () => {
     const turns = data.partnerTurn as number[];
+    const moves = data.handsMoves as number[];
+    const size = F.HANDS_PLAN_SIZE - 1;
     const asked = perFrame(F.LEADER_INPUT_SIZE, (t, o, at) => {
       const i = at / F.LEADER_INPUT_SIZE;
-      F.leaderInput(follower, leader, t, o, at, turns.slice(i * F.KEYS, (i + 1) * F.KEYS));
+      F.leaderInput(follower, leader, t, o, at, turns.slice(i * F.KEYS, (i + 1) * F.KEYS), moves.slice(i * size, (i + 1) * size));
     });
     expectClose(asked, data.leaderInputAsked, 'leader input, asked');
   });

@@ -108,9 +108,22 @@ describe('the duet loop, step by step', () => {
 describe('a turn asked for', () => {
   it('figureInput gives the planned partner turn over the request\'s life', () => {
     for (const c of data.figureInputs as { frame: number; direction: number; keys: number[] }[]) {
-      expectClose(R.figureInput({ frame: c.frame, direction: c.direction })!, c.keys, `figure keys at ${c.frame}`);
+      expectClose(R.figureInput({ frame: c.frame, direction: c.direction, hands: new Float64Array(6) })!, c.keys, `figure keys at ${c.frame}`);
     }
     expect(R.figureInput(null)).toBeNull();
+  });
+  it('handsInput raises his lead hand and lowers it over the request\'s life', () => {
+    const leader = new R.Dancer(Float64Array.from(data.offsets.leader));
+    const source = trackOf(features, 'leader', R.TRACK_FRAMES);
+    leader.track.positions.set(source.positions);
+    leader.track.rotations.set(source.rotations);
+    leader.track.root.set(source.root);
+    leader.track.heading.set(source.heading);
+    for (const c of data.handsInputs as { frame: number; direction: number; hands: number[][]; moves: number[] }[]) {
+      const request = { frame: c.frame, direction: c.direction, hands: Float64Array.from(c.hands.flat()) };
+      expectClose(R.handsInput(request, leader)!, c.moves, `hands plan at ${c.frame}`);
+    }
+    expect(R.handsInput(null, leader)).toBeNull();
   });
   it('a request ends after REQUEST_SECONDS', () => {
     const duet = R.startDuet({ skeleton: { offsets: data.offsets }, startPose: data.startPose });

@@ -14,7 +14,8 @@ from pathlib import Path
 import numpy as np
 
 from ..mirror.bvh import BvhError, read_bvh
-from ..mirror.features import (HISTORY, Track, figure_block, follower_input, intention_target, leader_input,
+from ..mirror.features import (HISTORY, Track, figure_block, follower_input, hands_moves, hands_plan_block,
+                               intention_target, leader_input,
                                output_features, partner_turn,
                        valid_frames)
 from ..mirror.skeleton import FPS, HEAD, SCALE, Motion, mirror_motion, reduce_bvh, resample, time_warp
@@ -136,7 +137,8 @@ def samples(lead: Track, follow: Track) -> dict[str, np.ndarray]:
         "follower_intention": intention_target(lead, follow, frames),
         # The leader's samples carry the figure the follower really danced (train.py hides it in
         # a share of them, so the leader also learns to lead on his own).
-        "leader_input": leader_input(follow, lead, frames, figure_block(partner_turn(follow, frames), len(frames))),
+        "leader_input": leader_input(follow, lead, frames, figure_block(partner_turn(follow, frames), len(frames)),
+                                     hands_plan_block(hands_moves(lead, frames), len(frames))),
         "leader_output": output_features(lead, frames),
         "leader_intention": intention_target(follow, lead, frames),
     }

@@ -103,6 +103,10 @@ def prepare(data: str, out: str, validation: list[str], test: list[str], leader:
                 # sample is asked, so its own statistics would put the unasked 0 a hundred stds away.
                 fig = F.block_slices(F.LEADER_INPUT_LAYOUT)["figure"]
                 mean[fig], std[fig] = 0.0, 1.0
+                # The hands plan likewise keeps `shown` raw and its moves centred on "stay": a hidden
+                # plan (zeros) then reads as no move, and the moves keep their own spread.
+                plan = F.block_slices(F.LEADER_INPUT_LAYOUT)["hands_plan"]
+                mean[plan], std[plan.start] = 0.0, 1.0
             stats[f"{role}_{kind}_mean"], stats[f"{role}_{kind}_std"] = mean, std
     # Bone offsets of each role (the first take's, as export ships them): the training terms on
     # the decoded body (partner_losses) run forward kinematics with them. In the CMU takes each

@@ -30,7 +30,8 @@ from tqdm import tqdm
 from ..data.dataset import DataError, TEST_TAKES
 from ..data.folders import add_folder
 from ..mirror.rollout import NOW, REQUEST_SECONDS, ask_turn, start_duet, step
-from ..mirror.skeleton import FPS
+from ..mirror import features as feat
+from ..mirror.skeleton import FPS, HANDS
 from . import figures as Fg
 from . import turn_cues as C
 from . import options as O
@@ -42,27 +43,41 @@ from .evaluate_inputs import EvalError, find_models, load_eval_takes, load_onnx
 LEGIBILITY_LEAD = 0.5
 REQUEST_EVERY = 6.0      # s between requests in one duet (a turn and the time to settle after it)
 WARM_UP = 3.0            # s of dancing before the first request
+# His hand counts as raised above 1.6 m: the recorded leader's higher hand goes above it in 84 %
+# of her turns (1.5 s before the turn completes), and is above it in 17 % of all his frames.
+HAND_RAISED = 1.6
 
 
 def branch(duet, leader, follower, temperature: float, rng: np.random.Generator, direction: int | None,
-           frames: int, with_body: bool = False) -> tuple[np.ndarray, np.ndarray | None]:
+           frames: int, with_body: bool = False) -> tuple[np.ndarray, np.ndarray | None, float]:
     """Dance a copy of the duet `frames` steps on (asked for a turn in `direction` first, or not):
-    the follower's world positions [frames + 1, 17, 3], the request's frame first, and (with_body)
+    the follower's world positions [frames + 1, 17, 3], the request's frame first, (with_body)
     his body at each of those frames (turn_cues.leader_body: his past, pose and plan in his own
-    root space; None without)."""
+    root space; None without), and the highest his hands went (m above the floor)."""
     d = copy.deepcopy(duet)
     if direction is not None:
         ask_turn(d, direction)
     out = np.zeros((frames + 1, 17, 3))
     body = np.zeros((frames + 1, C.LEADER_BODY_SIZE)) if with_body else None
-    now = np.array([NOW])
+    now, hand = np.array([NOW]), 0.0
+    hands = np.zeros((frames + 1, 2, 3))
     for f in range(frames + 1):
         if f > 0:
             step(d, leader, follower, np.zeros(2), temperature, rng)
         out[f] = d.follower.track.positions[NOW]
+        hand = max(hand, float(d.leader.track.positions[NOW][HANDS, 1].max()))
+        hands[f] = feat.to_root_space_points(d.leader.track.positions[NOW][HANDS], d.leader.root, d.leader.heading)
         if with_body:
             body[f] = C.leader_body(d.follower.track, d.leader.track, now)[0]
-    return out, body
+    return out, body, hand, winding(hands)
+
+
+def winding(hands: np.ndarray) -> float:
+    """The signed area (m²) the higher of his hands [frames, 2, 3] (his root space) sweeps over the
+    floor plan: negative winds the way that leads her turn to the left (+1), as in the recording."""
+    p = hands[:, int(hands[..., 1].mean(0).argmax())]
+    x, z = p[:, 0] - p[:, 0].mean(), p[:, 2] - p[:, 2].mean()
+    return float(0.5 * (x[:-1] * z[1:] - z[:-1] * x[1:]).sum())
 
 
 def lead_seen(detector: C.Detector | None, body: np.ndarray | None, direction: int) -> bool | None:
@@ -88,9 +103,9 @@ def one_duet(manifest, leader, follower, temperature: float, seed: int, seconds:
         if f in ask_at:
             direction = int(rng.choice([-1, 1]))
             state = rng.bit_generator.state
-            asked, body_asked = branch(duet, leader, follower, temperature, np.random.default_rng(seed * 1000 + f),
+            asked, body_asked, hand_asked, wind_asked = branch(duet, leader, follower, temperature, np.random.default_rng(seed * 1000 + f),
                                        direction, window, detector is not None)
-            unasked, body_unasked = branch(duet, leader, follower, temperature,
+            unasked, body_unasked, hand_unasked, wind_unasked = branch(duet, leader, follower, temperature,
                                            np.random.default_rng(seed * 1000 + f), None, window, detector is not None)
             rng.bit_generator.state = state
             turns_asked, turns_unasked = Fg.turns(Fg.facing(asked)), Fg.turns(Fg.facing(unasked))
@@ -98,6 +113,9 @@ def one_duet(manifest, leader, follower, temperature: float, seed: int, seconds:
                              "turned": bool(turns_asked), "turned_that_way": any(d == direction for _, d in turns_asked),
                              "seconds": turns_asked[0][0] / FPS if turns_asked else None,
                              "turned_unasked": bool(turns_unasked),
+                             "hand_m": hand_asked, "hand_m_unasked": hand_unasked,
+                             "winding": wind_asked, "winding_unasked": wind_unasked,
+                             "hand_raised": hand_asked > HAND_RAISED, "hand_raised_unasked": hand_unasked > HAND_RAISED,
                              "lead_seen": lead_seen(detector, body_asked, direction),
                              "lead_seen_unasked": lead_seen(detector, body_unasked, direction)})
         step(duet, leader, follower, np.zeros(2), temperature, rng)
@@ -113,6 +131,7 @@ def summary(per_seed: list[dict], ref: dict) -> dict:
     share = lambda k: sum(r[k] for r in req) / n if n else float("nan")
     out = {"requests": n, "turned": share("turned"), "turned_that_way": share("turned_that_way"),
            "turned_unasked": share("turned_unasked"),
+           "hand_raised": share("hand_raised"), "hand_raised_unasked": share("hand_raised_unasked"),
            "median_seconds": float(np.median([r["seconds"] for r in req if r["seconds"] is not None]))
            if any(r["turned"] for r in req) else None}
     if n and req[0]["lead_seen"] is not None:
@@ -150,6 +169,8 @@ def write_markdown(path: Path, res: dict) -> None:
          f"| the same moments, unasked | {100 * s['turned_unasked']:.0f} % |",
          f"| ratio asked / unasked | {s['turned'] / s['turned_unasked']:.1f}× |" if s["turned_unasked"] else
          "| ratio asked / unasked | – (no turn unasked) |", "",
+         f"His hand above {HAND_RAISED:g} m within 2.5 s: {100 * s['hand_raised']:.0f} % of the requests, "
+         f"{100 * s['hand_raised_unasked']:.0f} % of the same moments unasked.", "",
          *([f"Does he lead? A detector of the recorded leads (training.evaluation.turn_cues, leader_body: his "
             f"own body and plan, not where she is; a turn completing {LEGIBILITY_LEAD:g} s later) sees him lead the asked "
             f"way in {100 * s['lead_seen']:.0f} % of the requests and in {100 * s['lead_seen_unasked']:.0f} % "

@@ -66,6 +66,16 @@ class Run:
     steps: int      # steps left
 
 
+def recorded_hands(recorded: Track, t: int, me: Track) -> np.ndarray:
+    """[1, KEYS, 2, 3] the recorded hands' places at the future keys of frame t (in the recorded
+    root space), less where his own hands are now (in his): the moves that take his hands there."""
+    f = np.array([t])
+    future = feat.hands_moves(recorded, f) + feat.to_root_space_points(
+        recorded.positions[t][feat.HANDS], recorded.root[t], recorded.heading[t])[None, None]
+    now = feat.to_root_space_points(me.positions[NOW][feat.HANDS], me.root[NOW], me.heading[NOW])
+    return future - now[None, None]
+
+
 def inputs_at(run: Run, role: str, led_turn: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(input, recorded output, intention target) of a rollout at its frame: the input from its own
     track beside the recorded partner; the targets the recording's (with `led_turn`, the
@@ -77,7 +87,9 @@ def inputs_at(run: Run, role: str, led_turn: bool = False) -> tuple[np.ndarray, 
     else:
         partner, recorded = window(c.follower, t), c.leader
         steer_along_recording(run.me, recorded, t)   # his plan: the recorded path, laid from where he stands
-        x = feat.leader_input(partner, run.me.track, now, feat.figure_block(c.partner_turn[t][None], 1))[0]
+        # His hands plan: where the recorded hands went over the next second, from where his are.
+        plan = feat.hands_plan_block(recorded_hands(recorded, t, run.me.track), 1)
+        x = feat.leader_input(partner, run.me.track, now, feat.figure_block(c.partner_turn[t][None], 1), plan)[0]
     y = feat.output_features(recorded, np.array([t]))[0]
     j = feat.intention_target(partner, run.me.track, now)[0]
     if led_turn:

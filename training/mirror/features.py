@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .skeleton import FEET, FPS, JOINT_NAMES, KEY_JOINTS, Motion, root_from_motion
+from .skeleton import FEET, FPS, HANDS, JOINT_NAMES, KEY_JOINTS, Motion, root_from_motion
 
 KEYS = 6                                     # trajectory keys per second (the paper's k)
 KEY_STEP = FPS // KEYS                       # 5 frames between keys at 30 fps
@@ -28,6 +28,7 @@ POSE_SIZE = N_JOINTS * 12                    # 204
 ROOT_UPDATE_SIZE = 3
 CONTACTS_SIZE = 2
 FIGURE_SIZE = 1 + KEYS                       # 7: asked, then the partner's planned turn at each key
+HANDS_PLAN_SIZE = 1 + KEYS * len(HANDS) * 3  # 37: shown, then where each hand is to go at each key
 
 # (name, size) in order; docs/features.md explains each block.
 FOLLOWER_INPUT_LAYOUT = [
@@ -41,6 +42,7 @@ LEADER_INPUT_LAYOUT = [
     ("partner_pose", POSE_SIZE),
     ("self_trajectory_past", TRAJECTORY_SIZE), ("self_key_joints_past", KEY_JOINTS_SIZE),
     ("self_pose", POSE_SIZE), ("control", TRAJECTORY_SIZE), ("figure", FIGURE_SIZE),
+    ("hands_plan", HANDS_PLAN_SIZE),
 ]
 OUTPUT_LAYOUT = [
     ("root_update", ROOT_UPDATE_SIZE), ("trajectory_future", TRAJECTORY_SIZE),
@@ -48,7 +50,7 @@ OUTPUT_LAYOUT = [
 ]
 INTENTION_LAYOUT = [("partner_key_joints_future", KEY_JOINTS_SIZE)]
 INPUT_SIZE = sum(s for _, s in FOLLOWER_INPUT_LAYOUT)     # 660: the follower's input
-LEADER_INPUT_SIZE = sum(s for _, s in LEADER_INPUT_LAYOUT)  # 667: the same blocks, control and figure
+LEADER_INPUT_SIZE = sum(s for _, s in LEADER_INPUT_LAYOUT)  # 704: the same blocks, control, figure, hands plan
 OUTPUT_SIZE = sum(s for _, s in OUTPUT_LAYOUT)            # 323
 INTENTION_SIZE = KEY_JOINTS_SIZE                          # 90
 INPUT_SIZES = {"follower": INPUT_SIZE, "leader": LEADER_INPUT_SIZE}
@@ -212,9 +214,34 @@ def partner_turn(partner: Track, frames: np.ndarray) -> np.ndarray:
     return (heading[idx] - heading[frames][:, None]) / (2 * np.pi)
 
 
-def leader_input(partner: Track, me: Track, frames: np.ndarray, figure: np.ndarray | None = None) -> np.ndarray:
-    """Input I [N, 667] for the leader (partner = follower, control = own future trajectory, then
-    the figure block: figure_block's [N, 7], zeros when not given)."""
+def hands_plan_block(moves: np.ndarray | None, n: int) -> np.ndarray:
+    """The leader's hands plan [n, 37]: `shown` (1 when a plan is given), then how far each hand
+    (left, right) is to move from where it is now to where it is at each future key, in his root
+    space now ([n, KEYS, 2, 3] flattened key by key). None: no plan (zeros), and his hands go
+    where he likes, as he learnt from the samples whose plan was hidden. A raised hand is how a
+    salsa leader leads her turn; this block is how a visitor raises it."""
+    out = np.zeros((n, HANDS_PLAN_SIZE))
+    if moves is not None:
+        out[:, 0] = 1.0
+        out[:, 1:] = np.asarray(moves).reshape(n, -1)
+    return out
+
+
+def hands_moves(me: Track, frames: np.ndarray) -> np.ndarray:
+    """[N, KEYS, 2, 3] the recorded hands' moves from each frame to each future key, in the root
+    space at the frame: the hands plan of the leader's samples."""
+    root, heading = me.root[frames], me.heading[frames]
+    idx = frames[:, None] + FUTURE_OFFSETS[None]
+    future = to_root_space_points(me.positions[idx][:, :, HANDS], root[:, None, None], heading[:, None, None])
+    now = to_root_space_points(me.positions[frames][:, HANDS], root[:, None], heading[:, None])
+    return future - now[:, None]
+
+
+def leader_input(partner: Track, me: Track, frames: np.ndarray, figure: np.ndarray | None = None,
+                 hands_plan: np.ndarray | None = None) -> np.ndarray:
+    """Input I [N, 704] for the leader (partner = follower, control = own future trajectory, then
+    the figure block: figure_block's [N, 7], and the hands plan: hands_plan_block's [N, 37], zeros
+    when not given)."""
     root, heading = me.root[frames], me.heading[frames]
     return np.concatenate([
         _trajectory_at(partner, frames, PAST_OFFSETS, root, heading),
@@ -225,6 +252,7 @@ def leader_input(partner: Track, me: Track, frames: np.ndarray, figure: np.ndarr
         _pose_at(me, frames, root, heading),
         _trajectory_at(me, frames, FUTURE_OFFSETS, root, heading),
         figure_block(None, len(frames)) if figure is None else figure,
+        hands_plan_block(None, len(frames)) if hands_plan is None else hands_plan,
     ], -1)
 
 

@@ -1,6 +1,6 @@
 // The neural policies: one ONNX InferenceSession per model, stepped once per frame.
 //
-// I/O contract (docs/features.md): inputs `input` [B, 660] (the leader's [B, 667]), `temperature` [1], `noise` [B, C·D]
+// I/O contract (docs/features.md): inputs `input` [B, 660] (the leader's [B, 704]), `temperature` [1], `noise` [B, C·D]
 // uniform in (0, 1); outputs `output` [B, 323], `intention` [B, 90] (only models with an intention
 // predictor), `code` [B, C]. Everything here is allocated once: callers write into `input`, call
 // run(), and read `result`, so stepping at 30 Hz creates no garbage of ours.
@@ -29,7 +29,7 @@ interface Batch {
 }
 
 export class Policy implements StepPolicy {
-  /** Write the [660] (leader: [667]) input features here before run(). */
+  /** Write the [660] (leader: [704]) input features here before run(). */
   readonly input: Float32Array;
   /** Filled by run(); the same object and arrays every call. */
   readonly result: PolicyResult;

@@ -8,7 +8,7 @@
 // path allocates nothing. Module-level scratch arrays hold gathered inputs (JS is single-threaded
 // and none of these functions re-enters another while its scratch is live).
 
-import { FEET, FPS, KEY_JOINTS, type Motion, N_JOINTS, POSITIONS_SIZE, ROTATIONS_SIZE, rootFromMotion } from './skeleton';
+import { FEET, FPS, HANDS, KEY_JOINTS, type Motion, N_JOINTS, POSITIONS_SIZE, ROTATIONS_SIZE, rootFromMotion } from './skeleton';
 
 /** Any float array a feature can be written into (policy inputs are float32, tests use float64). */
 export type Out = Float32Array | Float64Array;
@@ -27,6 +27,7 @@ export const POSE_SIZE = N_JOINTS * 12; // 204
 export const ROOT_UPDATE_SIZE = 3;
 export const CONTACTS_SIZE = 2;
 export const FIGURE_SIZE = 1 + KEYS; // 7: asked, then the partner's planned turn at each key
+export const HANDS_PLAN_SIZE = 1 + KEYS * HANDS.length * 3; // 37: shown, then where each hand is to go at each key
 
 export type Layout = ReadonlyArray<readonly [string, number]>;
 
@@ -42,6 +43,7 @@ export const LEADER_INPUT_LAYOUT: Layout = [
   ['partner_pose', POSE_SIZE],
   ['self_trajectory_past', TRAJECTORY_SIZE], ['self_key_joints_past', KEY_JOINTS_SIZE],
   ['self_pose', POSE_SIZE], ['control', TRAJECTORY_SIZE], ['figure', FIGURE_SIZE],
+  ['hands_plan', HANDS_PLAN_SIZE],
 ];
 export const OUTPUT_LAYOUT: Layout = [
   ['root_update', ROOT_UPDATE_SIZE], ['trajectory_future', TRAJECTORY_SIZE],
@@ -50,7 +52,7 @@ export const OUTPUT_LAYOUT: Layout = [
 export const INTENTION_LAYOUT: Layout = [['partner_key_joints_future', KEY_JOINTS_SIZE]];
 const layoutSize = (layout: Layout) => layout.reduce((sum, [, size]) => sum + size, 0);
 export const INPUT_SIZE = layoutSize(FOLLOWER_INPUT_LAYOUT); // 660: the follower's input
-export const LEADER_INPUT_SIZE = layoutSize(LEADER_INPUT_LAYOUT); // 667: the same blocks, control and figure
+export const LEADER_INPUT_SIZE = layoutSize(LEADER_INPUT_LAYOUT); // 704: the same blocks, control, figure, hands plan
 export const OUTPUT_SIZE = layoutSize(OUTPUT_LAYOUT); // 323
 export const INTENTION_SIZE = KEY_JOINTS_SIZE; // 90
 export const INPUT_SIZES: Readonly<Record<string, number>> = { follower: INPUT_SIZE, leader: LEADER_INPUT_SIZE };
@@ -331,6 +333,8 @@ const INPUT_BLOCKS: Record<string, InputBlock> = {
   control: (_partner, me, t, x, z, h, out, at) => trajectoryAt(me, t, FUTURE_OFFSETS, x, z, h, out, at),
   // Nobody asks for a figure here; leaderInput writes the request over it when there is one.
   figure: (_partner, _me, _t, _x, _z, _h, out, at) => figureBlock(null, out, at),
+  // Nor for a lead; leaderInput writes the request's hands plan over it when there is one.
+  hands_plan: (_partner, _me, _t, _x, _z, _h, out, at) => handsPlanBlock(null, out, at),
 };
 
 /**
@@ -342,6 +346,18 @@ const INPUT_BLOCKS: Record<string, InputBlock> = {
 export function figureBlock(partnerTurn: ArrayLike<number> | null, out: Out, at = 0): void {
   out[at] = partnerTurn ? 1 : 0;
   for (let k = 0; k < KEYS; k++) out[at + 1 + k] = partnerTurn ? partnerTurn[k] : 0;
+}
+
+/**
+ * The leader's hands plan [37] at out[at..]: `shown` (1 when a plan is given), then how far each
+ * hand (left, right) is to move from where it is now to where it is at each future key, in his
+ * root space now ([KEYS][2][3], key by key). null: no plan (zeros), and his hands go where he
+ * likes, as he learnt from the samples whose plan was hidden. A raised hand is how a salsa leader
+ * leads her turn; this block is how a visitor raises it.
+ */
+export function handsPlanBlock(moves: ArrayLike<number> | null, out: Out, at = 0): void {
+  out[at] = moves ? 1 : 0;
+  for (let i = 1; i < HANDS_PLAN_SIZE; i++) out[at + i] = moves ? moves[i - 1] : 0;
 }
 
 /** A layout table as (writer, start) pairs in its order (Python concatenates; here every block writes at its offset). */
@@ -371,14 +387,20 @@ export function followerInput(partner: Track, me: Track, t: number, out: Out, at
 }
 
 const FIGURE_AT = blockSlices(LEADER_INPUT_LAYOUT).figure.start;
+const HANDS_PLAN_AT = blockSlices(LEADER_INPUT_LAYOUT).hands_plan.start;
 
 /**
- * Input I [667] for the leader (partner = follower, control = own future trajectory, then the
- * figure block: figureBlock of `figure`, the partner's planned turn per key, zeros when null).
+ * Input I [704] for the leader (partner = follower, control = own future trajectory, then the
+ * figure block: figureBlock of `figure`, the partner's planned turn per key, and the hands plan:
+ * handsPlanBlock of `handsPlan`, each zeros when null).
  */
-export function leaderInput(partner: Track, me: Track, t: number, out: Out, at = 0, figure: ArrayLike<number> | null = null): void {
+export function leaderInput(
+  partner: Track, me: Track, t: number, out: Out, at = 0,
+  figure: ArrayLike<number> | null = null, handsPlan: ArrayLike<number> | null = null,
+): void {
   writeInput(LEADER_PLAN, partner, me, t, out, at);
   if (figure) figureBlock(figure, out, at + FIGURE_AT);
+  if (handsPlan) handsPlanBlock(handsPlan, out, at + HANDS_PLAN_AT);
 }
 
 /** Output O [323]: the self at t+1, in the root space of t+1 (root update in t's). */

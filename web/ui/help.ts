@@ -26,7 +26,7 @@ const METHOD = [
 ];
 
 const KEYS =
-  'Keys: arrows or WASD lead · T lead her turn to her right, Shift+T to her left · Space pause · R start again (the camera too) · ' +
+  'Keys: arrows or WASD lead · T raise your right hand over her to lead a turn, Shift+T your left · Space pause · R start again (the camera too) · ' +
   '“● clip” saves a 6 s video, the corners button goes full screen · drag to turn the camera, wheel to zoom. Phone: drag one finger ' +
   'to lead, two fingers to turn and zoom; “pause” and the two “turn” buttons by the title.';
 
