@@ -22,7 +22,7 @@
 // the strip's because she completes the led turn there (835° to her left within 2.5 s asked,
 // 276° the other way unasked): what a led turn looks like when it works.
 //
-// Run: node --test tests/e2e/turns.test.mjs
+// Run: node --test tests/e2e/turns.test.mjs (DUET_TURN_SEED, DUET_TURN_DIRECTION: another seed, -1 her right)
 
 import { after, before, describe, test } from 'node:test';
 import assert from 'node:assert/strict';
@@ -32,7 +32,7 @@ import { ROOT, launch, startServer, waitReady } from './harness.mjs';
 import { FPS, J, Reloaded, armProbe, captureLedTurn, followerTurn, leaderDivergence, leaderHand, poseDistance, readProbe } from './turns.mjs';
 
 const SEED = Number(process.env.DUET_TURN_SEED ?? 7);
-const DIRECTION = 1; // counterclockwise seen from above: her left (Shift+T)
+const DIRECTION = Number(process.env.DUET_TURN_DIRECTION ?? 1); // +1 counterclockwise seen from above: her left (Shift+T)
 const ASK_AT = 4 * FPS; // the request, in steps after the page started dancing
 const UNTIL = ASK_AT + 3 * FPS; // recorded up to 3 s after the request
 const FRAMES = 6; // strip frames, every 0.5 s of dance from the request on

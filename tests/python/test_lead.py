@@ -163,3 +163,20 @@ def test_lead_runs_on_freshly_exported_models(exported, data3, tmp_path, capsys)
 def test_lead_names_missing_models(tmp_path, capsys):
     assert lead.main(["--models", str(tmp_path), "--seeds", "1"]) == 2
     assert "manifest.json not found" in capsys.readouterr().err
+
+
+def test_recorded_leads_reads_his_hands_around_her_turns(data3, capsys):
+    """The numbers behind the page's lead, read from 3 recorded takes: mirrored, every turn has
+    one of the other direction, so both directions report and wind opposite ways."""
+    from training.evaluation import recorded_leads
+    assert recorded_leads.main(["--data", str(data3)]) == 0
+    out = capsys.readouterr().out
+    assert "Her turns to her left (+1)" in out and "Her turns to her right (-1)" in out
+    left, right = (int(line.rsplit("negative in ", 1)[1].split(" %")[0]) for line in out.splitlines() if "winds" in line)
+    assert left + right == 100                      # mirrored copies wind the other way
+
+
+def test_recorded_leads_names_a_folder_without_takes(tmp_path, capsys):
+    from training.evaluation import recorded_leads
+    assert recorded_leads.main(["--data", str(tmp_path)]) == 2
+    assert "error" in capsys.readouterr().err

@@ -1,0 +1,96 @@
+"""python -m training.evaluation.recorded_leads: what the recorded leader's hands do around her turns.
+
+The numbers behind the page's lead (training/mirror/rollout.py: LEAD_HAND_RAISED, RAISE, and the
+hand that leads each direction). For every recorded follower turn (figures.turns: 300 degrees
+within 2.5 s, timed where the 300 are reached), in every take as recorded and mirrored, it reads
+the leader's hands in his own root space (x to his left, y up, z ahead) from WINDOW[0] to
+WINDOW[1] seconds around the turn's completion, and reports:
+- how high his higher hand peaks in the PEAK seconds before completion, how often above RAISED
+  metres, and how often his hands are that high in any frame;
+- when the peak comes, which hand it is for each direction, and where it is;
+- which way the higher hand winds over the floor plan in the last second (its signed area,
+  lead.winding's sign: negative for her turn to the left).
+
+    python -m training.evaluation.recorded_leads
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+
+import numpy as np
+
+from ..data.dataset import DataError, discover_takes, load_pair, pair_tracks
+from ..data.folders import add_folder
+from ..mirror import features as feat
+from ..mirror.skeleton import FPS, HANDS
+from . import figures as F
+from .lead import HAND_RAISED, winding
+
+WINDOW = (-2.0, 0.5)   # s around the turn's completion
+PEAK = 1.5             # s before completion where the lead's peak is looked for
+WIND = 1.0             # s before completion over which the winding is read
+
+
+def hands_around_turns(data: str) -> tuple[dict[int, list[np.ndarray]], np.ndarray]:
+    """({direction: [hands [frames, 2, 3] around each turn]}, all his hands [N, 2, 3]), root space."""
+    offsets = np.arange(int(WINDOW[0] * FPS), int(WINDOW[1] * FPS) + 1)
+    around, every = {1: [], -1: []}, []
+    for take in discover_takes(data):
+        lead_m, follow_m = load_pair(take)
+        for mirror in (False, True):
+            lead, follow = pair_tracks(lead_m, follow_m, 0, mirror)
+            hands = feat.to_root_space_points(lead.positions[:, HANDS], lead.root[:, None], lead.heading[:, None])
+            every.append(hands)
+            for t, direction in F.turns(F.facing(follow.positions)):
+                idx = t + offsets
+                if idx[0] >= 0 and idx[-1] < lead.frames:
+                    around[direction].append(hands[idx])
+    return around, np.concatenate(every)
+
+
+def report(around: dict[int, list[np.ndarray]], every: np.ndarray) -> list[str]:
+    start = int(WINDOW[0] * FPS)
+    peak = slice(int(-PEAK * FPS) - start, -start + 1)
+    wind = slice(int(-WIND * FPS) - start, -start + 1)
+    n = sum(len(v) for v in around.values())
+    highest = np.concatenate([np.stack(v)[:, peak, :, 1].max(axis=(1, 2)) for v in around.values()])
+    lines = [f"{n} recorded follower turns (as recorded and mirrored); his hands in his root space.",
+             f"His higher hand's peak in the {PEAK:g} s before her turn completes: median {np.median(highest):.2f} m "
+             f"(10-90 %: {np.percentile(highest, 10):.2f}-{np.percentile(highest, 90):.2f}); above {HAND_RAISED:g} m "
+             f"in {100 * (highest > HAND_RAISED).mean():.0f} % of her turns, against {100 * (every[..., 1].max(-1) > HAND_RAISED).mean():.0f} % "
+             f"of all his frames."]
+    for direction, name in ((1, "to her left (+1)"), (-1, "to her right (-1)")):
+        h = np.stack(around[direction])[:, peak]                       # [turns, frames, 2, 3]
+        flat = h[..., 1].reshape(len(h), -1).argmax(1)
+        frame, hand = np.unravel_index(flat, h.shape[1:3])
+        at = h[np.arange(len(h)), frame, hand]                           # [turns, 3]
+        left = hand == 0
+        seconds = (frame + peak.start + start) / FPS
+        signs = np.array([np.sign(winding(x)) for x in np.stack(around[direction])[:, wind]])
+        lines.append(f"Her turns {name}: {len(h)}; the peak {-np.median(seconds):.2f} s before completion (median); "
+                     f"the left hand's in {100 * left.mean():.0f} %, at ({', '.join(f'{v:.2f}' for v in at[left].mean(0))}) m, "
+                     f"the right hand's at ({', '.join(f'{v:.2f}' for v in at[~left].mean(0))}) m; the hand winds "
+                     f"negative in {100 * (signs < 0).mean():.0f} % over the last {WIND:g} s.")
+    return lines
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m training.evaluation.recorded_leads", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    add_folder(ap, "data", "BVH couples")
+    args = ap.parse_args(argv)
+    try:
+        around, every = hands_around_turns(args.data)
+    except DataError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+    if not around[1] or not around[-1]:
+        print(f"error: {args.data}: no recorded turn of both directions to read a lead from", file=sys.stderr)
+        return 2
+    print("\n".join(report(around, every)))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
