@@ -53,7 +53,8 @@ def test_the_led_turn_is_the_leaders_figure_beside_the_follower_intention(prepar
     leader = load_split(str(prepared3), "train", "leader")
     assert led["intention"].shape[1] == feat.INTENTION_SIZE + feat.KEYS
     np.testing.assert_array_equal(led["intention"][:, :feat.INTENTION_SIZE], plain["intention"])
-    np.testing.assert_array_equal(led["intention"][:, feat.INTENTION_SIZE:], leader["input"][:, -feat.KEYS:])
+    fig = feat.block_slices(feat.LEADER_INPUT_LAYOUT)["figure"]
+    np.testing.assert_array_equal(led["intention"][:, feat.INTENTION_SIZE:], leader["input"][:, fig][:, 1:])
     # Somewhere in the takes the follower turns: the label is not all zeros.
     assert np.abs(led["intention"][:, -1]).max() > 0.5
     stats = with_led_turn(load_stats(str(prepared3), "follower"), feat.KEYS)

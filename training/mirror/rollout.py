@@ -47,15 +47,16 @@ TURN_SECONDS = 1.2         # s
 REQUEST_SECONDS = 2.5      # s
 # The request also becomes his hands plan (features.hands_plan_block): his lead hand (the left for
 # her turn to the left, +1, the right for -1) rises above his head and comes down again, the other
-# stays where it was. In the recording his higher hand peaks above 1.6 m in 84 % of her turns
-# (median 1.83 m; in 17 % of all frames), a third of a second before the turn completes: the left
-# hand for 60 % of her turns to the left, at (0.02, 1.80, 0.28) m in his root space (x to his left,
-# z ahead), the right hand mirrored for her turns to the right (training.evaluation.recorded_leads). RAISE: (start, up, start down,
-# down) in s after the request; the raise is held while she turns. The plan asks 1.90 m, above the
-# recorded 1.80: the network stops short of a planned hand (a median 1.76 m asked for 1.90; asked
-# for 1.80 and held to 1.6 s, his hand passed 1.6 m in 61 % of requests, for 1.90 and 1.8 s in 80 %).
-# In the recording the hand also circles the way she turns; a planned circle (12 or 25 cm) left
-# his hand's path as it was, so the plan holds none (docs/results.md, "The hands plan").
+# stays where it was. In the recording (training.evaluation.recorded_leads) his higher hand peaks
+# above 1.6 m in 84 % of her turns (median 1.83 m; in 17 % of all frames), a third of a second
+# before the turn completes: the left hand for 60 % of her turns to the left, at (0.02, 1.80, 0.28)
+# m in his root space (x to his left, z ahead), the right hand mirrored for her turns to the right.
+# RAISE: (start, up, start down, down) in s after the request; the raise is held while she turns.
+# The plan asks 1.90 m, above the recorded 1.80: the network stops short of a planned hand (a median
+# 1.76 m asked for 1.90; asked for 1.80 and held to 1.6 s, his hand passed 1.6 m in 61 % of
+# requests, for 1.90 and 1.8 s in 80 %). In the recording the hand also circles the way she turns; a
+# planned circle (12 or 25 cm) left his hand's path as it was, so the plan holds none
+# (docs/results.md, "The hands plan").
 LEAD_HAND_RAISED = (0.02, 1.90, 0.28)  # m, the left hand, root space
 RAISE = (0.1, 0.5, 1.8, 2.3)           # s
 
