@@ -27,7 +27,7 @@ export class Fetcher {
   readonly wasm: Promise<WebAssembly.Module>;
   /** Resolves with the worker's first message: it runs, and its downloads have begun. */
   readonly started: Promise<void>;
-  /** Files the worker fetched (its own resource timing), as of its last delivered model. */
+  /** Files the worker fetched (its own resource timing), as of its last message with a list (the wasm, a model). */
   files: FetchedFile[] = [];
   /** Every download asked for so far is in (its last byte; the wasm may still be compiling). */
   done = false;
@@ -95,6 +95,7 @@ export class Fetcher {
         bootMark(message.stage, message.at - performance.timeOrigin);
         break;
       case 'wasm':
+        this.files = message.files;
         this.compiled.resolve(message.module);
         break;
       case 'model':

@@ -50,7 +50,9 @@ const slots = new DownloadSlots();
 const wasm = loadWasm(progress, slots);
 bootSpan('download:wasm', () => wasm.received);
 bootSpan('compile:wasm', () => wasm.module).then(
-  (module) => post({ type: 'wasm', module }),
+  // The files so far go with it too: a model that arrived before the wasm had finished could not
+  // name it, and the page keeps the last list it was sent (fetcher.ts).
+  (module) => post({ type: 'wasm', module, files: fetchedFiles() }),
   (error) => post(failure('wasm', error)),
 );
 

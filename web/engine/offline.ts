@@ -102,7 +102,7 @@ async function workerOf(version: string): Promise<ServiceWorker | null> {
  */
 export function keepForOffline(version: string, fetchedElsewhere: string[] = []): void {
   if (!available()) return;
-  // The wasm by name too: the fetcher worker lists its files as of its last model, and on a fast
+  // The wasm by name too: the fetcher worker lists its files as of its last message, and on a fast
   // link the wasm's own entry can come after that (its body is read by the compiler); without it
   // the repeat visit downloaded the wasm again (tests/e2e/offline.test.mjs failed once in two runs).
   const urls = [location.href, new URL(WASM_URL, location.href).href,

@@ -26,8 +26,8 @@ export type FromWorker =
   | { type: 'progress'; loaded: number; total: number; sized: boolean }
   /** A boot stage (boot.ts) reached in the worker; `at`: ms since the epoch (timeOrigin + now). */
   | { type: 'mark'; stage: string; at: number }
-  /** onnxruntime's wasm, compiled. */
-  | { type: 'wasm'; module: WebAssembly.Module }
+  /** onnxruntime's wasm, compiled, and what the worker fetched so far. */
+  | { type: 'wasm'; module: WebAssembly.Module; files: FetchedFile[] }
   /** A model file's bytes (checked against the manifest), and what the worker fetched so far. */
   | { type: 'model'; name: string; bytes: Uint8Array; files: FetchedFile[] }
   /** The wasm (`name` 'wasm') or a model could not be loaded: a DuetError's title and detail. */
