@@ -407,7 +407,9 @@ const handsWorld = new Float64Array(HANDS.length * 3);
 /** His hands (left, right) in his root space now, into out [2 × 3]. */
 function handsInRootSpace(leader: Dancer, out: Float64Array): void {
   const p = leader.positions;
-  HANDS.forEach((j, i) => handsWorld.set(p.subarray(3 * j, 3 * j + 3), 3 * i));
+  for (let i = 0; i < HANDS.length; i++) {
+    for (let c = 0; c < 3; c++) handsWorld[3 * i + c] = p[3 * HANDS[i] + c];
+  }
   toRootSpacePoints(handsWorld, 0, HANDS.length, leader.rootX, leader.rootZ, leader.heading, out, 0);
 }
 
