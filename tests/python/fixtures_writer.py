@@ -469,9 +469,15 @@ def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_o
     sunk[pose.start + 1] -= 0.5
     outputs = np.stack(upright + [tipped, sunk])
     ranges = {"hip_low": 0.95, "head_above_hip_low": 0.5, "feet_wide": 1.07, "angle_high": [2.5, 0.59]}  # this body's
+    # The leader's head margin: the head over the hips let off 0.04 m, under a range whose head part
+    # binds for the upright bodies (so the slack shows).
+    tight = {**ranges, "head_above_hip_low": 0.75}
     uprightness = {"outputs": exact(outputs), "ranges": ranges,
                    "margins": out7(G.upright_margin(outputs, ranges, follow_offsets)),
-                   "best": G.most_upright(outputs, ranges, follow_offsets)}
+                   "best": G.most_upright(outputs, ranges, follow_offsets),
+                   "tight": tight, "tightMargins": out7(G.upright_margin(outputs, tight, follow_offsets)),
+                   "slackMargins": out7(G.upright_margin(outputs, tight, follow_offsets, 0.04)),
+                   "handsPlanShown": G.HANDS_PLAN_SHOWN}
     return {
         "NOW": ro.NOW, "TRACK_FRAMES": ro.TRACK_FRAMES, "guards": guards, "upright": uprightness,
         "rotationsFromVectors": {"forward": exact(vectors_f), "up": exact(vectors_u),

@@ -54,6 +54,9 @@ def test_the_leader_is_guarded_as_the_manifest_says():
     lead = O.leader_policy(policy, m, args)
     # His own variety stays the duet's (the leader's temperature); the margin is the manifest's.
     assert isinstance(lead, UprightGuard) and lead.samples == 8 and lead.temperature is None and lead.margin == 0.1
+    assert lead.head_margin is None                       # a manifest without headMargin: the one margin
+    head = manifest(leaderTemperature=0.5, leaderGuard={"samples": 8, "margin": 0.07, "headMargin": 0.03})
+    assert O.leader_policy(policy, head, args).head_margin == 0.03
     off = parse("--leader-guard", "0")
     assert O.resolve(off, m) is None and O.leader_policy(policy, m, off) is policy
     old = parse()

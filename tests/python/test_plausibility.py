@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 import numpy as np
+import pytest
 import torch
 
 from training.evaluation import plausibility as P
@@ -223,3 +224,54 @@ def test_seeds_runs_the_guard_and_refuses_a_guard_of_one(exported, data3, tmp_pa
     assert "upright guard (training/mirror/guard.py): 4 samples" in (tmp_path / "g" / "seeds.md").read_text()
     assert seeds.main(base + ["--guard", "1", "--out", str(tmp_path / "o")]) == 2
     assert "--guard 1" in capsys.readouterr().err
+
+
+def test_the_leaders_guard_judges_his_head_from_its_own_margin_except_while_he_leads():
+    """guard.slack_for and UprightGuard(head_margin=...): the leader's head over his hips is judged
+    from the smaller head margin (a narrow range: at the full margin the guard kept his stiffest
+    sample), but while his input shows a hands plan (a request runs) from the full one."""
+    from training.evaluation.plausibility import CHEST
+    from training.mirror.guard import HANDS_PLAN_SHOWN, POSE, UprightGuard, slack_for, upright_margin
+    from training.mirror.skeleton import HEAD
+
+    r = {"hip_low": 0.7, "head_above_hip_low": 0.6, "feet_wide": 1.0, "angle_high": [3.0, 0.6]}
+
+    def output(head_over_hip: float) -> np.ndarray:
+        out = np.zeros(feat.OUTPUT_SIZE, np.float32)
+        pose = out[POSE].reshape(feat.N_JOINTS, 12)
+        pose[:, 1] = 1.0                          # hips 0.3 m above their low: only the head can bind
+        pose[CHEST, 1] = 1.4                      # the chest straight above the hips
+        pose[HEAD, 1] = 1.0 + head_over_hip
+        out[POSE] = pose.reshape(-1)
+        return out
+
+    bent = output(0.64)                           # 0.04 m above the head's low end
+    assert np.allclose(upright_margin(bent, r), [0.04], atol=1e-6)
+    assert np.allclose(upright_margin(bent, r, head_slack=0.05), [0.09], atol=1e-6)
+    # The hips' part is not let off: a body whose hips are low stays low whatever the slack.
+    low = output(0.7)
+    low[POSE.start + 1] = 0.72
+    assert upright_margin(low, r, head_slack=1.0)[0] < 0.05
+
+    unasked = np.zeros(feat.LEADER_INPUT_SIZE, np.float32)
+    leading = unasked.copy()
+    leading[HANDS_PLAN_SHOWN] = 1.0
+    assert slack_for(unasked, 0.07, 0.03) == pytest.approx(0.04)
+    assert slack_for(leading, 0.07, 0.03) == 0.0
+    assert slack_for(unasked, 0.07, None) == 0.0
+    assert slack_for(np.zeros(feat.INPUT_SIZE), 0.07, 0.03) == pytest.approx(0.04)   # not a leader's input
+
+    calls = []
+
+    def policy(x, temperature, rng):
+        calls.append(len(np.atleast_2d(x)))
+        outs = np.stack([bent if len(calls) == 1 or len(calls) == 2 else output(0.7)] * len(np.atleast_2d(x)))
+        return {"output": outs}
+
+    guard = UprightGuard(policy, r, samples=4, margin=0.07, head_margin=0.03)
+    rng = np.random.default_rng(0)
+    guard(unasked, 0.5, rng)                      # 0.04 above the low end, the head margin 0.03: passes
+    assert guard.guarded == 0 and calls == [1]
+    chosen = guard(leading, 0.5, rng)             # leading: judged from 0.07, so the batch is drawn
+    assert guard.guarded == 1 and calls == [1, 1, 4]
+    assert chosen["output"][0][POSE][HEAD * 12 + 1] == pytest.approx(1.7)

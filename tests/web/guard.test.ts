@@ -1,14 +1,14 @@
 // web/mirror/guard.ts against training/mirror/guard.py: the upright margin of follower outputs judged
 // on the body they draw (two plausible ones, one tipped over by its rotations while its positions
-// stand, one sunk by its hip), and the choice of the most upright.
+// stand, one sunk by its hip), and the choice of the most upright; the leader's head margin.
 
 import { describe, expect, it } from 'vitest';
-import { OUTPUT_SIZE } from '../../web/mirror/features';
-import { mostUpright, uprightMargin } from '../../web/mirror/guard';
+import { INPUT_SIZE, LEADER_INPUT_SIZE, OUTPUT_SIZE } from '../../web/mirror/features';
+import { HANDS_PLAN_SHOWN, mostUpright, slackFor, uprightMargin } from '../../web/mirror/guard';
 import { expectClose, fixture } from './fixture';
 
 const data = fixture('rollout');
-const { outputs, ranges, margins, best } = data.upright;
+const { outputs, ranges, margins, best, tight, tightMargins, slackMargins, handsPlanShown } = data.upright;
 const offsets = Float64Array.from(data.offsets.follower);
 
 describe('uprightMargin', () => {
@@ -25,5 +25,27 @@ describe('uprightMargin', () => {
     expect(mostUpright(Float32Array.from(outputs), margins.length, OUTPUT_SIZE, ranges, offsets)).toBe(best);
     const tippedFirst = Float32Array.from([...outputs.slice(2 * OUTPUT_SIZE, 3 * OUTPUT_SIZE), ...outputs.slice(OUTPUT_SIZE, 2 * OUTPUT_SIZE)]);
     expect(mostUpright(tippedFirst, 2, OUTPUT_SIZE, ranges, offsets)).toBe(1);
+  });
+});
+
+describe('the leader guard\'s head margin', () => {
+  it('lets off the head over the hips alone, as Python does', () => {
+    const out = Float32Array.from(outputs);
+    const judged = (slack: number) => margins.map((_: number, i: number) => uprightMargin(out, i * OUTPUT_SIZE, tight, offsets, slack));
+    expectClose(judged(0), tightMargins, 'margins under a range whose head part binds');
+    expectClose(judged(0.04), slackMargins, 'the same with 0.04 m of head slack');
+    expect(slackMargins[0]).toBeCloseTo(tightMargins[0] + 0.04, 5); // the head part was binding
+    expect(slackMargins[3]).toBeLessThan(0); // the sunk body stays low
+  });
+
+  it('is let off unless his input shows a hands plan (he leads a turn), and only with a headMargin', () => {
+    expect(HANDS_PLAN_SHOWN).toBe(handsPlanShown);
+    const settings = { samples: 8, margin: 0.07, headMargin: 0.03 };
+    const input = new Float32Array(LEADER_INPUT_SIZE);
+    expect(slackFor(input, settings)).toBeCloseTo(0.04, 12);
+    input[HANDS_PLAN_SHOWN] = 1;
+    expect(slackFor(input, settings)).toBe(0);
+    expect(slackFor(new Float32Array(LEADER_INPUT_SIZE), { samples: 8, margin: 0.07 })).toBe(0);
+    expect(slackFor(new Float32Array(INPUT_SIZE).fill(1), settings)).toBeCloseTo(0.04, 12); // not a leader's input
   });
 });

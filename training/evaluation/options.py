@@ -69,12 +69,14 @@ def follower_policy(policy, manifest: dict, args, leader_temperature: float):
 
 def leader_policy(policy, manifest: dict, args):
     """The leader's policy as the (resolved) options ask: guarded like the follower (at the
-    manifest's leaderGuard margin, judging the body his bones draw), or as it is."""
+    manifest's leaderGuard margin, his head over his hips at its headMargin when it has one,
+    judging the body his bones draw), or as it is."""
     samples = getattr(args, "leader_guard", 0) or 0
     if samples and manifest.get("plausibility"):
-        margin = float((manifest.get("leaderGuard") or {}).get("margin", 0.0))
-        return UprightGuard(policy, manifest["plausibility"], samples, None, margin,
-                            manifest["skeleton"]["offsets"]["leader"])
+        settings = manifest.get("leaderGuard") or {}
+        head = settings.get("headMargin")
+        return UprightGuard(policy, manifest["plausibility"], samples, None, float(settings.get("margin", 0.0)),
+                            manifest["skeleton"]["offsets"]["leader"], None if head is None else float(head))
     return policy
 
 

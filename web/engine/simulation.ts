@@ -9,7 +9,7 @@ import { FUTURE_OFFSETS, INPUT_SIZE, INTENTION_SIZE, KEYS, OUTPUT_SIZE, follower
 import { KEY_JOINTS, type Motion, POSITIONS_SIZE, ROTATIONS_SIZE } from '../mirror/skeleton';
 import { ContactLayer, FOLLOWER_CONTACT } from '../mirror/contact';
 import { FootLock } from '../mirror/footik';
-import { type GuardSettings, type Ranges, mostUpright, uprightMargin } from '../mirror/guard';
+import { type GuardSettings, type Ranges, mostUpright, slackFor, uprightMargin } from '../mirror/guard';
 import { LeaderPlayback } from './playback';
 import { StepTimer } from './timing';
 import {
@@ -196,13 +196,14 @@ export class DuetSimulation implements Simulation {
     const guard = this.leaderGuard;
     if (!guard) return;
     const offsets = this.duet.leader.offsets;
-    if (uprightMargin(this.leaderOutput, 0, guard.ranges, offsets) >= guard.settings.margin) return;
-    const k = guard.settings.samples;
     const policy = this.leaderPolicy;
+    const slack = slackFor(policy.input, guard.settings);
+    if (uprightMargin(this.leaderOutput, 0, guard.ranges, offsets, slack) >= guard.settings.margin) return;
+    const k = guard.settings.samples;
     const input = policy.batchInput(k);
     for (let n = 0; n < k; n++) input.set(policy.input, n * policy.input.length);
     const { output } = await policy.runBatch(k, temperature);
-    const best = mostUpright(output, k, OUTPUT_SIZE, guard.ranges, offsets);
+    const best = mostUpright(output, k, OUTPUT_SIZE, guard.ranges, offsets, slack);
     this.leaderOutput.set(output.subarray(best * OUTPUT_SIZE, (best + 1) * OUTPUT_SIZE));
     this.upright++;
   }

@@ -6,9 +6,12 @@
 // recording's steepest), the page runs the same input again with fresh Gumbel draws and takes the
 // most upright sample (simulation.ts). Every candidate is one step on from the same state, so the
 // body never jumps; the guard only chooses among the network's own reactions. Measured in Python:
-// it chose in 210 of 1.8 M follower steps of the 100 x 10 min soak (docs/reliability.md).
+// it chose in 210 of 1.8 M follower steps of the 100 x 10 min soak (docs/reliability.md). The
+// leader's guard judges his head over his hips from a smaller margin (headMargin) except while he
+// leads a turn: at the full margin that narrow range made it pick his stiffest sample in a quarter
+// of his steps (guard.py, LEADER_HEAD_MARGIN).
 
-import { N_JOINTS, OUTPUT_LAYOUT, blockSlices } from './features';
+import { LEADER_INPUT_LAYOUT, LEADER_INPUT_SIZE, N_JOINTS, OUTPUT_LAYOUT, blockSlices } from './features';
 import { MIN_ANKLE_HEIGHT, rotationsFromVectors } from './rollout';
 import { FEET, HEAD, forwardKinematicsReduced } from './skeleton';
 
@@ -28,9 +31,13 @@ export interface Ranges {
 export interface GuardSettings {
   samples: number;
   margin: number;
+  /** The leader's: metres before the edge of the head over the hips (a narrow range) it acts. */
+  headMargin?: number;
 }
 
 const POSE = blockSlices(OUTPUT_LAYOUT).pose;
+/** The leader input's column that is 1 while a request runs (the hands plan's "shown"). */
+export const HANDS_PLAN_SHOWN = blockSlices(LEADER_INPUT_LAYOUT).hands_plan.start;
 const forward = new Float64Array(3 * N_JOINTS);
 const up = new Float64Array(3 * N_JOINTS);
 const rotations = new Float64Array(9 * N_JOINTS);
@@ -41,8 +48,9 @@ const joints = new Float64Array(3 * N_JOINTS);
  * hips, head over hips, feet apart and the torso's lean (negative: that far outside). The pose is
  * in the next root's space, whose y is the height above the floor; the lean is how far the chest
  * may still move sideways over the hips before the torso leans more than the recording's steepest.
+ * `headSlack` metres are added to the head-over-hips part alone.
  */
-export function uprightMargin(output: ArrayLike<number>, at: number, r: Ranges, offsets: ArrayLike<number>): number {
+export function uprightMargin(output: ArrayLike<number>, at: number, r: Ranges, offsets: ArrayLike<number>, headSlack = 0): number {
   const pose = at + POSE.start;
   for (let j = 0; j < N_JOINTS; j++) {
     for (let k = 0; k < 3; k++) {
@@ -66,15 +74,25 @@ export function uprightMargin(output: ArrayLike<number>, at: number, r: Ranges, 
   const tz = joints[3 * CHEST + 2] - joints[2];
   const sideways = Math.hypot(tx, tz);
   const allowed = Math.hypot(tx, ty, tz) * Math.sin(r.angle_high[r.angle_high.length - 1]);
-  return Math.min(hip - r.hip_low, head - hip - r.head_above_hip_low, r.feet_wide - feet, allowed - sideways);
+  return Math.min(hip - r.hip_low, head - hip - r.head_above_hip_low + headSlack, r.feet_wide - feet, allowed - sideways);
+}
+
+/**
+ * Metres a guard lets off the head-over-hips part for this input: margin - headMargin; none when
+ * it has no headMargin, or while the input is a leader's that shows a hands plan (he leads a turn).
+ */
+export function slackFor(input: ArrayLike<number>, settings: GuardSettings): number {
+  if (settings.headMargin === undefined) return 0;
+  if (input.length === LEADER_INPUT_SIZE && input[HANDS_PLAN_SHOWN] >= 0.5) return 0;
+  return settings.margin - settings.headMargin;
 }
 
 /** The index of the most upright of `count` outputs laid one after another from output[0..]. */
-export function mostUpright(output: ArrayLike<number>, count: number, size: number, r: Ranges, offsets: ArrayLike<number>): number {
+export function mostUpright(output: ArrayLike<number>, count: number, size: number, r: Ranges, offsets: ArrayLike<number>, headSlack = 0): number {
   let best = 0;
   let bestMargin = -Infinity;
   for (let i = 0; i < count; i++) {
-    const m = uprightMargin(output, i * size, r, offsets);
+    const m = uprightMargin(output, i * size, r, offsets, headSlack);
     if (m > bestMargin) {
       best = i;
       bestMargin = m;
