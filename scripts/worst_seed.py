@@ -3,14 +3,15 @@ training.evaluation.seeds, with the contact layer): the 6 s with most follower f
 that the worst seed of a seeds table can be looked at, not only counted.
 
     PYTHONPATH=. .venv/bin/python scripts/worst_seed.py SEED OUT.png [--models DIR] [--flag angles_out|body]
-        [--seconds 60] [--temperature T --follower-temperature T --guard K --guard-margin M]
+        [--seconds 60] [--dancer follower|leader] [--temperature T --follower-temperature T --guard K --guard-margin M]
 
 The variety and guard options are training.evaluation.options' (default: the manifest's, as the
 page dances); with --seconds 600 a seed is the soak's rollout of that seed.
 
 --flag angles_out (default): joint angles out of the recorded range; body: hips low, head low or
 feet wide (plausibility.BODY_FLAGS, what a bad second counts); guarded: the steps in which the
-upright guard took another sample (what it caught, to look at).
+upright guard took another sample (what it caught, to look at). --dancer leader: his flags, not hers
+(guarded: still the follower's guard).
 """
 import argparse
 
@@ -32,6 +33,7 @@ ap.add_argument("out")
 ap.add_argument("--models", default="public/models")
 ap.add_argument("--flag", choices=["angles_out", "body", "guarded"], default="angles_out")
 ap.add_argument("--seconds", type=float, default=60.0)
+ap.add_argument("--dancer", choices=["follower", "leader"], default="follower", help="whose flags choose the 6 s")
 O.add_options(ap)
 args = ap.parse_args()
 
@@ -56,7 +58,7 @@ def noted(x, temperature, rng):
 noted.frame = 0
 soak_one(manifest, O.leader_policy(load_onnx(leader), manifest, args), noted, args.seed, int(args.seconds * FPS), args.temperature, rec)
 L, F = rec["leader_shown"], rec["follower_shown"]
-flags = P.frame_flags(F, manifest["plausibility"])
+flags = P.frame_flags(F if args.dancer == "follower" else L, manifest["plausibility"])
 flags["guarded"] = np.isin(np.arange(len(F)), chosen)
 bad = (P.body_flagged(flags) if args.flag == "body" else flags[args.flag]).astype(float)
 label = {"body": "body low, folded or split", "guarded": "guard chose"}.get(args.flag, "angle out")
@@ -72,7 +74,7 @@ for k, ax in enumerate(axes.flat):
     ax.set_xlim(-1.2, 1.2); ax.set_ylim(0, 1.9); ax.set_aspect("equal"); ax.set_xticks([]); ax.set_yticks([])
     # Flagged within the half second this frame stands for (a guard's choice is a single step).
     ax.set_title(f"t={t / FPS:.1f} s{'  ' + label if bad[t:t + FPS // 2].any() else ''}", fontsize=9)
-fig.suptitle(f"{args.models}, steered seed {args.seed}" + (f" (guard K={args.guard}, {args.guard_margin:g} m)" if args.guard else "") + ": the 6 s with most follower frames flagged "
+fig.suptitle(f"{args.models}, steered seed {args.seed}" + (f" (guard K={args.guard}, {args.guard_margin:g} m)" if args.guard else "") + f": the 6 s with most {args.dancer} frames flagged "
              f"({label}), side view (x, height), a frame every 0.5 s")
 fig.tight_layout()
 fig.savefig(args.out, dpi=80)

@@ -159,7 +159,8 @@ def write_manifest(out: Path, models: dict[str, StepModel], data: str, prepared:
         # The follower's upright guard (training/mirror/guard.py, web/mirror/guard.ts).
         "guard": {"samples": GUARD_SAMPLES, "margin": GUARD_MARGIN},
         # ... and the leader's (the same guard with its own margin).
-        "leaderGuard": {"samples": LEADER_SAMPLES, "margin": LEADER_MARGIN, "headMargin": LEADER_HEAD_MARGIN},
+        "leaderGuard": {"samples": LEADER_SAMPLES, "margin": LEADER_MARGIN,
+                        **({} if LEADER_HEAD_MARGIN is None else {"headMargin": LEADER_HEAD_MARGIN})},
         # The training dancers' range (evaluation.plausibility): soak counts a collapse against it
         # and training.evaluation.seeds judges every steered frame against it.
         "plausibility": plausibility_ranges(prepared),
