@@ -40,12 +40,11 @@ describe('the leader guard\'s head margin', () => {
 
   it('is let off unless his input shows a hands plan (he leads a turn), and only with a headMargin', () => {
     expect(HANDS_PLAN_SHOWN).toBe(handsPlanShown);
-    const settings = { samples: 8, margin: 0.07, headMargin: 0.03 };
     const input = new Float32Array(LEADER_INPUT_SIZE);
-    expect(slackFor(input, settings)).toBeCloseTo(0.04, 12);
+    expect(slackFor(input, 0.07, 0.03)).toBeCloseTo(0.04, 12);
     input[HANDS_PLAN_SHOWN] = 1;
-    expect(slackFor(input, settings)).toBe(0);
-    expect(slackFor(new Float32Array(LEADER_INPUT_SIZE), { samples: 8, margin: 0.07 })).toBe(0);
-    expect(slackFor(new Float32Array(INPUT_SIZE).fill(1), settings)).toBeCloseTo(0.04, 12); // not a leader's input
+    expect(slackFor(input, 0.07, 0.03)).toBe(0);
+    expect(slackFor(new Float32Array(LEADER_INPUT_SIZE), 0.07)).toBe(0);
+    expect(slackFor(new Float32Array(INPUT_SIZE).fill(1), 0.07, 0.03)).toBeCloseTo(0.04, 12); // not a leader's input
   });
 });

@@ -197,7 +197,7 @@ export class DuetSimulation implements Simulation {
     if (!guard) return;
     const offsets = this.duet.leader.offsets;
     const policy = this.leaderPolicy;
-    const slack = slackFor(policy.input, guard.settings);
+    const slack = slackFor(policy.input, guard.settings.margin, guard.settings.headMargin);
     if (uprightMargin(this.leaderOutput, 0, guard.ranges, offsets, slack) >= guard.settings.margin) return;
     const k = guard.settings.samples;
     const input = policy.batchInput(k);

@@ -6,10 +6,10 @@
 // recording's steepest), the page runs the same input again with fresh Gumbel draws and takes the
 // most upright sample (simulation.ts). Every candidate is one step on from the same state, so the
 // body never jumps; the guard only chooses among the network's own reactions. Measured in Python:
-// it chose in 210 of 1.8 M follower steps of the 100 x 10 min soak (docs/reliability.md). The
-// leader's guard judges his head over his hips from a smaller margin (headMargin) except while he
-// leads a turn: at the full margin that narrow range made it pick his stiffest sample in a quarter
-// of his steps (guard.py, LEADER_HEAD_MARGIN).
+// it chose in 210 of 1.8 M follower steps of the 100 x 10 min soak (docs/reliability.md). A
+// manifest's leaderGuard.headMargin judges the leader's head over his hips from a smaller margin,
+// except while he leads a turn; the shipped manifest has none (with it his partner fell in the
+// soak: guard.py, LEADER_HEAD_MARGIN).
 
 import { LEADER_INPUT_LAYOUT, LEADER_INPUT_SIZE, N_JOINTS, OUTPUT_LAYOUT, blockSlices } from './features';
 import { MIN_ANKLE_HEIGHT, rotationsFromVectors } from './rollout';
@@ -81,10 +81,10 @@ export function uprightMargin(output: ArrayLike<number>, at: number, r: Ranges, 
  * Metres a guard lets off the head-over-hips part for this input: margin - headMargin; none when
  * it has no headMargin, or while the input is a leader's that shows a hands plan (he leads a turn).
  */
-export function slackFor(input: ArrayLike<number>, settings: GuardSettings): number {
-  if (settings.headMargin === undefined) return 0;
+export function slackFor(input: ArrayLike<number>, margin: number, headMargin?: number): number {
+  if (headMargin === undefined) return 0;
   if (input.length === LEADER_INPUT_SIZE && input[HANDS_PLAN_SHOWN] >= 0.5) return 0;
-  return settings.margin - settings.headMargin;
+  return margin - headMargin;
 }
 
 /** The index of the most upright of `count` outputs laid one after another from output[0..]. */
