@@ -75,6 +75,13 @@ class TrainConfig:
     # with its own weight; the interaction term skips them (their recorded distances are moot).
     proximity_share: float = 0.0
     lambda_proximity: float = 0.0
+    # Follower: this share of samples has the partner's whole body lowered by up to
+    # `partner_lowered_depth` metres (lower_partner), the target still her recorded next frame.
+    # Our leader lunges deeper and more often than the recorded one, and she followed him down and
+    # fell (docs/results.md, "She follows his lunge down"); lowered, he teaches her that his height
+    # alone does not take her to the floor. The body terms skip these samples, as the moved ones.
+    partner_lowered_share: float = 0.0
+    partner_lowered_depth: float = 0.0
     # Std of Gaussian noise (in normalized units) on the dancer's own past and pose in the input,
     # the target staying the recorded next frame: at run time those blocks are the model's own
     # earlier outputs, and a model that only ever saw recorded ones has never learnt to come back
@@ -204,6 +211,12 @@ MODELS = {
     # no difference the 6 folds can show (docs/results.md, "Turn timing").
     "follower_led_turn": replace(steady(OURS), model=replace(steady(OURS).model, turn_keys=feat.KEYS),
                                  state_dropout=0.5, turn_weight=4.0, own_rollouts_from=10),
+    # Measured, not shipped (docs/results.md, "She follows his lunge down"): his body lowered by up
+    # to 0.15 m in a quarter of her samples (TrainConfig.partner_lowered_share). Beside the leader
+    # with room for his head she still followed his lunges down: the soak's first 4 seeds from 0
+    # and from 50 all fell (the shipped follower: 0 of those 8).
+    "follower_lowered": replace(steady(OURS), state_dropout=0.5, turn_weight=4.0, own_rollouts_from=10,
+                                partner_lowered_share=0.25, partner_lowered_depth=0.15),
     # The followers shipped until then (no own rollouts, no turn weight).
     "follower_before_own": replace(steady(OURS), state_dropout=0.5),
     "follower_ccm_before_own": replace(steady(CCM), state_dropout=0.5),
@@ -407,6 +420,22 @@ def move_partner_closer(x: torch.Tensor, share: float, gen: torch.Generator) -> 
     return x, moved
 
 
+def lower_partner(x: torch.Tensor, share: float, depth: float, gen: torch.Generator) -> tuple[torch.Tensor, torch.Tensor]:
+    """Follower inputs (raw) -> a copy where `share` of the samples have every partner height (key
+    joints, pose) lowered by one amount drawn from [0, depth] m; his path on the floor, directions
+    and velocities stay. Returns (x, lowered mask)."""
+    sl = feat.block_slices(feat.FOLLOWER_INPUT_LAYOUT)
+    b = len(x)
+    lowered = torch.rand(b, generator=gen) < share
+    drop = torch.where(lowered, depth * torch.rand(b, generator=gen), torch.zeros(b))
+    x = x.clone()
+    for block, width in (("partner_key_joints_past", 3), ("partner_pose", 12)):
+        part = x[:, sl[block]].reshape(b, -1, width)
+        part[..., 1] -= drop[:, None]
+        x[:, sl[block]] = part.reshape(b, -1)
+    return x, lowered
+
+
 ONSET_FUTURE_DEGREES = 180.0   # the dancer's own heading turns this much over the next second ...
 ONSET_PAST_DEGREES = 90.0      # ... after turning less than this over the last one
 
@@ -520,9 +549,9 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
 
     def inputs(idx, proximity: bool = False):
         """Normalized inputs of a batch as the networks read them (with state noise), which samples
-        had their partner moved closer, and the inputs without noise (what the body terms compare
+        had their partner moved closer, which had him moved at all (closer or lowered), and the inputs without noise (what the body terms compare
         the decoded pose with: the pose the dancer really was in)."""
-        x, moved = xr[idx], None
+        x, moved, altered = xr[idx], None, None
         if role == "leader" and cfg.control_noise + cfg.control_rotation > 0:
             x = augment_control(x, cfg, gen)
         if role == "leader" and cfg.figure_dropout > 0:
@@ -533,12 +562,16 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
             x = hide_block(x, "hands_plan", cfg.hands_plan_dropout, gen)
         if proximity and role == "follower" and cfg.proximity_share > 0:
             x, moved = move_partner_closer(x, cfg.proximity_share, gen)
+            altered = moved
+        if proximity and role == "follower" and cfg.partner_lowered_share > 0:
+            x, lowered = lower_partner(x, cfg.partner_lowered_share, cfg.partner_lowered_depth, gen)
+            altered = lowered if altered is None else altered | lowered
         clean = ((x - stats["input_mean"]) / stats["input_std"]).to(device)
         if cfg.state_noise == 0:
-            return clean, moved, clean
+            return clean, moved, altered, clean
         noisy = clean.clone()
         noisy[:, own] += cfg.state_noise * torch.randn(len(noisy), len(own), generator=gen).to(device)
-        return noisy, moved, clean
+        return noisy, moved, altered, clean
 
     def save(stage_, epoch_):
         if rank == 0:
@@ -629,7 +662,7 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
             for o in (opt_g, opt_d):
                 for g in o.param_groups:
                     g["lr"] = lr
-            (x, moved, x_clean), yb = inputs(idx, proximity=True), y[idx].to(device)
+            (x, moved, altered, x_clean), yb = inputs(idx, proximity=True), y[idx].to(device)
             intention, extra = None, 0.0
             if mcfg.intention:
                 if cfg.end_to_end:
@@ -662,7 +695,7 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
                 l_r, l_c = (w * (recon - yb) ** 2).mean(), (w * (code - code_hat) ** 2).mean()
             loss = cfg.lambda_reconstruction * l_r + cfg.lambda_codebook * l_c + extra
             if any(partner_weights.values()):
-                keep = slice(None) if moved is None else ~moved.to(device)   # recorded relations only
+                keep = slice(None) if altered is None else ~altered.to(device)   # recorded relations only
                 off = offsets[mirrored[idx]]
                 terms = partner_terms(raw(recon[keep], "output"), raw(yb[keep], "output"), raw(x_clean[keep], "input"),
                                       off[keep], role, cfg.recorded_contacts,
