@@ -31,7 +31,6 @@ if str(REPO) not in sys.path:      # run as a script from anywhere
 from training.mirror import features as feat  # noqa: E402
 from training.mirror import guard as G  # noqa: E402
 from training.mirror import rollout as ro  # noqa: E402
-from training.mirror import view as V  # noqa: E402
 from training.mirror.contact import ContactLayer  # noqa: E402
 from training.mirror.bvh import BvhError, forward_kinematics, local_transforms, parse_bvh  # noqa: E402
 from training.mirror.features import Track  # noqa: E402
@@ -478,20 +477,12 @@ def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_o
                    "best": G.most_upright(outputs, ranges, follow_offsets),
                    "tight": tight, "tightMargins": out7(G.upright_margin(outputs, tight, follow_offsets)),
                    "slackMargins": out7(G.upright_margin(outputs, tight, follow_offsets, 0.04)),
+                   # The follower's hip margin: her hips judged 0.1 m further from the edge.
+                   "hipSlackMargins": out7(G.upright_margin(outputs, ranges, follow_offsets, 0.0, -0.1)),
+                   "hipSlackBest": G.most_upright(outputs, ranges, follow_offsets, 0.0, -0.1),
                    "handsPlanShown": G.HANDS_PLAN_SHOWN}
-    # How the follower sees her leader (training/mirror/view.py): a step's input as it is (his hips
-    # above the floor) and with his whole body 0.3 m lower (below it), lifted back to the floor.
-    standing = np.array(steps[0]["followerInput"], float)
-    lunging = V.lift_partner(standing, 0.0)
-    lunging[V.PARTNER_POSE.start + 1:V.PARTNER_POSE.stop:V.POSE_WIDTH] -= 0.3
-    lunging[V.PARTNER_KEY_JOINTS.start + 1:V.PARTNER_KEY_JOINTS.stop:V.KEY_WIDTH] -= 0.3
-    view_inputs = np.stack([standing, lunging])
-    floor = float(standing[V.PARTNER_POSE.start + 1]) - 0.1
-    partner_view = {"inputs": exact(view_inputs), "floor": floor,
-                    "lifts": exact(V.partner_lift(view_inputs, floor)), "lifted": out7(V.lift_partner(view_inputs, floor))}
     return {
         "NOW": ro.NOW, "TRACK_FRAMES": ro.TRACK_FRAMES, "guards": guards, "upright": uprightness,
-        "partnerView": partner_view,
         "rotationsFromVectors": {"forward": exact(vectors_f), "up": exact(vectors_u),
                                  "expected": out7(ro.rotations_from_vectors(vectors_f, vectors_u))},
         "offsets": {"leader": exact(lead_offsets), "follower": exact(follow_offsets)},

@@ -33,6 +33,14 @@ def test_defaults_come_from_the_manifest():
     assert (args.temperature, args.follower_temperature, args.guard, args.guard_margin) == (0.5, 1.0, 8, 0.05)
     f = O.follower_policy(policy, m, args, args.temperature)
     assert isinstance(f, UprightGuard) and f.samples == 8 and f.temperature == 1.0 and f.margin == 0.05
+    assert f.hip_slack == 0.0                               # no hipMargin: her hips from the one margin
+    hips = manifest(leaderTemperature=0.5, guard={"samples": 8, "margin": 0.05, "hipMargin": 0.15})
+    args = parse()
+    assert O.resolve(args, hips) is None and args.guard_hip_margin == 0.15
+    assert O.follower_policy(policy, hips, args, args.temperature).hip_slack == pytest.approx(-0.1)
+    args = parse("--guard-hip-margin", "0.05")
+    assert O.resolve(args, hips) is None and O.follower_policy(policy, hips, args, 0.5).hip_slack == 0.0
+    assert "--guard-hip-margin" in O.resolve(parse("--guard-hip-margin", "-1"), hips)
 
 
 def test_options_override_the_manifest_and_an_old_manifest_has_no_guard():

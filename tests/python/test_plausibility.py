@@ -275,3 +275,42 @@ def test_the_leaders_guard_judges_his_head_from_its_own_margin_except_while_he_l
     chosen = guard(leading, 0.5, rng)             # leading: judged from 0.07, so the batch is drawn
     assert guard.guarded == 1 and calls == [1, 1, 4]
     assert chosen["output"][0][POSE][HEAD * 12 + 1] == pytest.approx(1.7)
+
+
+def test_the_followers_guard_judges_her_hips_from_their_own_margin():
+    """UprightGuard(hip_margin=...): her hips are judged from the larger hip margin, the rest of the
+    body from the guard's margin, and the batch's pick follows the same judgement."""
+    from training.evaluation.plausibility import CHEST
+    from training.mirror.guard import POSE, UprightGuard, most_upright, upright_margin
+    from training.mirror.skeleton import HEAD
+
+    r = {"hip_low": 0.7, "head_above_hip_low": 0.3, "feet_wide": 1.0, "angle_high": [3.0, 0.6]}
+
+    def output(hips: float) -> np.ndarray:
+        out = np.zeros(feat.OUTPUT_SIZE, np.float32)
+        pose = out[POSE].reshape(feat.N_JOINTS, 12)
+        pose[:, 1] = hips                         # the feet together at the hips' place: only the hips can bind
+        pose[CHEST, 1] = hips + 0.4
+        pose[HEAD, 1] = hips + 0.7
+        out[POSE] = pose.reshape(-1)
+        return out
+
+    sinking = output(0.80)                        # 0.10 m above the hips' low end
+    assert np.allclose(upright_margin(sinking, r), [0.10], atol=1e-6)
+    assert np.allclose(upright_margin(sinking, r, hip_slack=-0.1), [0.0], atol=1e-6)
+    assert most_upright(np.stack([sinking, output(0.9), output(0.85)]), r, hip_slack=-0.1) == 1
+
+    calls = []
+
+    def policy(x, temperature, rng):
+        calls.append(len(np.atleast_2d(x)))
+        return {"output": np.stack([sinking] + [output(0.78 + 0.04 * i) for i in range(1, len(np.atleast_2d(x)))])}
+
+    rng = np.random.default_rng(0)
+    plain = UprightGuard(policy, r, samples=4, margin=0.05)
+    assert plain(np.zeros(feat.INPUT_SIZE), 0.5, rng)["output"][0][POSE.start + 1] == pytest.approx(0.80)
+    assert plain.guarded == 0 and calls == [1]    # 0.10 m up: outside the 0.05 m margin
+    hips = UprightGuard(policy, r, samples=4, margin=0.05, hip_margin=0.15)
+    chosen = hips(np.zeros(feat.INPUT_SIZE), 0.5, rng)
+    assert hips.guarded == 1 and calls == [1, 1, 4]   # within 0.15 m: the batch, and its highest hips
+    assert chosen["output"][0][POSE.start + 1] == pytest.approx(0.90)

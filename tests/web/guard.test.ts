@@ -8,7 +8,7 @@ import { HANDS_PLAN_SHOWN, mostUpright, slackFor, uprightMargin } from '../../we
 import { expectClose, fixture } from './fixture';
 
 const data = fixture('rollout');
-const { outputs, ranges, margins, best, tight, tightMargins, slackMargins, handsPlanShown } = data.upright;
+const { outputs, ranges, margins, best, tight, tightMargins, slackMargins, hipSlackMargins, hipSlackBest, handsPlanShown } = data.upright;
 const offsets = Float64Array.from(data.offsets.follower);
 
 describe('uprightMargin', () => {
@@ -25,6 +25,16 @@ describe('uprightMargin', () => {
     expect(mostUpright(Float32Array.from(outputs), margins.length, OUTPUT_SIZE, ranges, offsets)).toBe(best);
     const tippedFirst = Float32Array.from([...outputs.slice(2 * OUTPUT_SIZE, 3 * OUTPUT_SIZE), ...outputs.slice(OUTPUT_SIZE, 2 * OUTPUT_SIZE)]);
     expect(mostUpright(tippedFirst, 2, OUTPUT_SIZE, ranges, offsets)).toBe(1);
+  });
+});
+
+describe('the follower guard\'s hip margin', () => {
+  it('judges her hips alone from further up, as Python does', () => {
+    const out = Float32Array.from(outputs);
+    const got = margins.map((_: number, i: number) => uprightMargin(out, i * OUTPUT_SIZE, ranges, offsets, 0, -0.1));
+    expectClose(got, hipSlackMargins, 'margins with her hips judged 0.1 m further from the edge');
+    expect(got[3]).toBeCloseTo(margins[3] - 0.1, 5); // the sunk body: its hips were what bound
+    expect(mostUpright(out, margins.length, OUTPUT_SIZE, ranges, offsets, 0, -0.1)).toBe(hipSlackBest);
   });
 });
 

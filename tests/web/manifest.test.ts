@@ -53,16 +53,6 @@ describe('validateManifest', () => {
       /^layout\.followerInput is missing; this page expects "partner_trajectory_past" \(24\), /);
   });
 
-  it('refuses a partner floor it cannot read, and takes one it can', () => {
-    expect(refusal((m) => (m.followerView = { partnerHipFloor: -0.1 }))).toBe(
-      'followerView.partnerHipFloor is -0.1, this page expects metres from 0 to 2');
-    expect(refusal((m) => (m.followerView = {} as Manifest['followerView']))).toBe(
-      'followerView.partnerHipFloor is undefined, this page expects metres from 0 to 2');
-    const manifest = shipped();
-    manifest.followerView = { partnerHipFloor: 0.9 };
-    expect(() => validateManifest(manifest)).not.toThrow();
-  });
-
   it('checks the sizes first, as before', () => {
     expect(refusal((m) => (m.layout.input = 600))).toBe('layout.input is 600, this page expects 660');
   });

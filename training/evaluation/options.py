@@ -1,23 +1,20 @@
 """How the evaluation commands run the two dancers: by default as the page does, from the manifest.
 
 The manifest says each dancer's variety (temperature: `leaderTemperature` for the leader model,
-`defaultTemperature` for the follower, the page's "variety" slider), the follower's upright guard
-("guard": samples and margin, training/mirror/guard.py) and how low she sees her leader
-("followerView": partnerHipFloor, training/mirror/view.py). soak, seeds, interaction and
+`defaultTemperature` for the follower, the page's "variety" slider) and the follower's upright guard
+("guard": samples and margin, training/mirror/guard.py). soak, seeds, interaction and
 scripts/worst_seed.py take these options, fill what is not given from the manifest (`resolve`) and
 wrap their follower with `follower_policy`. A manifest without those fields (older exports) runs
 both dancers at `defaultTemperature` with no guard, as the page then does.
 
     python -m training.evaluation.seeds --guard 0                       # the follower without its guard
     python -m training.evaluation.soak --temperature 0.5 --follower-temperature 1 --guard 8 --guard-margin 0.05
-    python -m training.evaluation.soak --partner-floor 0                # she sees his lunges as deep as they are
 """
 from __future__ import annotations
 
 import argparse
 
 from ..mirror.guard import UprightGuard, Variety
-from ..mirror.view import PartnerView
 
 
 def add_options(ap: argparse.ArgumentParser) -> None:
@@ -31,12 +28,12 @@ def add_options(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--guard-margin", type=float, default=None, metavar="M",
                     help="the guard acts once the drawn pose is within M metres of the range's edge "
                          "(default: the manifest's)")
+    ap.add_argument("--guard-hip-margin", type=float, default=None, metavar="M",
+                    help="the follower's guard judges her hips from M metres before the range's edge "
+                         "(default: the manifest's guard.hipMargin, else the guard's margin)")
     ap.add_argument("--leader-guard", type=int, default=None, metavar="K",
                     help="the leader's upright guard with K samples (0: off; default: the manifest's "
                          "leaderGuard, acting at its margin)")
-    ap.add_argument("--partner-floor", type=float, default=None, metavar="M",
-                    help="the follower reads her leader's hips as no lower than M metres (training/mirror/view.py; "
-                         "0: as they are; default: the manifest's followerView)")
 
 
 def resolve(args, manifest: dict) -> str | None:
@@ -50,10 +47,10 @@ def resolve(args, manifest: dict) -> str | None:
         args.guard = int(guard.get("samples", 0))
     if args.guard_margin is None:
         args.guard_margin = float(guard.get("margin", 0.0))
-    if getattr(args, "partner_floor", None) is None:
-        args.partner_floor = float((manifest.get("followerView") or {}).get("partnerHipFloor", 0.0))
-    if args.partner_floor < 0:
-        return f"--partner-floor {args.partner_floor}: a height in metres, 0 (off) or more"
+    if getattr(args, "guard_hip_margin", None) is None:
+        args.guard_hip_margin = guard.get("hipMargin")
+    if args.guard_hip_margin is not None and args.guard_hip_margin < 0:
+        return f"--guard-hip-margin {args.guard_hip_margin}: metres, 0 or more"
     if getattr(args, "leader_guard", None) is None:
         args.leader_guard = int((manifest.get("leaderGuard") or {}).get("samples", 0))
     if args.leader_guard < 0 or args.leader_guard == 1:
@@ -68,15 +65,13 @@ def resolve(args, manifest: dict) -> str | None:
 
 
 def follower_policy(policy, manifest: dict, args, leader_temperature: float):
-    """The follower's policy as the (resolved) options ask: reading her leader from the partner
-    floor (its guard's batches too), guarded (judging the body the follower's bones draw), at its
-    own variety, or as it is."""
+    """The follower's policy as the (resolved) options ask: guarded (judging the body the follower's
+    bones draw, her hips from the guard's hipMargin when it has one), at its own variety, or as it is."""
     temperature = None if args.follower_temperature == leader_temperature else args.follower_temperature
-    if getattr(args, "partner_floor", 0):
-        policy = PartnerView(policy, args.partner_floor)
     if args.guard:
+        hips = getattr(args, "guard_hip_margin", None)
         return UprightGuard(policy, manifest["plausibility"], args.guard, temperature, args.guard_margin,
-                            manifest["skeleton"]["offsets"]["follower"])
+                            manifest["skeleton"]["offsets"]["follower"], hip_margin=None if hips is None else float(hips))
     return policy if temperature is None else Variety(policy, temperature)
 
 
@@ -94,22 +89,6 @@ def leader_policy(policy, manifest: dict, args):
 
 
 def restart_count(policy) -> None:
-    """Zero the guard's count, and the partner view's, before a duet (a plain policy has none)."""
+    """Zero the guard's count before a duet (a plain policy has none)."""
     if hasattr(policy, "guarded"):
         policy.guarded = 0
-    view = partner_view(policy)
-    if view is not None:
-        view.lifted = 0
-
-
-def partner_view(policy) -> PartnerView | None:
-    """The PartnerView inside a follower policy (under its guard), or None."""
-    while policy is not None and not isinstance(policy, PartnerView):
-        policy = getattr(policy, "policy", None)
-    return policy
-
-
-def lifted_count(policy) -> int:
-    """Steps in which the follower's input showed her leader lifted to the partner floor."""
-    view = partner_view(policy)
-    return 0 if view is None else view.lifted

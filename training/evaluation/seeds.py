@@ -112,7 +112,7 @@ def run_method(args, method: str, r: dict, test: list[str], bar) -> dict:
     frames = int(args.seconds * FPS)
     jobs = [(seed, frames, args.temperature) for seed in range(args.first_seed, args.first_seed + args.seeds)]
     options = {k: getattr(args, k) for k in ("temperature", "follower_temperature", "guard", "guard_margin",
-                                             "leader_guard", "partner_floor")}
+                                             "guard_hip_margin", "leader_guard")}
     init = (args.models, method, args.data, test, r, options)
 
     def counted(results):
@@ -177,7 +177,7 @@ def run(args) -> dict:
     res["config"] = {"models": str(args.models), "seeds": args.seeds, "first_seed": args.first_seed,
                      "seconds": args.seconds, "temperature": args.temperature,
                      "follower_temperature": args.follower_temperature, "guard": args.guard,
-                     "guard_margin": args.guard_margin, "partner_floor": args.partner_floor,
+                     "guard_margin": args.guard_margin, "guard_hip_margin": args.guard_hip_margin,
                      "wall_seconds": time.time() - t0}
     return res
 

@@ -194,15 +194,15 @@ def main(argv=None) -> int:
     results = []
     print(f"{args.rollouts} rollouts x {frames} frames ({args.minutes:g} min at {FPS} Hz), "
           f"follower {args.follower}, variety: leader {temperature:g}, follower {args.follower_temperature:g}, " +
-          (f"upright guard of {args.guard} samples, margin {args.guard_margin:g} m" if args.guard else "no upright guard") +
-          (f", partner floor {args.partner_floor:g} m" if args.partner_floor else ""))
+          (f"upright guard of {args.guard} samples, margin {args.guard_margin:g} m" +
+           (f" (her hips {args.guard_hip_margin:g} m)" if args.guard_hip_margin is not None else "")
+           if args.guard else "no upright guard"))
     print(" seed  nonfinite  max dist m  bone err mm  min foot cm  frozen L  frozen F  resets  result")
     for i in tqdm(range(args.rollouts), desc="soak", unit="rollout", leave=False):
         rec = {}
         O.restart_count(follower)
         r = soak_one(manifest, leader, follower, args.seed + i, frames, temperature, rec)
         r["guarded"] = getattr(follower, "guarded", 0)
-        r["lifted"] = O.lifted_count(follower)
         r["interaction"] = M.interaction(rec["leader"], rec["follower"], rec["leader_contacts"], rec["follower_contacts"])
         r["interaction_layer"] = M.interaction(rec["leader_shown"], rec["follower_shown"], rec["leader_contacts"],
                                                rec["follower_contacts"])
@@ -223,7 +223,7 @@ def main(argv=None) -> int:
                "min_foot_cm": min(r["min_foot"] for r in results) * 100,
                "frozen_max": max(max(r["frozen_leader"], r["frozen_follower"]) for r in results),
                "resets": sum(r["resets"] for r in results), "seconds": time.time() - t0,
-               "guarded": sum(r["guarded"] for r in results), "lifted": sum(r["lifted"] for r in results)}
+               "guarded": sum(r["guarded"] for r in results)}
     for key in ("interaction", "interaction_layer"):
         summary[key] = {k: float(np.mean([r[key][k] for r in results])) for k in results[0][key]}
     if ranges:
@@ -239,9 +239,6 @@ def main(argv=None) -> int:
     if args.guard:
         print(f"upright guard: chose another sample in {summary['guarded']} steps "
               f"({summary['guarded'] / (frames * len(results)):.2%} of frames)")
-    if args.partner_floor:
-        print(f"partner floor: she read her leader lifted to hips at {args.partner_floor:g} m in {summary['lifted']} "
-              f"steps ({summary['lifted'] / (frames * len(results)):.2%} of frames)")
     for key, title in (("interaction", "networks alone"), ("interaction_layer", "with the contact layer")):
         m = summary[key]
         print(f"interaction, {title}: torsos through each other {m['interpenetration']:.1%} of frames, "

@@ -60,11 +60,6 @@ export function validateManifest(manifest: Manifest): void {
     if (typeof entry.file !== 'string' || !/^[\w.-]+\.onnx$/.test(entry.file)) throw bad(`model "${name}" has a bad file name`);
     if (!(entry.channels > 0 && entry.classes > 0)) throw bad(`model "${name}" needs channels and classes`);
   }
-  // A floor the page cannot read would silently leave the follower reading every lunge as it is.
-  const view = manifest.followerView;
-  if (view !== undefined && !(typeof view?.partnerHipFloor === 'number' && view.partnerHipFloor >= 0 && view.partnerHipFloor < 2)) {
-    throw bad(`followerView.partnerHipFloor is ${JSON.stringify(view?.partnerHipFloor)}, this page expects metres from 0 to 2`);
-  }
 }
 
 /** Where a manifest's block list first differs from this page's (null where they agree). */

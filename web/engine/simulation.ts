@@ -10,7 +10,6 @@ import { KEY_JOINTS, type Motion, POSITIONS_SIZE, ROTATIONS_SIZE } from '../mirr
 import { ContactLayer, FOLLOWER_CONTACT } from '../mirror/contact';
 import { FootLock } from '../mirror/footik';
 import { type GuardSettings, type Ranges, mostUpright, slackFor, uprightMargin } from '../mirror/guard';
-import { liftPartner } from '../mirror/view';
 import { LeaderPlayback } from './playback';
 import { StepTimer } from './timing';
 import {
@@ -76,8 +75,6 @@ export class DuetSimulation implements Simulation {
   private readonly uprightGuard: { settings: GuardSettings; ranges: Ranges } | null;
   /** The leader's guard (the same test at the manifest's leaderGuard margin). */
   private readonly leaderGuard: { settings: GuardSettings; ranges: Ranges } | null;
-  /** Metres: the followers read their leader's hips no lower than this (web/mirror/view.ts; 0: as they are). */
-  private readonly partnerFloor: number;
   /** The leader model's own variety (the manifest's); the slider sets the followers'. */
   private readonly leaderTemperature: number | null;
   private readonly followerOutputs: Float32Array[];
@@ -105,7 +102,6 @@ export class DuetSimulation implements Simulation {
     this.uprightGuard = g && g.samples >= 2 && manifest.plausibility ? { settings: g, ranges: manifest.plausibility } : null;
     const lg = manifest.leaderGuard;
     this.leaderGuard = lg && lg.samples >= 2 && manifest.plausibility ? { settings: lg, ranges: manifest.plausibility } : null;
-    this.partnerFloor = manifest.followerView?.partnerHipFloor ?? 0;
     this.duet = startDuet(manifest, followers.length);
     this.leaderView = new View(false);
     this.followerViews = followers.map((p) => new View(p.hasIntention));
@@ -157,7 +153,6 @@ export class DuetSimulation implements Simulation {
       steerPlan(duet.leader, duet.steering, sx, sz);
     }
     stepInputs(duet, playing ? null : this.leaderPolicy.input, this.followerInputs);
-    if (this.partnerFloor > 0) for (const x of this.followerInputs) liftPartner(x, this.partnerFloor);
     if (!playing) {
       const result = await this.leaderPolicy.run(this.leaderTemperature ?? temperature);
       this.leaderOutput.set(result.output);
@@ -177,20 +172,22 @@ export class DuetSimulation implements Simulation {
 
   /**
    * The upright guard (web/mirror/guard.ts) on follower i's output of this step: when the body it
-   * would draw comes within the margin of the recording's range, run the same input with fresh
-   * samples and keep the most upright (each one step on from the same state: no jump).
+   * would draw comes within the margin of the recording's range (her hips within the hipMargin),
+   * run the same input with fresh samples and keep the most upright (each one step on from the
+   * same state: no jump).
    */
   private async keepUpright(i: number, temperature: number): Promise<void> {
     const guard = this.uprightGuard;
     if (!guard) return;
     const offsets = this.duet.followers[i].offsets;
-    if (uprightMargin(this.followerOutputs[i], 0, guard.ranges, offsets) >= guard.settings.margin) return;
+    const hipSlack = guard.settings.hipMargin === undefined ? 0 : guard.settings.margin - guard.settings.hipMargin;
+    if (uprightMargin(this.followerOutputs[i], 0, guard.ranges, offsets, 0, hipSlack) >= guard.settings.margin) return;
     const k = guard.settings.samples;
     const policy = this.followerPolicies[i];
     const input = policy.batchInput(k);
     for (let n = 0; n < k; n++) input.set(policy.input, n * INPUT_SIZE);
     const { output, intention } = await policy.runBatch(k, temperature);
-    const best = mostUpright(output, k, OUTPUT_SIZE, guard.ranges, offsets);
+    const best = mostUpright(output, k, OUTPUT_SIZE, guard.ranges, offsets, 0, hipSlack);
     this.followerOutputs[i].set(output.subarray(best * OUTPUT_SIZE, (best + 1) * OUTPUT_SIZE));
     if (intention) this.followerIntentions[i]?.set(intention.subarray(best * INTENTION_SIZE, (best + 1) * INTENTION_SIZE));
     this.upright++;
@@ -234,10 +231,7 @@ export class DuetSimulation implements Simulation {
       this.ghostBranched[i] = true;
     }
     const input = policy.batchInput(k);
-    for (let i = 0; i < k; i++) {
-      followerInput(this.duet.leader.track, this.ghostDancers[i].track, NOW, input, i * INPUT_SIZE);
-      if (this.partnerFloor > 0) liftPartner(input, this.partnerFloor, i * INPUT_SIZE);
-    }
+    for (let i = 0; i < k; i++) followerInput(this.duet.leader.track, this.ghostDancers[i].track, NOW, input, i * INPUT_SIZE);
     const { output } = await policy.runBatch(k, this.temperature);
     while (this.ghostPoses.length < k) this.ghostPoses.push(new Float32Array(POSITIONS_SIZE));
     for (let i = 0; i < k; i++) {

@@ -3,7 +3,6 @@
 // models, pose) is the simulation's business.
 
 import type { GuardSettings, Ranges } from '../mirror/guard';
-import type { ViewSettings } from '../mirror/view';
 import type { Motion } from '../mirror/skeleton';
 import type { RecordableDuet } from '../ui/record';
 
@@ -148,8 +147,6 @@ export interface Manifest {
   guard?: GuardSettings;
   /** The leader's upright guard, the same with its own margin; absent: no guard. */
   leaderGuard?: GuardSettings;
-  /** How low the followers see their leader (web/mirror/view.ts); absent: as he is. */
-  followerView?: ViewSettings;
   /** The recording's range (training/evaluation/plausibility.py); the guard judges against it. */
   plausibility?: Ranges;
   credit: string;

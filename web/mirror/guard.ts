@@ -9,7 +9,8 @@
 // it chose in 210 of 1.8 M follower steps of the 100 x 10 min soak (docs/reliability.md). A
 // manifest's leaderGuard.headMargin judges the leader's head over his hips from a smaller margin,
 // except while he leads a turn; the shipped manifest has none (with it his partner fell in the
-// soak: guard.py, LEADER_HEAD_MARGIN).
+// soak: guard.py, LEADER_HEAD_MARGIN). A manifest's guard.hipMargin judges the follower's hips
+// from a larger margin: they drop fast once she falls (guard.py, FOLLOWER_HIP_MARGIN).
 
 import { LEADER_INPUT_LAYOUT, LEADER_INPUT_SIZE, N_JOINTS, OUTPUT_LAYOUT, blockSlices } from './features';
 import { MIN_ANKLE_HEIGHT, rotationsFromVectors } from './rollout';
@@ -33,6 +34,8 @@ export interface GuardSettings {
   margin: number;
   /** The leader's: metres before the edge of the head over the hips (a narrow range) it acts. */
   headMargin?: number;
+  /** The follower's: metres before the edge of the hips it acts (they drop fast once she falls). */
+  hipMargin?: number;
 }
 
 const POSE = blockSlices(OUTPUT_LAYOUT).pose;
@@ -48,9 +51,11 @@ const joints = new Float64Array(3 * N_JOINTS);
  * hips, head over hips, feet apart and the torso's lean (negative: that far outside). The pose is
  * in the next root's space, whose y is the height above the floor; the lean is how far the chest
  * may still move sideways over the hips before the torso leans more than the recording's steepest.
- * `headSlack` metres are added to the head-over-hips part alone.
+ * `headSlack` metres are added to the head-over-hips part alone, `hipSlack` to the hips' part alone.
  */
-export function uprightMargin(output: ArrayLike<number>, at: number, r: Ranges, offsets: ArrayLike<number>, headSlack = 0): number {
+export function uprightMargin(
+  output: ArrayLike<number>, at: number, r: Ranges, offsets: ArrayLike<number>, headSlack = 0, hipSlack = 0,
+): number {
   const pose = at + POSE.start;
   for (let j = 0; j < N_JOINTS; j++) {
     for (let k = 0; k < 3; k++) {
@@ -74,7 +79,7 @@ export function uprightMargin(output: ArrayLike<number>, at: number, r: Ranges, 
   const tz = joints[3 * CHEST + 2] - joints[2];
   const sideways = Math.hypot(tx, tz);
   const allowed = Math.hypot(tx, ty, tz) * Math.sin(r.angle_high[r.angle_high.length - 1]);
-  return Math.min(hip - r.hip_low, head - hip - r.head_above_hip_low + headSlack, r.feet_wide - feet, allowed - sideways);
+  return Math.min(hip - r.hip_low + hipSlack, head - hip - r.head_above_hip_low + headSlack, r.feet_wide - feet, allowed - sideways);
 }
 
 /**
@@ -88,11 +93,13 @@ export function slackFor(input: ArrayLike<number>, margin: number, headMargin?: 
 }
 
 /** The index of the most upright of `count` outputs laid one after another from output[0..]. */
-export function mostUpright(output: ArrayLike<number>, count: number, size: number, r: Ranges, offsets: ArrayLike<number>, headSlack = 0): number {
+export function mostUpright(
+  output: ArrayLike<number>, count: number, size: number, r: Ranges, offsets: ArrayLike<number>, headSlack = 0, hipSlack = 0,
+): number {
   let best = 0;
   let bestMargin = -Infinity;
   for (let i = 0; i < count; i++) {
-    const m = uprightMargin(output, i * size, r, offsets, headSlack);
+    const m = uprightMargin(output, i * size, r, offsets, headSlack, hipSlack);
     if (m > bestMargin) {
       best = i;
       bestMargin = m;
