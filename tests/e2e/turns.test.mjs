@@ -18,9 +18,9 @@
 // - the strips' frames are not blank.
 // Whether the follower completes a turn is printed, not asserted: she is not told, and over seeds
 // 1-10 she turned 300° either way within 2.5 s in 4 of 10 asked runs and 5 of 10 unasked (in
-// Python over 500 requests, 72 % against 57 %: docs/results.md, "The hands plan"). Seed 7 is
-// the strip's because she completes the led turn there (835° to her left within 2.5 s asked,
-// 276° the other way unasked): what a led turn looks like when it works.
+// Python over 500 requests, 73 % against 61 % since 2026-11-27: docs/results.md, "Room for his
+// head"). Seed 7 is the strip's because she completes the led turn there (496° to her left within
+// 2.5 s asked, 4° unasked, with the guards of 2026-11-27): what a led turn looks like when it works.
 //
 // Run: node --test tests/e2e/turns.test.mjs (DUET_TURN_SEED, DUET_TURN_DIRECTION: another seed, -1 her right)
 

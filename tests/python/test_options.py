@@ -79,3 +79,21 @@ def test_the_leader_is_guarded_as_the_manifest_says():
 ])
 def test_bad_options_are_refused_in_plain_words(argv, m, words):
     assert words in O.resolve(parse(*argv), m)
+
+
+def test_the_shipped_manifest_carries_the_guards_export_writes():
+    """The guards' settings in public/models/manifest.json are guard.py's, as export writes them
+    (the page and every evaluation command read them from there)."""
+    import json
+    from pathlib import Path
+
+    from training.mirror import guard as G
+
+    shipped = json.loads((Path(__file__).parents[2] / "public/models/manifest.json").read_text())
+    follower = {"samples": G.SAMPLES, "margin": G.MARGIN}
+    if G.FOLLOWER_HIP_MARGIN is not None:
+        follower["hipMargin"] = G.FOLLOWER_HIP_MARGIN
+    leader = {"samples": G.LEADER_SAMPLES, "margin": G.LEADER_MARGIN}
+    if G.LEADER_HEAD_MARGIN is not None:
+        leader["headMargin"] = G.LEADER_HEAD_MARGIN
+    assert shipped["guard"] == follower and shipped["leaderGuard"] == leader

@@ -32,9 +32,11 @@ MARGIN = 0.05   # m
 # Her hips, though, go down fast once she falls (0.39 m in a quarter second before the soak's fall
 # of seed 9), and once they are low no sample brings them up: judged from FOLLOWER_HIP_MARGIN, the
 # guard catches the drop earlier. Her hips stand above 0.898 m in 99 % of the recorded frames, so
-# from 0.15 m over the range's low end (0.713 m) it hardly acts while she dances (docs/results.md,
-# "Her hips guarded from further up"). None: the hips judged from MARGIN like the rest.
-FOLLOWER_HIP_MARGIN: float | None = None   # m (0.15 measured)
+# from 0.15 m over the range's low end (0.713 m) it acts in 0.25 % of her steered steps. Beside the
+# leader who lunges (LEADER_HEAD_MARGIN below) she then fell in 1 of 66 soak rollouts, against 7 of
+# 66 with her hips judged from 0.05 m (docs/results.md, "Room for his head, her hips guarded").
+# None: the hips judged from MARGIN like the rest.
+FOLLOWER_HIP_MARGIN: float | None = 0.15   # m
 # The leader trained on his own rollouts dances (steered, body motion 0.54 m/s over 100 seeds against 0.33 before) but,
 # steered, a few seeds had a second with his hips low. The same guard, acting from LEADER_MARGIN
 # before the range's edge (40 steered seeds): 0.05 m acted in 3.9 % of his steps and left 1 seed
@@ -46,10 +48,11 @@ LEADER_MARGIN = 0.07   # m
 # over his hips, within 0.07 m of the low end in 67 % of his frames): judged from 0.07 m there, the
 # guard acts in 43 % of his steps, in 59 % of those none of its 8 samples passes, and it takes the
 # one standing straightest, a stiff leader (2.0 turns a minute nobody steering, 100 seeds). A
-# head_margin judges that part from less: at 0.03 m (the full margin while a request runs) he turned
-# 6.1 a minute, but in the soak his partner fell in 7 of 66 rollouts (1 of 100 at 0.07 m), so the
-# manifest carries none (LEADER_HEAD_MARGIN None). docs/results.md, "The leader's guard".
-LEADER_HEAD_MARGIN: float | None = None   # m; None: the head is judged from LEADER_MARGIN
+# head_margin judges that part from less: at 0.03 m (the full margin while a request runs) he turns
+# 6.1 times a minute nobody steering (2.0 at 0.07 m; 100 seeds). Beside him, lunging now, his
+# partner fell in 7 of 66 soak rollouts until her hips were guarded from FOLLOWER_HIP_MARGIN.
+# docs/results.md, "The leader's guard" and "Room for his head, her hips guarded".
+LEADER_HEAD_MARGIN: float | None = 0.03   # m; None: the head is judged from LEADER_MARGIN
 
 POSE = feat.block_slices(feat.OUTPUT_LAYOUT)["pose"]
 HANDS_PLAN_SHOWN = feat.block_slices(feat.LEADER_INPUT_LAYOUT)["hands_plan"].start   # 1 while a request runs

@@ -7,10 +7,10 @@
 // most upright sample (simulation.ts). Every candidate is one step on from the same state, so the
 // body never jumps; the guard only chooses among the network's own reactions. Measured in Python:
 // it chose in 210 of 1.8 M follower steps of the 100 x 10 min soak (docs/reliability.md). A
-// manifest's leaderGuard.headMargin judges the leader's head over his hips from a smaller margin,
-// except while he leads a turn; the shipped manifest has none (with it his partner fell in the
-// soak: guard.py, LEADER_HEAD_MARGIN). A manifest's guard.hipMargin judges the follower's hips
-// from a larger margin: they drop fast once she falls (guard.py, FOLLOWER_HIP_MARGIN).
+// manifest's leaderGuard.headMargin judges the leader's head over his hips from a smaller margin
+// (0.03 m shipped), except while he leads a turn; its guard.hipMargin judges the follower's hips
+// from a larger one (0.15 m shipped): beside the leader who then lunges, her hips drop fast when
+// she falls (guard.py, LEADER_HEAD_MARGIN and FOLLOWER_HIP_MARGIN).
 
 import { LEADER_INPUT_LAYOUT, LEADER_INPUT_SIZE, N_JOINTS, OUTPUT_LAYOUT, blockSlices } from './features';
 import { MIN_ANKLE_HEIGHT, rotationsFromVectors } from './rollout';
