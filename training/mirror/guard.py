@@ -33,8 +33,9 @@ MARGIN = 0.05   # m
 # of seed 9), and once they are low no sample brings them up: judged from FOLLOWER_HIP_MARGIN, the
 # guard catches the drop earlier. Her hips stand above 0.898 m in 99 % of the recorded frames, so
 # from 0.15 m over the range's low end (0.713 m) it acts in 0.25 % of her steered steps. Beside the
-# leader who lunges (LEADER_HEAD_MARGIN below) she then fell in 1 of 66 soak rollouts, against 7 of
-# 66 with her hips judged from 0.05 m (docs/results.md, "Room for his head, her hips guarded").
+# leader who lunges (LEADER_HEAD_MARGIN below) she then fell in 1 of the 66 soak rollouts that lost
+# 7 with her hips judged from 0.05 m, and in 3 of all 100 (1 of 100 beside the stiff leader before):
+# docs/results.md, "Room for his head, her hips guarded".
 # None: the hips judged from MARGIN like the rest.
 FOLLOWER_HIP_MARGIN: float | None = 0.15   # m
 # The leader trained on his own rollouts dances (steered, body motion 0.54 m/s over 100 seeds against 0.33 before) but,
