@@ -78,7 +78,7 @@ class TrainConfig:
     # Follower: this share of samples has the partner's whole body lowered by up to
     # `partner_lowered_depth` metres (lower_partner), the target still her recorded next frame.
     # Our leader lunges deeper and more often than the recorded one, and she followed him down and
-    # fell (docs/results.md, "She follows his lunge down"); lowered, he teaches her that his height
+    # fell (docs/results.md, "Room for his head, her hips guarded"); lowered, he teaches her that his height
     # alone does not take her to the floor. The body terms skip these samples, as the moved ones.
     partner_lowered_share: float = 0.0
     partner_lowered_depth: float = 0.0
@@ -211,7 +211,7 @@ MODELS = {
     # no difference the 6 folds can show (docs/results.md, "Turn timing").
     "follower_led_turn": replace(steady(OURS), model=replace(steady(OURS).model, turn_keys=feat.KEYS),
                                  state_dropout=0.5, turn_weight=4.0, own_rollouts_from=10),
-    # Measured, not shipped (docs/results.md, "She follows his lunge down"): his body lowered by up
+    # Measured, not shipped (docs/results.md, "Room for his head, her hips guarded"): his body lowered by up
     # to 0.15 m in a quarter of her samples (TrainConfig.partner_lowered_share). Beside the leader
     # with room for his head she still followed his lunges down: the soak's first 4 seeds from 0
     # and from 50 all fell (the shipped follower: 0 of those 8).
@@ -549,8 +549,9 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
 
     def inputs(idx, proximity: bool = False):
         """Normalized inputs of a batch as the networks read them (with state noise), which samples
-        had their partner moved closer, which had him moved at all (closer or lowered), and the inputs without noise (what the body terms compare
-        the decoded pose with: the pose the dancer really was in)."""
+        had their partner moved closer, which had him moved at all (closer or lowered), and the
+        inputs without noise (what the body terms compare the decoded pose with: the pose the
+        dancer really was in)."""
         x, moved, altered = xr[idx], None, None
         if role == "leader" and cfg.control_noise + cfg.control_rotation > 0:
             x = augment_control(x, cfg, gen)
