@@ -72,7 +72,7 @@ export class DuetSimulation implements Simulation {
   private readonly guardCounts = { resets: 0, leashed: 0, upright: 0 };
   /** Steps in which an upright guard took another of a dancer's samples (follower or leader). */
   private upright = 0;
-  private readonly uprightGuard: { settings: GuardSettings; ranges: Ranges } | null;
+  private readonly uprightGuard: { settings: GuardSettings; ranges: Ranges; hipSlack: number } | null;
   /** The leader's guard (the same test at the manifest's leaderGuard margin). */
   private readonly leaderGuard: { settings: GuardSettings; ranges: Ranges } | null;
   /** The leader model's own variety (the manifest's); the slider sets the followers'. */
@@ -99,7 +99,9 @@ export class DuetSimulation implements Simulation {
     this.temperature = manifest.defaultTemperature ?? 0.5;
     this.leaderTemperature = manifest.leaderTemperature ?? null;
     const g = manifest.guard;
-    this.uprightGuard = g && g.samples >= 2 && manifest.plausibility ? { settings: g, ranges: manifest.plausibility } : null;
+    // Her hips judged from the hipMargin: a negative slack on that part (guard.py's hip_slack, set once).
+    const hipSlack = g?.hipMargin === undefined ? 0 : g.margin - g.hipMargin;
+    this.uprightGuard = g && g.samples >= 2 && manifest.plausibility ? { settings: g, ranges: manifest.plausibility, hipSlack } : null;
     const lg = manifest.leaderGuard;
     this.leaderGuard = lg && lg.samples >= 2 && manifest.plausibility ? { settings: lg, ranges: manifest.plausibility } : null;
     this.duet = startDuet(manifest, followers.length);
@@ -180,14 +182,13 @@ export class DuetSimulation implements Simulation {
     const guard = this.uprightGuard;
     if (!guard) return;
     const offsets = this.duet.followers[i].offsets;
-    const hipSlack = guard.settings.hipMargin === undefined ? 0 : guard.settings.margin - guard.settings.hipMargin;
-    if (uprightMargin(this.followerOutputs[i], 0, guard.ranges, offsets, 0, hipSlack) >= guard.settings.margin) return;
+    if (uprightMargin(this.followerOutputs[i], 0, guard.ranges, offsets, 0, guard.hipSlack) >= guard.settings.margin) return;
     const k = guard.settings.samples;
     const policy = this.followerPolicies[i];
     const input = policy.batchInput(k);
     for (let n = 0; n < k; n++) input.set(policy.input, n * INPUT_SIZE);
     const { output, intention } = await policy.runBatch(k, temperature);
-    const best = mostUpright(output, k, OUTPUT_SIZE, guard.ranges, offsets, 0, hipSlack);
+    const best = mostUpright(output, k, OUTPUT_SIZE, guard.ranges, offsets, 0, guard.hipSlack);
     this.followerOutputs[i].set(output.subarray(best * OUTPUT_SIZE, (best + 1) * OUTPUT_SIZE));
     if (intention) this.followerIntentions[i]?.set(intention.subarray(best * INTENTION_SIZE, (best + 1) * INTENTION_SIZE));
     this.upright++;
