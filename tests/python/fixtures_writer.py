@@ -385,6 +385,22 @@ def dancer_state(d: ro.Dancer) -> dict:
             "resets": d.resets, "intention": None if d.intention is None else out7(d.intention)}
 
 
+def hip_slack_cases() -> list[dict]:
+    """guard.hip_slack_for on inputs that show his hips at a few heights: a follower's, and a
+    leader's input of his own size (never judged by her partner's hips), with and without the rule."""
+    out = []
+    for size, hips, settings in ((feat.INPUT_SIZE, 0.85, (0.05, 0.15, 0.88, 0.2)), (feat.INPUT_SIZE, 0.95, (0.05, 0.15, 0.88, 0.2)),
+                                 (feat.INPUT_SIZE, 0.85, (0.05, 0.15, None, None)), (feat.INPUT_SIZE, 0.85, (0.05, None, 0.88, 0.2)),
+                                 (feat.INPUT_SIZE, 0.95, (0.05, None, None, None)), (feat.LEADER_INPUT_SIZE, 0.85, (0.07, None, 0.88, 0.2))):
+        x = np.zeros(size)
+        x[G.PARTNER_HIPS] = hips
+        margin, hip_margin, low, low_margin = settings
+        out.append({"size": size, "hips": hips, "margin": margin, "hipMargin": hip_margin, "partnerLow": low,
+                    "partnerLowHipMargin": low_margin, "slack": G.hip_slack_for(x, margin, hip_margin, low, low_margin)})
+    return out
+
+
+
 def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_offsets, follow_offsets) -> dict:
     vectors_f = np.round(rng.normal(size=(5, 3)), 6)
     vectors_u = np.round(rng.normal(size=(5, 3)), 6)
@@ -480,7 +496,9 @@ def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_o
                    # The follower's hip margin: her hips judged 0.1 m further from the edge.
                    "hipSlackMargins": out7(G.upright_margin(outputs, ranges, follow_offsets, 0.0, -0.1)),
                    "hipSlackBest": G.most_upright(outputs, ranges, follow_offsets, 0.0, -0.1),
-                   "handsPlanShown": G.HANDS_PLAN_SHOWN}
+                   "handsPlanShown": G.HANDS_PLAN_SHOWN,
+                   # Her hips' slack from what her input shows of his hips (guard.hip_slack_for).
+                   "partnerHips": G.PARTNER_HIPS, "hipSlackFor": hip_slack_cases()}
     return {
         "NOW": ro.NOW, "TRACK_FRAMES": ro.TRACK_FRAMES, "guards": guards, "upright": uprightness,
         "rotationsFromVectors": {"forward": exact(vectors_f), "up": exact(vectors_u),

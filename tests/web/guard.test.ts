@@ -4,11 +4,12 @@
 
 import { describe, expect, it } from 'vitest';
 import { INPUT_SIZE, LEADER_INPUT_SIZE, OUTPUT_SIZE } from '../../web/mirror/features';
-import { HANDS_PLAN_SHOWN, mostUpright, slackFor, uprightMargin } from '../../web/mirror/guard';
+import { HANDS_PLAN_SHOWN, PARTNER_HIPS, hipSlackFor, mostUpright, slackFor, uprightMargin } from '../../web/mirror/guard';
 import { expectClose, fixture } from './fixture';
 
 const data = fixture('rollout');
-const { outputs, ranges, margins, best, tight, tightMargins, slackMargins, hipSlackMargins, hipSlackBest, handsPlanShown } = data.upright;
+const { outputs, ranges, margins, best, tight, tightMargins, slackMargins, hipSlackMargins, hipSlackBest, handsPlanShown, partnerHips, hipSlackFor: hipCases } =
+  data.upright;
 const offsets = Float64Array.from(data.offsets.follower);
 
 describe('uprightMargin', () => {
@@ -35,6 +36,25 @@ describe('the follower guard\'s hip margin', () => {
     expectClose(got, hipSlackMargins, 'margins with her hips judged 0.1 m further from the edge');
     expect(got[3]).toBeCloseTo(margins[3] - 0.1, 5); // the sunk body: its hips were what bound
     expect(mostUpright(out, margins.length, OUTPUT_SIZE, ranges, offsets, 0, -0.1)).toBe(hipSlackBest);
+  });
+});
+
+describe('the follower guard beside his lunge', () => {
+  it('judges her hips from partnerLowHipMargin while her input shows his hips below partnerLow, as Python does', () => {
+    expect(PARTNER_HIPS).toBe(partnerHips);
+    for (const c of hipCases) {
+      const input = new Float32Array(c.size);
+      input[PARTNER_HIPS] = c.hips;
+      const settings = {
+        samples: 32, margin: c.margin, hipMargin: c.hipMargin ?? undefined,
+        partnerLow: c.partnerLow ?? undefined, partnerLowHipMargin: c.partnerLowHipMargin ?? undefined,
+      };
+      expect(hipSlackFor(input, settings), JSON.stringify(c)).toBeCloseTo(c.slack, 6);
+    }
+    // his hips low in her input: judged from 0.2 m (slack -0.15); standing tall: from the hipMargin (-0.1)
+    expect(hipCases[0].slack).toBeCloseTo(-0.15, 6);
+    expect(hipCases[1].slack).toBeCloseTo(-0.1, 6);
+    expect(hipCases[5].slack).toBe(0); // a leader's own input is never judged by her partner's hips
   });
 });
 

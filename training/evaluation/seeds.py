@@ -112,7 +112,8 @@ def run_method(args, method: str, r: dict, test: list[str], bar) -> dict:
     frames = int(args.seconds * FPS)
     jobs = [(seed, frames, args.temperature) for seed in range(args.first_seed, args.first_seed + args.seeds)]
     options = {k: getattr(args, k) for k in ("temperature", "follower_temperature", "guard", "guard_margin",
-                                             "guard_hip_margin", "leader_guard")}
+                                             "guard_hip_margin", "guard_partner_low", "guard_partner_low_hip_margin",
+                                             "leader_guard")}
     init = (args.models, method, args.data, test, r, options)
 
     def counted(results):
@@ -178,6 +179,8 @@ def run(args) -> dict:
                      "seconds": args.seconds, "temperature": args.temperature,
                      "follower_temperature": args.follower_temperature, "guard": args.guard,
                      "guard_margin": args.guard_margin, "guard_hip_margin": args.guard_hip_margin,
+                     "guard_partner_low": args.guard_partner_low,
+                     "guard_partner_low_hip_margin": args.guard_partner_low_hip_margin,
                      "wall_seconds": time.time() - t0}
     return res
 

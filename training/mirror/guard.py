@@ -25,9 +25,13 @@ from .skeleton import FEET, HEAD, forward_kinematics_reduced
 from ..evaluation.plausibility import CHEST
 
 # 0 of 100 steered seeds with a bad second and no fall in the soaks measured with these (a margin
-# of 0.02 m let one seed fall, 0.1 m chose in every step and became a different sampler; 32
-# samples did no better than 8): docs/plausibility.md.
-SAMPLES = 8
+# of 0.02 m let one seed fall, 0.1 m chose in every step and became a different sampler):
+# docs/plausibility.md. 32 samples did no better than 8 then, beside the stiff leader; beside the
+# leader who lunges (LEADER_HEAD_MARGIN below) they do: continued 20 times each from four moments
+# just before the soak's falls of seeds 49 and 86, she fell in 20 of 80 with 8 samples, 13 with
+# 16, 5 with 32 and 3 with 64 (docs/results.md, "Her guard beside his lunge"). The guard acts in
+# under 1 % of her steps, so the larger batch costs the page nothing in the median step.
+SAMPLES = 32
 MARGIN = 0.05   # m
 # Her hips, though, go down fast once she falls (0.39 m in a quarter second before the soak's fall
 # of seed 9), and once they are low no sample brings them up: judged from FOLLOWER_HIP_MARGIN, the
@@ -38,6 +42,15 @@ MARGIN = 0.05   # m
 # docs/results.md, "Room for his head, her hips guarded".
 # None: the hips judged from MARGIN like the rest.
 FOLLOWER_HIP_MARGIN: float | None = 0.15   # m
+# Every fall left in the soak came a second or two after the leader's lunge (his hips at 0.84-0.86
+# m, in his lowest 2.5 %): she reads his low body and goes down with him. While her input shows his
+# hips below PARTNER_LOW, her hips are judged from PARTNER_LOW_HIP_MARGIN (0.913 m, her recorded
+# hips' 1.5th percentile) instead: from the same four moments, with 32 samples, she then fell in
+# 0 of 80. His hips are that low in 2.5 % of his steered frames (the recording's leader: 2.3 %
+# below 0.84 m), so it rarely acts. The guard only reads what she reads; she gets no command.
+# None: no such rule.
+PARTNER_LOW: float | None = 0.88   # m, his hip height in her input
+PARTNER_LOW_HIP_MARGIN = 0.20      # m
 # The leader trained on his own rollouts dances (steered, body motion 0.54 m/s over 100 seeds against 0.33 before) but,
 # steered, a few seeds had a second with his hips low. The same guard, acting from LEADER_MARGIN
 # before the range's edge (40 steered seeds): 0.05 m acted in 3.9 % of his steps and left 1 seed
@@ -57,6 +70,8 @@ LEADER_HEAD_MARGIN: float | None = 0.03   # m; None: the head is judged from LEA
 
 POSE = feat.block_slices(feat.OUTPUT_LAYOUT)["pose"]
 HANDS_PLAN_SHOWN = feat.block_slices(feat.LEADER_INPUT_LAYOUT)["hands_plan"].start   # 1 while a request runs
+# The partner's hip height in a follower's input (the pose block's first joint, y, in her root space).
+PARTNER_HIPS = feat.block_slices(feat.FOLLOWER_INPUT_LAYOUT)["partner_pose"].start + 1
 
 
 def upright_margin(outputs: np.ndarray, r: dict, offsets: np.ndarray | None = None,
@@ -106,32 +121,49 @@ def slack_for(x: np.ndarray, margin: float, head_margin: float | None) -> float:
     return margin - head_margin
 
 
+def hip_slack_for(x: np.ndarray, margin: float, hip_margin: float | None, partner_low: float | None = None,
+                  partner_low_hip_margin: float | None = None) -> float:
+    """Metres a guard adds to the hips' part for input x (negative: they are judged from a larger
+    margin): margin - partner_low_hip_margin while x is a follower's input showing her partner's
+    hips below partner_low, else margin - hip_margin; none without either."""
+    first = np.atleast_2d(x)[0]
+    if (partner_low is not None and partner_low_hip_margin is not None and len(first) == feat.INPUT_SIZE
+            and first[PARTNER_HIPS] < partner_low):
+        return margin - partner_low_hip_margin
+    return 0.0 if hip_margin is None else margin - hip_margin
+
+
 class UprightGuard:
     """Wraps a policy (x, temperature, rng) -> {output, intention, ...}; `guarded` counts the steps
     in which it picked another sample (reset it per duet). `temperature` overrides the one the
     duet's step asks for (the follower's own variety; the leader keeps the duet's). `head_margin`
     (the leader's): the head over the hips is judged from that margin instead, except while his
-    input shows a hands plan. `hip_margin` (the follower's): the hips are judged from that margin."""
+    input shows a hands plan. `hip_margin` (the follower's): the hips are judged from that margin;
+    `partner_low`, `partner_low_hip_margin` (hers): from that one while her input shows his hips
+    below that height."""
 
     def __init__(self, policy, ranges: dict, samples: int = SAMPLES, temperature: float | None = None,
                  margin: float = MARGIN, offsets: np.ndarray | None = None, head_margin: float | None = None,
-                 hip_margin: float | None = None):
+                 hip_margin: float | None = None, partner_low: float | None = None,
+                 partner_low_hip_margin: float | None = None):
         if samples < 2:
             raise ValueError("the guard needs at least 2 samples to choose from")
         self.policy, self.ranges, self.samples, self.temperature = policy, ranges, samples, temperature
         self.margin, self.offsets, self.head_margin = margin, offsets, head_margin
-        self.hip_slack = 0.0 if hip_margin is None else margin - hip_margin
+        self.hip_margin, self.partner_low, self.partner_low_hip_margin = hip_margin, partner_low, partner_low_hip_margin
+        self.hip_slack = 0.0 if hip_margin is None else margin - hip_margin   # while he stands tall
         self.guarded = 0
 
     def __call__(self, x: np.ndarray, temperature: float, rng: np.random.Generator) -> dict:
         t = temperature if self.temperature is None else self.temperature
         slack = slack_for(x, self.margin, self.head_margin)
+        hips = hip_slack_for(x, self.margin, self.hip_margin, self.partner_low, self.partner_low_hip_margin)
         out = self.policy(x, t, rng)
-        if upright_margin(out["output"], self.ranges, self.offsets, slack, self.hip_slack)[0] >= self.margin:
+        if upright_margin(out["output"], self.ranges, self.offsets, slack, hips)[0] >= self.margin:
             return out
         self.guarded += 1
         many = self.policy(np.repeat(np.atleast_2d(x), self.samples, 0), t, rng)
-        best = most_upright(many["output"], self.ranges, self.offsets, slack, self.hip_slack)
+        best = most_upright(many["output"], self.ranges, self.offsets, slack, hips)
         return {k: v[best:best + 1] for k, v in many.items()}
 
 

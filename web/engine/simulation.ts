@@ -9,7 +9,7 @@ import { FUTURE_OFFSETS, INPUT_SIZE, INTENTION_SIZE, KEYS, OUTPUT_SIZE, follower
 import { KEY_JOINTS, type Motion, POSITIONS_SIZE, ROTATIONS_SIZE } from '../mirror/skeleton';
 import { ContactLayer, FOLLOWER_CONTACT } from '../mirror/contact';
 import { FootLock } from '../mirror/footik';
-import { type GuardSettings, type Ranges, mostUpright, slackFor, uprightMargin } from '../mirror/guard';
+import { type GuardSettings, type Ranges, hipSlackFor, mostUpright, slackFor, uprightMargin } from '../mirror/guard';
 import { LeaderPlayback } from './playback';
 import { StepTimer } from './timing';
 import {
@@ -72,7 +72,7 @@ export class DuetSimulation implements Simulation {
   private readonly guardCounts = { resets: 0, leashed: 0, upright: 0 };
   /** Steps in which an upright guard took another of a dancer's samples (follower or leader). */
   private upright = 0;
-  private readonly uprightGuard: { settings: GuardSettings; ranges: Ranges; hipSlack: number } | null;
+  private readonly uprightGuard: { settings: GuardSettings; ranges: Ranges } | null;
   /** The leader's guard (the same test at the manifest's leaderGuard margin). */
   private readonly leaderGuard: { settings: GuardSettings; ranges: Ranges } | null;
   /** The leader model's own variety (the manifest's); the slider sets the followers'. */
@@ -99,9 +99,7 @@ export class DuetSimulation implements Simulation {
     this.temperature = manifest.defaultTemperature ?? 0.5;
     this.leaderTemperature = manifest.leaderTemperature ?? null;
     const g = manifest.guard;
-    // Her hips judged from the hipMargin: a negative slack on that part (guard.py's hip_slack, set once).
-    const hipSlack = g?.hipMargin === undefined ? 0 : g.margin - g.hipMargin;
-    this.uprightGuard = g && g.samples >= 2 && manifest.plausibility ? { settings: g, ranges: manifest.plausibility, hipSlack } : null;
+    this.uprightGuard = g && g.samples >= 2 && manifest.plausibility ? { settings: g, ranges: manifest.plausibility } : null;
     const lg = manifest.leaderGuard;
     this.leaderGuard = lg && lg.samples >= 2 && manifest.plausibility ? { settings: lg, ranges: manifest.plausibility } : null;
     this.duet = startDuet(manifest, followers.length);
@@ -174,21 +172,22 @@ export class DuetSimulation implements Simulation {
 
   /**
    * The upright guard (web/mirror/guard.ts) on follower i's output of this step: when the body it
-   * would draw comes within the margin of the recording's range (her hips within the hipMargin),
-   * run the same input with fresh samples and keep the most upright (each one step on from the
-   * same state: no jump).
+   * would draw comes within the margin of the recording's range (her hips within the hipMargin, or
+   * the partnerLowHipMargin while she sees his hips low), run the same input with fresh samples and
+   * keep the most upright (each one step on from the same state: no jump).
    */
   private async keepUpright(i: number, temperature: number): Promise<void> {
     const guard = this.uprightGuard;
     if (!guard) return;
     const offsets = this.duet.followers[i].offsets;
-    if (uprightMargin(this.followerOutputs[i], 0, guard.ranges, offsets, 0, guard.hipSlack) >= guard.settings.margin) return;
-    const k = guard.settings.samples;
     const policy = this.followerPolicies[i];
+    const hipSlack = hipSlackFor(policy.input, guard.settings);
+    if (uprightMargin(this.followerOutputs[i], 0, guard.ranges, offsets, 0, hipSlack) >= guard.settings.margin) return;
+    const k = guard.settings.samples;
     const input = policy.batchInput(k);
     for (let n = 0; n < k; n++) input.set(policy.input, n * INPUT_SIZE);
     const { output, intention } = await policy.runBatch(k, temperature);
-    const best = mostUpright(output, k, OUTPUT_SIZE, guard.ranges, offsets, 0, guard.hipSlack);
+    const best = mostUpright(output, k, OUTPUT_SIZE, guard.ranges, offsets, 0, hipSlack);
     this.followerOutputs[i].set(output.subarray(best * OUTPUT_SIZE, (best + 1) * OUTPUT_SIZE));
     if (intention) this.followerIntentions[i]?.set(intention.subarray(best * INTENTION_SIZE, (best + 1) * INTENTION_SIZE));
     this.upright++;

@@ -10,9 +10,10 @@
 // manifest's leaderGuard.headMargin judges the leader's head over his hips from a smaller margin
 // (0.03 m shipped), except while he leads a turn; its guard.hipMargin judges the follower's hips
 // from a larger one (0.15 m shipped): beside the leader who then lunges, her hips drop fast when
-// she falls (guard.py, LEADER_HEAD_MARGIN and FOLLOWER_HIP_MARGIN).
+// she falls (guard.py, LEADER_HEAD_MARGIN and FOLLOWER_HIP_MARGIN); and while her input shows his
+// hips below guard.partnerLow (a lunge), from guard.partnerLowHipMargin (guard.py, PARTNER_LOW).
 
-import { LEADER_INPUT_LAYOUT, LEADER_INPUT_SIZE, N_JOINTS, OUTPUT_LAYOUT, blockSlices } from './features';
+import { FOLLOWER_INPUT_LAYOUT, INPUT_SIZE, LEADER_INPUT_LAYOUT, LEADER_INPUT_SIZE, N_JOINTS, OUTPUT_LAYOUT, blockSlices } from './features';
 import { MIN_ANKLE_HEIGHT, rotationsFromVectors } from './rollout';
 import { FEET, HEAD, forwardKinematicsReduced } from './skeleton';
 
@@ -36,11 +37,17 @@ export interface GuardSettings {
   headMargin?: number;
   /** The follower's: metres before the edge of the hips it acts (they drop fast once she falls). */
   hipMargin?: number;
+  /** The follower's: while her input shows his hips below this height (m), her hips are judged
+   *  from partnerLowHipMargin instead (she goes down with his lunge). */
+  partnerLow?: number;
+  partnerLowHipMargin?: number;
 }
 
 const POSE = blockSlices(OUTPUT_LAYOUT).pose;
 /** The leader input's column that is 1 while a request runs (the hands plan's "shown"). */
 export const HANDS_PLAN_SHOWN = blockSlices(LEADER_INPUT_LAYOUT).hands_plan.start;
+/** The partner's hip height in a follower's input (the pose block's first joint, y, in her root space). */
+export const PARTNER_HIPS = blockSlices(FOLLOWER_INPUT_LAYOUT).partner_pose.start + 1;
 const forward = new Float64Array(3 * N_JOINTS);
 const up = new Float64Array(3 * N_JOINTS);
 const rotations = new Float64Array(9 * N_JOINTS);
@@ -90,6 +97,19 @@ export function slackFor(input: ArrayLike<number>, margin: number, headMargin?: 
   if (headMargin === undefined) return 0;
   if (input.length === LEADER_INPUT_SIZE && input[HANDS_PLAN_SHOWN] >= 0.5) return 0;
   return margin - headMargin;
+}
+
+/**
+ * Metres a guard adds to the hips' part for this input (negative: they are judged from a larger
+ * margin): margin - partnerLowHipMargin while it is a follower's input showing her partner's hips
+ * below partnerLow, else margin - hipMargin; none without either.
+ */
+export function hipSlackFor(input: ArrayLike<number>, settings: GuardSettings): number {
+  const { margin, hipMargin, partnerLow, partnerLowHipMargin } = settings;
+  if (partnerLow !== undefined && partnerLowHipMargin !== undefined && input.length === INPUT_SIZE && input[PARTNER_HIPS] < partnerLow) {
+    return margin - partnerLowHipMargin;
+  }
+  return hipMargin === undefined ? 0 : margin - hipMargin;
 }
 
 /** The index of the most upright of `count` outputs laid one after another from output[0..]. */
