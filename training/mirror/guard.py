@@ -44,10 +44,12 @@ MARGIN = 0.05   # m
 FOLLOWER_HIP_MARGIN: float | None = 0.15   # m
 # Every fall left in the soak came a second or two after the leader's lunge (his hips at 0.84-0.86
 # m, in his lowest 2.5 %): she reads his low body and goes down with him. While her input shows his
-# hips below PARTNER_LOW, her hips are judged from PARTNER_LOW_HIP_MARGIN (0.913 m, her recorded
-# hips' 1.5th percentile) instead: from the same four moments, with 32 samples, she then fell in
-# 0 of 80. His hips are that low in 2.5 % of his steered frames (the recording's leader: 2.3 %
-# below 0.84 m), so it rarely acts. The guard only reads what she reads; she gets no command.
+# hips below PARTNER_LOW, her hips are judged from PARTNER_LOW_HIP_MARGIN (0.913 m, between her
+# recorded hips' 1st and 2.5th percentiles, 0.898 and 0.921 m) instead: from the same four moments,
+# with 32 samples, she then fell in 0 of 80. His hips are that low in 2.5 % of his steered frames
+# (the recorded leader's are below 0.84 m in 2.5 % of his), so it rarely acts. In the full soak 2
+# of 100 rollouts still fell (3 of 100 before), both after his lunge. The guard only reads what she
+# reads; she gets no command.
 # None: no such rule.
 PARTNER_LOW: float | None = 0.88   # m, his hip height in her input
 PARTNER_LOW_HIP_MARGIN = 0.20      # m
