@@ -37,7 +37,7 @@ const RESEARCH =
   '"possible reactions" are ghost rollouts (copies of the follower branched off at staggered steps ' +
   'within the last second, each run on by her model with fresh noise); an "upright choice" ' +
   'is a step in which the partner\'s sampled pose would have left the recorded dancers\' range (hips low, ' +
-  'torso tipping) and the page took the most upright of 8 fresh samples instead.';
+  'torso tipping) and the page took the most upright of 32 fresh samples instead.';
 
 function element<K extends keyof HTMLElementTagNameMap>(tag: K, className = '', text = ''): HTMLElementTagNameMap[K] {
   const e = document.createElement(tag);
