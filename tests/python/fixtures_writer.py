@@ -400,7 +400,6 @@ def hip_slack_cases() -> list[dict]:
     return out
 
 
-
 def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_offsets, follow_offsets) -> dict:
     vectors_f = np.round(rng.normal(size=(5, 3)), 6)
     vectors_u = np.round(rng.normal(size=(5, 3)), 6)

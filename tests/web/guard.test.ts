@@ -45,11 +45,8 @@ describe('the follower guard beside his lunge', () => {
     for (const c of hipCases) {
       const input = new Float32Array(c.size);
       input[PARTNER_HIPS] = c.hips;
-      const settings = {
-        samples: 32, margin: c.margin, hipMargin: c.hipMargin ?? undefined,
-        partnerLow: c.partnerLow ?? undefined, partnerLowHipMargin: c.partnerLowHipMargin ?? undefined,
-      };
-      expect(hipSlackFor(input, settings), JSON.stringify(c)).toBeCloseTo(c.slack, 6);
+      const slack = hipSlackFor(input, c.margin, c.hipMargin ?? undefined, c.partnerLow ?? undefined, c.partnerLowHipMargin ?? undefined);
+      expect(slack, JSON.stringify(c)).toBeCloseTo(c.slack, 6);
     }
     // his hips low in her input: judged from 0.2 m (slack -0.15); standing tall: from the hipMargin (-0.1)
     expect(hipCases[0].slack).toBeCloseTo(-0.15, 6);

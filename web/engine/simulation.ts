@@ -181,7 +181,8 @@ export class DuetSimulation implements Simulation {
     if (!guard) return;
     const offsets = this.duet.followers[i].offsets;
     const policy = this.followerPolicies[i];
-    const hipSlack = hipSlackFor(policy.input, guard.settings);
+    const { margin, hipMargin, partnerLow, partnerLowHipMargin } = guard.settings;
+    const hipSlack = hipSlackFor(policy.input, margin, hipMargin, partnerLow, partnerLowHipMargin);
     if (uprightMargin(this.followerOutputs[i], 0, guard.ranges, offsets, 0, hipSlack) >= guard.settings.margin) return;
     const k = guard.settings.samples;
     const input = policy.batchInput(k);

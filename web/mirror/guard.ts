@@ -104,8 +104,9 @@ export function slackFor(input: ArrayLike<number>, margin: number, headMargin?: 
  * margin): margin - partnerLowHipMargin while it is a follower's input showing her partner's hips
  * below partnerLow, else margin - hipMargin; none without either.
  */
-export function hipSlackFor(input: ArrayLike<number>, settings: GuardSettings): number {
-  const { margin, hipMargin, partnerLow, partnerLowHipMargin } = settings;
+export function hipSlackFor(
+  input: ArrayLike<number>, margin: number, hipMargin?: number, partnerLow?: number, partnerLowHipMargin?: number,
+): number {
   if (partnerLow !== undefined && partnerLowHipMargin !== undefined && input.length === INPUT_SIZE && input[PARTNER_HIPS] < partnerLow) {
     return margin - partnerLowHipMargin;
   }
