@@ -179,6 +179,34 @@ def test_partner_terms_are_zero_on_the_recording_and_bite_on_error(prepared3):
     assert float(worse["interaction"]) > 0.0
 
 
+def test_foot_contact_term_spares_turning_samples(prepared3):
+    """contact_spare_turning: the samples whose recorded heading turns faster than the threshold
+    leave the foot-contact term (a pivot on a planted foot), the others weigh as before."""
+    with np.load(prepared3 / "train.npz") as z:
+        rows = np.nonzero(z["take"] == z["take"][0])[0][:256]
+        x = torch.tensor(z["leader_input"][rows], dtype=torch.float64)
+        y = torch.tensor(z["leader_output"][rows], dtype=torch.float64)
+        mirror = z["mirror"][rows]
+    from training.data.prepared import load_offsets
+    offsets = load_offsets(str(prepared3), "leader", "cpu").double()[torch.from_numpy(mirror).long()]
+    slid = y.clone()
+    slid[:, 0] += 0.05                  # every decoded body 5 cm off: planted feet slide
+    turn = y[:, P.OUT["root_update"].start + 2].abs()
+    threshold = float(turn.median())
+    full = float(P.partner_terms(slid, y, x, offsets, "leader", True)["foot_contact"])
+    spared = float(P.partner_terms(slid, y, x, offsets, "leader", True, spare_turning=threshold)["foot_contact"])
+    assert full > 0.0
+    assert 0.0 < spared < full
+    keep = turn <= threshold            # the term by hand over the samples that turn slowly
+    me = P.decoded_positions(slid, offsets)
+    before = P.block_positions(x, P.input_slices("leader")["self_pose"])
+    slide = (me[:, P.FEET][..., [0, 2]] - before[:, P.FEET][..., [0, 2]]).pow(2).sum(-1)
+    contacts = y[:, P.OUT["contacts"]].clamp(0, 1) * keep[:, None]
+    assert spared == pytest.approx(float((contacts * slide).mean()), rel=1e-9)
+    huge = float(P.partner_terms(slid, y, x, offsets, "leader", True, spare_turning=10.0)["foot_contact"])
+    assert huge == pytest.approx(full, rel=1e-12)
+
+
 def test_interaction_command_on_fresh_models(exported, data3, tmp_path, capsys):
     from training.evaluation.interaction import main
     rc = main(["--data", str(data3), "--takes", "06", "--models", str(exported["models"]), "--seeds", "1",

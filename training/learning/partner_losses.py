@@ -100,15 +100,21 @@ def interaction_loss(me: torch.Tensor, target: torch.Tensor, partner: torch.Tens
 
 def partner_terms(out: torch.Tensor, target: torch.Tensor, x: torch.Tensor, offsets: torch.Tensor,
                   role: str, recorded_contacts: bool = False,
-                  interaction_joints: list[int] = INTERACTION_JOINTS) -> dict[str, torch.Tensor]:
+                  interaction_joints: list[int] = INTERACTION_JOINTS,
+                  spare_turning: float = 0.0) -> dict[str, torch.Tensor]:
     """Raw decoded output, raw target output [B, 323], raw input [B, 660], offsets [B, 17, 3] ->
     the three terms (scalars). The foot-contact term is weighted by the decoded contacts, or by
-    the recorded ones with `recorded_contacts`."""
+    the recorded ones with `recorded_contacts`; with `spare_turning` (radians per frame) it skips
+    the samples whose recorded heading turns faster than that (a dancer pivoting on a planted foot)."""
     sl = input_slices(role)
     me = decoded_positions(out, offsets)
     recorded = decoded_positions(target, offsets)
     partner = block_positions(x, sl["partner_pose"])
     before = block_positions(x, sl["self_pose"])
+    contacts = (target if recorded_contacts else out)[:, OUT["contacts"]]
+    if spare_turning > 0:
+        turning = target[:, OUT["root_update"].start + 2].abs() > spare_turning
+        contacts = contacts * (~turning)[:, None]
     return {"penetration": penetration_loss(me, partner),
-            "foot_contact": foot_contact_loss(me, before, (target if recorded_contacts else out)[:, OUT["contacts"]]),
+            "foot_contact": foot_contact_loss(me, before, contacts),
             "interaction": interaction_loss(me, recorded, partner, interaction_joints)}
