@@ -141,24 +141,37 @@ export async function createPolicy(manifest: Manifest, name: string, bytes: Uint
     );
   }
   checkSession(name, entry, session);
-  await warmUp(session, entry);
+  await warmUp(session, entry, warmBatches(manifest, entry));
   return new Policy(name, entry, session, seed);
 }
 
 /**
- * One run on neutral inputs right after the session is created. A session's first run is much
- * slower than the next ones (onnxruntime allocates and plans its buffers then): done here, it
- * overlaps with the other downloads instead of delaying the first dancing frame. Tensors of its
- * own, so the policy's noise stream (and so the dance for a seed) is untouched.
+ * The batch sizes a model runs at: one step, and the batch of its dancer's upright guard
+ * (simulation.ts). The guard acts in well under 1 % of steps, so its first batch can come minutes
+ * into a dance; warmed up here, that step neither waits for new buffers nor grows the wasm memory.
  */
-async function warmUp(session: Session, entry: ModelEntry): Promise<void> {
+function warmBatches(manifest: Manifest, entry: ModelEntry): number[] {
+  const guard = entry.role === 'leader' ? manifest.leaderGuard : manifest.guard;
+  return guard && guard.samples >= 2 ? [1, guard.samples] : [1];
+}
+
+/**
+ * One run per batch size on neutral inputs right after the session is created. A session's first
+ * run at a size is much slower than the next ones (onnxruntime allocates and plans its buffers
+ * then): done here, it overlaps with the other downloads instead of delaying the first dancing
+ * frame. Tensors of its own, so the policy's noise stream (and so the dance for a seed) is untouched.
+ */
+async function warmUp(session: Session, entry: ModelEntry, batches: number[]): Promise<void> {
+  const width = inputSize(entry);
   const noise = entry.channels * entry.classes;
-  const outputs = await session.run({
-    input: new ort.Tensor('float32', new Float32Array(inputSize(entry)), [1, inputSize(entry)]),
-    temperature: new ort.Tensor('float32', new Float32Array([1]), [1]),
-    noise: new ort.Tensor('float32', new Float32Array(noise).fill(0.5), [1, noise]),
-  }, entry.intention ? ['output', 'intention'] : ['output']);
-  for (const tensor of Object.values(outputs)) tensor.dispose();
+  for (const k of batches) {
+    const outputs = await session.run({
+      input: new ort.Tensor('float32', new Float32Array(k * width), [k, width]),
+      temperature: new ort.Tensor('float32', new Float32Array([1]), [1]),
+      noise: new ort.Tensor('float32', new Float32Array(k * noise).fill(0.5), [k, noise]),
+    }, entry.intention ? ['output', 'intention'] : ['output']);
+    for (const tensor of Object.values(outputs)) tensor.dispose();
+  }
 }
 
 /** The ONNX graph must have the inputs and outputs of the contract, with matching widths. */
