@@ -191,7 +191,7 @@ def test_foot_contact_term_spares_turning_samples(prepared3):
     offsets = load_offsets(str(prepared3), "leader", "cpu").double()[torch.from_numpy(mirror).long()]
     slid = y.clone()
     slid[:, 0] += 0.05                  # every decoded body 5 cm off: planted feet slide
-    turn = y[:, P.OUT["root_update"].start + 2].abs()
+    turn = y[:, P.HEADING_CHANGE].abs()
     threshold = float(turn.median())
     full = float(P.partner_terms(slid, y, x, offsets, "leader", True)["foot_contact"])
     spared = float(P.partner_terms(slid, y, x, offsets, "leader", True, spare_turning=threshold)["foot_contact"])

@@ -32,6 +32,7 @@ SPINE_SAMPLES = 5        # points per spine segment for the penetration distance
 # Joints of each dancer whose mutual distances the interaction term keeps: head, chest, hands
 # (a recipe can keep the hands only: TrainConfig.interaction_hands_only).
 INTERACTION_JOINTS = [4, 2, *HANDS]
+HEADING_CHANGE = OUT["root_update"].start + 2   # the output's heading change (radians per frame)
 
 
 def input_slices(role: str) -> dict[str, slice]:
@@ -113,7 +114,7 @@ def partner_terms(out: torch.Tensor, target: torch.Tensor, x: torch.Tensor, offs
     before = block_positions(x, sl["self_pose"])
     contacts = (target if recorded_contacts else out)[:, OUT["contacts"]]
     if spare_turning > 0:
-        turning = target[:, OUT["root_update"].start + 2].abs() > spare_turning
+        turning = target[:, HEADING_CHANGE].abs() > spare_turning
         contacts = contacts * (~turning)[:, None]
     return {"penetration": penetration_loss(me, partner),
             "foot_contact": foot_contact_loss(me, before, contacts),

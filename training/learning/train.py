@@ -188,6 +188,12 @@ def partner_variant(**changes) -> TrainConfig:
     return replace(OURS_NO_PROXIMITY, **changes)
 
 
+# The leader shipped until the evening of 2026-11-27 (foot contact 30 on his decoded contacts): the
+# shipped leader and its variants change only his foot-contact term (MODELS below).
+LEADER_BEFORE_CONTACT = replace(steady(LEADER_STOP_MOTION), figure_dropout=0.5, state_dropout=0.5, own_rollouts_from=10,
+                                hands_plan_dropout=0.5, seed=2)
+
+
 # The models `--all` trains (shipped), and the ones evaluation adds (ablations, larger CCM).
 MODELS = {
     # The predictor fits training frames better than new ones (MSE 0.14 vs 0.23): noise of the
@@ -258,29 +264,21 @@ MODELS = {
     # the next second), shown in half the samples: a visitor's request raises his lead hand
     # through it (rollout.hands_input), and beside him she turns after 77 % of requests against
     # 58 % of the same moments unasked (the figure block alone: 56 % against 56 %).
-    # Since 2026-11-27 (evening) his foot-contact term is the followers' (weight 100 on the recorded contacts,
-    # where it was 30 on his decoded ones), sparing the samples where his recorded heading turns
+    # Since 2026-11-27 (evening) his foot-contact term is the followers' (weight 100 on the
+    # recorded contacts, where it was 30 on his decoded ones), sparing the samples where his recorded heading turns
     # faster than 120 degrees a second (TrainConfig.contact_spare_turning). His steered skate in
     # contact was 2.01x the recording's, 64 % of it his planted foot sliding from where it was;
     # now 1.28x, and nobody steering he turns 9.5 times a minute (0.82x; before 5.6) and stays
     # within 1.47 m of his spot (before up to 4.13 m). Without the sparing he stopped turning
     # (0.7 a minute nobody steering; at 300, none); at 30 on the recorded contacts he turned 13.8
     # times a minute but had a bad second in 15 of 100 steered seeds (docs/results.md, "His feet").
-    "leader": replace(steady(LEADER_STOP_MOTION), figure_dropout=0.5, state_dropout=0.5, own_rollouts_from=10,
-                      hands_plan_dropout=0.5, seed=2, lambda_foot_contact=100.0, recorded_contacts=True,
+    "leader": replace(LEADER_BEFORE_CONTACT, lambda_foot_contact=100.0, recorded_contacts=True,
                       contact_spare_turning=120.0),
-    "leader_recorded_contact": replace(steady(LEADER_STOP_MOTION), figure_dropout=0.5, state_dropout=0.5,
-                                       own_rollouts_from=10, hands_plan_dropout=0.5, seed=2,
-                                       lambda_foot_contact=100.0, recorded_contacts=True),
-    "leader_recorded_contact_300": replace(steady(LEADER_STOP_MOTION), figure_dropout=0.5, state_dropout=0.5,
-                                           own_rollouts_from=10, hands_plan_dropout=0.5, seed=2,
-                                           lambda_foot_contact=300.0, recorded_contacts=True),
-    "leader_recorded_contact_30": replace(steady(LEADER_STOP_MOTION), figure_dropout=0.5, state_dropout=0.5,
-                                          own_rollouts_from=10, hands_plan_dropout=0.5, seed=2,
-                                          lambda_foot_contact=30.0, recorded_contacts=True),
+    "leader_recorded_contact": replace(LEADER_BEFORE_CONTACT, lambda_foot_contact=100.0, recorded_contacts=True),
+    "leader_recorded_contact_300": replace(LEADER_BEFORE_CONTACT, lambda_foot_contact=300.0, recorded_contacts=True),
+    "leader_recorded_contact_30": replace(LEADER_BEFORE_CONTACT, lambda_foot_contact=30.0, recorded_contacts=True),
     # The leader shipped until then (his decoded contacts, weight 30).
-    "leader_before_contact": replace(steady(LEADER_STOP_MOTION), figure_dropout=0.5, state_dropout=0.5,
-                                     own_rollouts_from=10, hands_plan_dropout=0.5, seed=2),
+    "leader_before_contact": LEADER_BEFORE_CONTACT,
     # The leader shipped before that (no hands plan).
     "leader_before_hands": replace(steady(LEADER_STOP_MOTION), figure_dropout=0.5, state_dropout=0.5,
                                    own_rollouts_from=10, seed=2),

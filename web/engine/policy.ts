@@ -148,7 +148,8 @@ export async function createPolicy(manifest: Manifest, name: string, bytes: Uint
 /**
  * The batch sizes a model runs at: one step, and the batch of its dancer's upright guard
  * (simulation.ts). The guard acts in well under 1 % of steps, so its first batch can come minutes
- * into a dance; warmed up here, that step neither waits for new buffers nor grows the wasm memory.
+ * into a dance; warmed up here, that step does not wait for new buffers. (The WebAssembly memory
+ * can still take one growth step later: tests/e2e/soak.test.mjs.)
  */
 function warmBatches(manifest: Manifest, entry: ModelEntry): number[] {
   const guard = entry.role === 'leader' ? manifest.leaderGuard : manifest.guard;
