@@ -160,6 +160,33 @@ def test_lead_runs_on_freshly_exported_models(exported, data3, tmp_path, capsys)
     assert "Does he lead?" in capsys.readouterr().out
 
 
+def test_the_film_dances_the_duet_the_table_measured(exported):
+    """unasked_duet (what scripts/worst_seed.py --nobody-steering films) is one_duet's duet of the
+    same seed: the same figures; asked for a turn, it is the same duet until the request."""
+    import argparse
+
+    from training.evaluation import figures as Fg
+    from training.evaluation import options as O
+    from training.evaluation.evaluate_inputs import find_models, load_onnx
+
+    manifest, onnx, leader_path = find_models(exported["models"])
+    args = argparse.Namespace(temperature=None, follower_temperature=None, guard=None, guard_margin=None,
+                              leader_guard=None)
+    assert O.resolve(args, manifest) is None
+    leader = O.leader_policy(load_onnx(leader_path), manifest, args)
+    follower = O.follower_policy(load_onnx(onnx["ours"]), manifest, args, args.temperature)
+    table = lead.one_duet(manifest, leader, follower, args.temperature, 1, 9.0)
+    film = lead.unasked_duet(manifest, leader, follower, args.temperature, 1, 9.0)
+    for who in ("leader", "follower"):
+        got = Fg.dancer(film[who])
+        assert all(got[k] == pytest.approx(v) for k, v in table[who].items()), who
+    assert film["leader_shown"].shape == film["leader"].shape == (9 * FPS, 17, 3)
+    asked = lead.unasked_duet(manifest, leader, follower, args.temperature, 1, 9.0, ask=(4.0, -1))
+    at = 4 * FPS
+    assert np.array_equal(asked["leader"][:at], film["leader"][:at])
+    assert not np.allclose(asked["leader"][at + FPS], film["leader"][at + FPS])
+
+
 def test_lead_names_missing_models(tmp_path, capsys):
     assert lead.main(["--models", str(tmp_path), "--seeds", "1"]) == 2
     assert "manifest.json not found" in capsys.readouterr().err

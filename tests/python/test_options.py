@@ -80,6 +80,10 @@ def test_the_leader_is_guarded_as_the_manifest_says():
     assert lead.head_margin is None                       # a manifest without headMargin: the one margin
     head = manifest(leaderTemperature=0.5, leaderGuard={"samples": 8, "margin": 0.07, "headMargin": 0.03})
     assert O.leader_policy(policy, head, args).head_margin == 0.03
+    assert lead.hip_margin is None and O.leader_policy(policy, head, args).hip_margin is None
+    hips = manifest(leaderTemperature=0.5, leaderGuard={"samples": 8, "margin": 0.07, "hipMargin": 0.1})
+    guarded = O.leader_policy(policy, hips, args)
+    assert guarded.hip_margin == 0.1 and guarded.hip_slack == pytest.approx(0.07 - 0.1)
     off = parse("--leader-guard", "0")
     assert O.resolve(off, m) is None and O.leader_policy(policy, m, off) is policy
     old = parse()
@@ -113,4 +117,6 @@ def test_the_shipped_manifest_carries_the_guards_export_writes():
     leader = {"samples": G.LEADER_SAMPLES, "margin": G.LEADER_MARGIN}
     if G.LEADER_HEAD_MARGIN is not None:
         leader["headMargin"] = G.LEADER_HEAD_MARGIN
+    if G.LEADER_HIP_MARGIN is not None:
+        leader["hipMargin"] = G.LEADER_HIP_MARGIN
     assert shipped["guard"] == follower and shipped["leaderGuard"] == leader

@@ -161,6 +161,21 @@ describe('createSimulation', () => {
     expect(q[4 * 3 + 1] - q[1]).toBeLessThan(0.2);
   });
 
+  it('the leader guard judges his hips from its hipMargin', async () => {
+    const ranges = { hip_low: 0.7, head_above_hip_low: 0.4, feet_wide: 1.07, angle_high: [2.5, 0.59] };
+    // A standing leader is within 5 m of the hips' edge: judged from there, every step is guarded.
+    const wide = { leaderTemperature: 0.5, leaderGuard: { samples: 4, margin: 0.05, hipMargin: 5 }, plausibility: ranges };
+    const hips = simulation([{ role: 'follower' }], { role: 'leader' }, wide);
+    await hips.sim.step(steer, 1);
+    expect(hips.lead.temperatures).toEqual([0.5, 0.5]); // his own run, then the guard's batch
+    expect(hips.sim.guards().upright).toBe(1);
+    // Judged from the margin alone, the same standing leader is left as he is.
+    const plain = simulation([{ role: 'follower' }], { role: 'leader' }, { ...wide, leaderGuard: { samples: 4, margin: 0.05 } });
+    await plain.sim.step(steer, 1);
+    expect(plain.lead.temperatures).toEqual([0.5]);
+    expect(plain.sim.guards().upright).toBe(0);
+  });
+
   it('starts both dancers in world space: leader at the origin, follower 0.8 m ahead facing it', () => {
     const sim = createSimulation({ manifest, leader: policy({ role: 'leader' }), followers: [policy({ role: 'follower' })], seed: 1 });
     expect(sim.leader.root).toEqual([0, 0]);

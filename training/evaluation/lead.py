@@ -125,6 +125,32 @@ def one_duet(manifest, leader, follower, temperature: float, seed: int, seconds:
             "leader_from_start_m": float(np.linalg.norm(lead[:, 0, [0, 2]] - lead[0, 0, [0, 2]], axis=-1).max())}
 
 
+def unasked_duet(manifest, leader, follower, temperature: float, seed: int, seconds: float,
+                 ask: tuple[float, int] | None = None) -> dict:
+    """The duet one_duet dances for `seed`, without its request copies (the random stream is the
+    same: each request's direction is still drawn): world positions [frames, 17, 3] of `leader`
+    and `follower` as the networks left them (what one_duet measures) and `leader_shown`,
+    `follower_shown` after the contact layer (what the page shows). To film a seed of
+    this command's tables (scripts/worst_seed.py --nobody-steering). `ask` (seconds, direction):
+    the duet itself is asked for a turn then (one_duet asks that request's copy at frame
+    seconds * FPS, with its own random stream: the film shows the request, not the same draws)."""
+    rng = np.random.default_rng(seed)
+    duet = start_duet(manifest)
+    frames = int(seconds * FPS)
+    window = int(REQUEST_SECONDS * FPS)
+    ask_at = set(range(int(WARM_UP * FPS), frames - window, int(REQUEST_EVERY * FPS)))
+    out = {k: np.zeros((frames, 17, 3)) for k in ("leader", "follower", "leader_shown", "follower_shown")}
+    for f in range(frames):
+        if f in ask_at:
+            rng.choice([-1, 1])
+        if ask is not None and f == int(round(ask[0] * FPS)):
+            ask_turn(duet, ask[1])
+        step(duet, leader, follower, np.zeros(2), temperature, rng)
+        out["leader"][f], out["follower"][f] = duet.leader.track.positions[NOW], duet.follower.track.positions[NOW]
+        out["leader_shown"][f], out["follower_shown"][f] = duet.shown
+    return out
+
+
 def summary(per_seed: list[dict], ref: dict) -> dict:
     req = [r for s in per_seed for r in s["requests"]]
     n = len(req)

@@ -69,6 +69,13 @@ LEADER_MARGIN = 0.07   # m
 # partner fell in 7 of 66 soak rollouts until her hips were guarded from FOLLOWER_HIP_MARGIN.
 # docs/results.md, "The leader's guard" and "Room for his head, her hips guarded".
 LEADER_HEAD_MARGIN: float | None = 0.03   # m; None: the head is judged from LEADER_MARGIN
+# His hips, like hers, go down in a crouch that no sample brings back up once it is low: the one
+# steered seed with a bad second beside the leader of 2026-11-27 (seed 61) crouched from 55.5 s on,
+# hips down to 0.47 m, his guard choosing in 70 steps without finding a standing sample. Judged
+# from 0.10 m (it acts while the drawn hips are under 0.813 m, below his lunges at 0.84-0.86 m), 100
+# steered seeds had no bad second and his guard chose in 0.20 % of his steps (0.23 % before);
+# nobody steering he turns and moves as before (docs/results.md, "His hips guarded").
+LEADER_HIP_MARGIN: float | None = 0.10    # m; None: the hips are judged from LEADER_MARGIN
 
 POSE = feat.block_slices(feat.OUTPUT_LAYOUT)["pose"]
 HANDS_PLAN_SHOWN = feat.block_slices(feat.LEADER_INPUT_LAYOUT)["hands_plan"].start   # 1 while a request runs

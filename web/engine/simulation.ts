@@ -194,19 +194,21 @@ export class DuetSimulation implements Simulation {
     this.upright++;
   }
 
-  /** The same guard on the leader's output (mirror/guard.py's UprightGuard wraps his policy alike). */
+  /** The same guard on the leader's output (mirror/guard.py's UprightGuard wraps his policy alike):
+   *  his head judged from the headMargin, his hips from the hipMargin, when the manifest has them. */
   private async keepLeaderUpright(temperature: number): Promise<void> {
     const guard = this.leaderGuard;
     if (!guard) return;
     const offsets = this.duet.leader.offsets;
     const policy = this.leaderPolicy;
     const slack = slackFor(policy.input, guard.settings.margin, guard.settings.headMargin);
-    if (uprightMargin(this.leaderOutput, 0, guard.ranges, offsets, slack) >= guard.settings.margin) return;
+    const hipSlack = hipSlackFor(policy.input, guard.settings.margin, guard.settings.hipMargin);
+    if (uprightMargin(this.leaderOutput, 0, guard.ranges, offsets, slack, hipSlack) >= guard.settings.margin) return;
     const k = guard.settings.samples;
     const input = policy.batchInput(k);
     for (let n = 0; n < k; n++) input.set(policy.input, n * policy.input.length);
     const { output } = await policy.runBatch(k, temperature);
-    const best = mostUpright(output, k, OUTPUT_SIZE, guard.ranges, offsets, slack);
+    const best = mostUpright(output, k, OUTPUT_SIZE, guard.ranges, offsets, slack, hipSlack);
     this.leaderOutput.set(output.subarray(best * OUTPUT_SIZE, (best + 1) * OUTPUT_SIZE));
     this.upright++;
   }

@@ -8,7 +8,8 @@
 // body never jumps; the guard only chooses among the network's own reactions. Measured in Python:
 // it chose in 210 of 1.8 M follower steps of the 100 x 10 min soak (docs/reliability.md). A
 // manifest's leaderGuard.headMargin judges the leader's head over his hips from a smaller margin
-// (0.03 m shipped), except while he leads a turn; its guard.hipMargin judges the follower's hips
+// (0.03 m shipped), except while he leads a turn, and its leaderGuard.hipMargin his hips from a
+// larger one (0.10 m: a crouch caught before it is too deep); its guard.hipMargin judges the follower's hips
 // from a larger one (0.15 m shipped): beside the leader who then lunges, her hips drop fast when
 // she falls (guard.py, LEADER_HEAD_MARGIN and FOLLOWER_HIP_MARGIN); and while her input shows his
 // hips below guard.partnerLow (a lunge), from guard.partnerLowHipMargin (guard.py, PARTNER_LOW).
@@ -35,7 +36,8 @@ export interface GuardSettings {
   margin: number;
   /** The leader's: metres before the edge of the head over the hips (a narrow range) it acts. */
   headMargin?: number;
-  /** The follower's: metres before the edge of the hips it acts (they drop fast once she falls). */
+  /** Metres before the edge of the hips it acts: hers drop fast once she falls, his in a crouch
+   *  that no sample brings back up once it is low (guard.py, LEADER_HIP_MARGIN). */
   hipMargin?: number;
   /** The follower's: while her input shows his hips below this height (m), her hips are judged
    *  from partnerLowHipMargin instead (she goes down with his lunge). */
