@@ -147,7 +147,7 @@ class UprightGuard:
     in which it picked another sample (reset it per duet). `temperature` overrides the one the
     duet's step asks for (the follower's own variety; the leader keeps the duet's). `head_margin`
     (the leader's): the head over the hips is judged from that margin instead, except while his
-    input shows a hands plan. `hip_margin` (the follower's): the hips are judged from that margin;
+    input shows a hands plan. `hip_margin` (both dancers'): the hips are judged from that margin;
     `partner_low`, `partner_low_hip_margin` (hers): from that one while her input shows his hips
     below that height."""
 
