@@ -19,7 +19,7 @@
 // Whether the follower completes a turn is printed, not asserted: she is not told, and over seeds
 // 1-20 she turned 300° either way within 2.5 s in 11 of 20 asked runs and 11 of 20 unasked (in
 // Python over 500 requests, 77 % against 71 %: docs/results.md, "His feet"). Seed 6 is the strip's
-// because she completes the led turn there (587° to her right within 1.13 s asked, 155° unasked,
+// because she completes the led turn there (587° to her right within 2.5 s asked, the first full turn after 1.13 s; 155° unasked,
 // with the leader of the evening of 2026-11-27; seed 7, the strip's before, no longer raises his
 // hand): what a led turn looks like when it works.
 //

@@ -90,13 +90,19 @@ def lead_seen(detector: C.Detector | None, body: np.ndarray | None, direction: i
     return any(d == direction for _, d in detector.turns(s))
 
 
+def request_frames(frames: int) -> set[int]:
+    """The frames of a duet of `frames` at which a request is made (one every REQUEST_EVERY seconds
+    after WARM_UP, each with REQUEST_SECONDS left to be danced)."""
+    return set(range(int(WARM_UP * FPS), frames - int(REQUEST_SECONDS * FPS), int(REQUEST_EVERY * FPS)))
+
+
 def one_duet(manifest, leader, follower, temperature: float, seed: int, seconds: float,
              detector: C.Detector | None = None) -> dict:
     rng = np.random.default_rng(seed)
     duet = start_duet(manifest)
     frames = int(seconds * FPS)
     window = int(REQUEST_SECONDS * FPS)
-    ask_at = set(range(int(WARM_UP * FPS), frames - window, int(REQUEST_EVERY * FPS)))
+    ask_at = request_frames(frames)
     lead, follow = np.zeros((frames, 17, 3)), np.zeros((frames, 17, 3))
     requests = []
     for f in range(frames):
@@ -137,8 +143,7 @@ def unasked_duet(manifest, leader, follower, temperature: float, seed: int, seco
     rng = np.random.default_rng(seed)
     duet = start_duet(manifest)
     frames = int(seconds * FPS)
-    window = int(REQUEST_SECONDS * FPS)
-    ask_at = set(range(int(WARM_UP * FPS), frames - window, int(REQUEST_EVERY * FPS)))
+    ask_at = request_frames(frames)
     out = {k: np.zeros((frames, 17, 3)) for k in ("leader", "follower", "leader_shown", "follower_shown")}
     for f in range(frames):
         if f in ask_at:

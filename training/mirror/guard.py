@@ -1,4 +1,4 @@
-"""The follower's upright guard (web/mirror/guard.ts mirrors it name for name).
+"""The dancers' upright guard, the follower's first (web/mirror/guard.ts mirrors it name for name).
 
 A follower whose decoder is kept reading its code (train.py's `follower`: state dropout) is as
 varied as the recording, but now and then, left alone, it sinks or tips over (docs/plausibility.md).

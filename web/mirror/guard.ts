@@ -1,4 +1,4 @@
-// Mirror of training/mirror/guard.py: the follower's upright guard.
+// Mirror of training/mirror/guard.py: the dancers' upright guard, the follower's first.
 //
 // When the body a follower's step would draw (the decoded hip and joint rotations through its
 // bones, lifted as applyOutput lifts it) comes within the manifest's margin of the recording's
@@ -9,8 +9,8 @@
 // it chose in 210 of 1.8 M follower steps of the 100 x 10 min soak (docs/reliability.md). A
 // manifest's leaderGuard.headMargin judges the leader's head over his hips from a smaller margin
 // (0.03 m shipped), except while he leads a turn, and its leaderGuard.hipMargin his hips from a
-// larger one (0.10 m: a crouch caught before it is too deep); its guard.hipMargin judges the follower's hips
-// from a larger one (0.15 m shipped): beside the leader who then lunges, her hips drop fast when
+// larger one (0.10 m: a crouch caught before it is too deep); its guard.hipMargin judges the
+// follower's hips from a larger one (0.15 m shipped): beside the leader who then lunges, her hips drop fast when
 // she falls (guard.py, LEADER_HEAD_MARGIN and FOLLOWER_HIP_MARGIN); and while her input shows his
 // hips below guard.partnerLow (a lunge), from guard.partnerLowHipMargin (guard.py, PARTNER_LOW).
 
