@@ -6,6 +6,7 @@
 //
 //   npm run bench                 # threads 1 and 2
 //   node scripts/bench.mjs --seconds 20 --json
+//   npm run bench -- --leading    # the same, T pressed every 2 s: every step leads her turn
 //   npm run bench -- --phone      # a phone on a mobile network: see scripts/bench_phone.mjs
 //   npm run bench -- --phone --boot-only --query threads=1   # only the two visits, extra URL settings
 //
@@ -22,6 +23,18 @@ const option = (name, fallback) => {
 const seconds = Number(option('seconds', 14)); // >= 10 s so the 300-step window is full
 const threadCounts = option('threads', '1,2').split(',').map(Number);
 const json = args.includes('--json');
+// While a turn is led the leader's guard draws its samples every step (leaderGuard.keepPlan), so the
+// step costs more then: --leading presses T every 2 s (a request lasts 2.5 s) to time those steps.
+const leading = args.includes('--leading');
+
+/** Waits `ms`, pressing T every 2 s when --leading. */
+async function dance(page, ms) {
+  if (!leading) return sleep(ms);
+  for (let t = 0; t < ms; t += 2000) {
+    await page.keyboard.press('t');
+    await sleep(Math.min(2000, ms - t));
+  }
+}
 
 const mb = (bytes) => `${(bytes / 1e6).toFixed(2)} MB`;
 
@@ -53,10 +66,10 @@ async function run(url, threads) {
 
     // Step time while steering, as a person would.
     await page.keyboard.down('ArrowUp');
-    await sleep((seconds * 1000) / 2);
+    await dance(page, (seconds * 1000) / 2);
     await page.keyboard.up('ArrowUp');
     await page.keyboard.down('ArrowLeft');
-    await sleep((seconds * 1000) / 2);
+    await dance(page, (seconds * 1000) / 2);
     await page.keyboard.up('ArrowLeft');
     const state = await duet(page);
     if (state.error) throw new Error(state.error);
@@ -108,7 +121,7 @@ if (json) {
   console.log(JSON.stringify(results, null, 1));
 } else {
   for (const r of results) {
-    console.log(`\nthreads ${r.threads} (asked ${r.requestedThreads}, cross-origin isolated: ${r.crossOriginIsolated})`);
+    console.log(`\nthreads ${r.threads} (asked ${r.requestedThreads}, cross-origin isolated: ${r.crossOriginIsolated})${leading ? ', T every 2 s' : ''}`);
     console.log(`  step            median ${r.stepMs.median.toFixed(2)} ms   p95 ${r.stepMs.p95.toFixed(2)} ms`);
     console.log(`  cold load       ${(r.coldLoadMs / 1000).toFixed(2)} s to the first dancing frame on screen`);
     console.log(`  models          ${mb(r.modelBytes)}`);

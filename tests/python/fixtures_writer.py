@@ -487,6 +487,10 @@ def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_o
     # The leader's head margin: the head over the hips let off 0.04 m, under a range whose head part
     # binds for the upright bodies (so the slack shows).
     tight = {**ranges, "head_above_hip_low": 0.75}
+    plan_input = np.zeros(feat.LEADER_INPUT_SIZE)
+    plan_input[G.HANDS_PLAN_SHOWN] = 1.0
+    plan_input[G.HAND_HEIGHTS] = 0.8, 0.7
+    plan_input[G.HAND_PLAN_FIRST] = 0.05, 0.4
     uprightness = {"outputs": exact(outputs), "ranges": ranges,
                    "margins": out7(G.upright_margin(outputs, ranges, follow_offsets)),
                    "best": G.most_upright(outputs, ranges, follow_offsets),
@@ -497,7 +501,14 @@ def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_o
                    "hipSlackBest": G.most_upright(outputs, ranges, follow_offsets, 0.0, -0.1),
                    "handsPlanShown": G.HANDS_PLAN_SHOWN,
                    # Her hips' slack from what her input shows of his hips (guard.hip_slack_for).
-                   "partnerHips": G.PARTNER_HIPS, "hipSlackFor": hip_slack_cases()}
+                   "partnerHips": G.PARTNER_HIPS, "hipSlackFor": hip_slack_cases(),
+                   # The leader's lead hand kept to a request's plan (guard.lead_hand_miss, nearest_plan),
+                   # on the same bodies: the plan raises his right hand 0.4 m by the first key. At margin 0
+                   # the second body's hand is nearest; at 0.05 it does not stand, and the first is taken.
+                   "handHeights": G.HAND_HEIGHTS, "handPlanFirst": G.HAND_PLAN_FIRST,
+                   "planInput": exact(plan_input), "planMiss": out7(G.lead_hand_miss(outputs, plan_input, follow_offsets)),
+                   "planBest": G.nearest_plan(outputs, plan_input, ranges, follow_offsets, 0.0),
+                   "planBestStanding": G.nearest_plan(outputs, plan_input, ranges, follow_offsets, 0.05)}
     return {
         "NOW": ro.NOW, "TRACK_FRAMES": ro.TRACK_FRAMES, "guards": guards, "upright": uprightness,
         "rotationsFromVectors": {"forward": exact(vectors_f), "up": exact(vectors_u),

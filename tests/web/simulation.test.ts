@@ -3,7 +3,7 @@
 // playback from a recording, foot locking on the drawn pose only, step timing.
 
 import { describe, expect, it } from 'vitest';
-import { FOLLOWER_INPUT_LAYOUT, INPUT_SIZE, LEADER_INPUT_LAYOUT, OUTPUT_LAYOUT, OUTPUT_SIZE, Track, blockSlices } from '../../web/mirror/features';
+import { FOLLOWER_INPUT_LAYOUT, INPUT_SIZE, LEADER_INPUT_LAYOUT, LEADER_INPUT_SIZE, OUTPUT_LAYOUT, OUTPUT_SIZE, Track, blockSlices } from '../../web/mirror/features';
 import { ANCHOR_FREE, ANCHOR_RATE, NOW } from '../../web/mirror/rollout';
 import { type DuetSimulation, createSimulation } from '../../web/engine/simulation';
 import type { Motion } from '../../web/mirror/skeleton';
@@ -43,15 +43,20 @@ interface FakeOptions {
 
 /** A stand-in for Policy: "keep the current pose, move `step` forward", built from its own input. */
 class FakePolicy implements StepPolicy {
-  readonly input = new Float32Array(INPUT_SIZE);
+  readonly input: Float32Array;
   readonly result = { output: new Float32Array(OUTPUT_SIZE), intention: null as Float32Array | null };
   readonly entry = { intention: false };
   runs = 0;
+  private readonly size: number;
+  /** The batch sizes asked for, in order. */
+  readonly batchSizes: number[] = [];
   /** The temperature of every run and batch, in order. */
   readonly temperatures: number[] = [];
   private readonly batches = new Map<number, { input: Float32Array; output: Float32Array }>();
 
   constructor(readonly options: FakeOptions) {
+    this.size = options.role === 'leader' ? LEADER_INPUT_SIZE : INPUT_SIZE;
+    this.input = new Float32Array(this.size);
     this.entry.intention = !!options.intention;
     if (options.intention) this.result.intention = new Float32Array(90);
   }
@@ -68,14 +73,15 @@ class FakePolicy implements StepPolicy {
   }
 
   batchInput(k: number) {
-    if (!this.batches.has(k)) this.batches.set(k, { input: new Float32Array(k * INPUT_SIZE), output: new Float32Array(k * OUTPUT_SIZE) });
+    if (!this.batches.has(k)) this.batches.set(k, { input: new Float32Array(k * this.size), output: new Float32Array(k * OUTPUT_SIZE) });
     return this.batches.get(k)!.input;
   }
 
   async runBatch(k: number, temperature: number) {
     this.temperatures.push(temperature);
+    this.batchSizes.push(k);
     const b = this.batches.get(k)!;
-    for (let i = 0; i < k; i++) this.fill(b.input, i * INPUT_SIZE, b.output, i * OUTPUT_SIZE, i);
+    for (let i = 0; i < k; i++) this.fill(b.input, i * this.size, b.output, i * OUTPUT_SIZE, i);
     return { output: b.output, intention: null };
   }
 
@@ -174,6 +180,28 @@ describe('createSimulation', () => {
     await plain.sim.step(steer, 1);
     expect(plain.lead.temperatures).toEqual([0.5]);
     expect(plain.sim.guards().upright).toBe(0);
+  });
+
+  it('with keepPlan, a request draws his samples at once and keeps the standing one whose lead hand is nearest the plan', async () => {
+    const ranges = { hip_low: 0.7, head_above_hip_low: 0.4, feet_wide: 1.07, angle_high: [2.5, 0.59] };
+    const keep = { leaderTemperature: 0.5, leaderGuard: { samples: 4, margin: 0.05, keepPlan: true }, plausibility: ranges };
+    // Sample i stands 2 cm x i further to his side (the fake's spread): the samples differ, all stand.
+    const { sim, lead } = simulation([{ role: 'follower' }], { role: 'leader', spread: 0.02 }, keep);
+    await sim.step(steer, 1);
+    expect(lead.temperatures).toEqual([0.5]); // nobody asks: his one run, standing, as before
+    expect(sim.askTurn(-1)).toBe(true);
+    await sim.step(steer, 1);
+    expect(lead.runs).toBe(1); // asked: no single run ...
+    expect(lead.batchSizes).toEqual([4]); // ... the batch alone, at his variety
+    expect(lead.temperatures).toEqual([0.5, 0.5]);
+    expect(sim.guards().upright).toBe(0); // a standing sample was kept: not a guarded step
+    // Without keepPlan the same request takes his one sample, as before.
+    const plain = simulation([{ role: 'follower' }], { role: 'leader', spread: 0.02 }, { ...keep, leaderGuard: { samples: 4, margin: 0.05 } });
+    await plain.sim.step(steer, 1);
+    plain.sim.askTurn(-1);
+    await plain.sim.step(steer, 1);
+    expect(plain.lead.runs).toBe(2);
+    expect(plain.lead.batchSizes).toEqual([]);
   });
 
   it('starts both dancers in world space: leader at the origin, follower 0.8 m ahead facing it', () => {

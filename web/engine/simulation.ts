@@ -9,7 +9,7 @@ import { FUTURE_OFFSETS, INPUT_SIZE, INTENTION_SIZE, KEYS, OUTPUT_SIZE, follower
 import { KEY_JOINTS, type Motion, POSITIONS_SIZE, ROTATIONS_SIZE } from '../mirror/skeleton';
 import { ContactLayer, FOLLOWER_CONTACT } from '../mirror/contact';
 import { FootLock } from '../mirror/footik';
-import { type GuardSettings, type Ranges, hipSlackFor, mostUpright, slackFor, uprightMargin } from '../mirror/guard';
+import { type GuardSettings, type Ranges, hipSlackFor, mostUpright, nearestPlan, showsPlan, slackFor, uprightMargin } from '../mirror/guard';
 import { LeaderPlayback } from './playback';
 import { StepTimer } from './timing';
 import {
@@ -153,11 +153,7 @@ export class DuetSimulation implements Simulation {
       steerPlan(duet.leader, duet.steering, sx, sz);
     }
     stepInputs(duet, playing ? null : this.leaderPolicy.input, this.followerInputs);
-    if (!playing) {
-      const result = await this.leaderPolicy.run(this.leaderTemperature ?? temperature);
-      this.leaderOutput.set(result.output);
-      await this.keepLeaderUpright(this.leaderTemperature ?? temperature);
-    }
+    if (!playing) await this.stepLeader(this.leaderTemperature ?? temperature);
     for (let i = 0; i < this.followerPolicies.length; i++) {
       const result = await this.followerPolicies[i].run(temperature);
       this.followerOutputs[i].set(result.output);
@@ -194,23 +190,35 @@ export class DuetSimulation implements Simulation {
     this.upright++;
   }
 
-  /** The same guard on the leader's output (mirror/guard.py's UprightGuard wraps his policy alike):
-   *  his head judged from the headMargin, his hips from the hipMargin, when the manifest has them. */
-  private async keepLeaderUpright(temperature: number): Promise<void> {
+  /** The leader's output of this step, under the same guard (mirror/guard.py's UprightGuard wraps
+   *  his policy alike): his head judged from the headMargin, his hips from the hipMargin, when the
+   *  manifest has them. With keepPlan, while a request runs, every step draws the samples at once
+   *  and takes the standing one whose lead hand is nearest the plan (guard.ts nearestPlan). */
+  private async stepLeader(temperature: number): Promise<void> {
     const guard = this.leaderGuard;
-    if (!guard) return;
+    if (!guard) {
+      this.leaderOutput.set((await this.leaderPolicy.run(temperature)).output);
+      return;
+    }
     const offsets = this.duet.leader.offsets;
     const policy = this.leaderPolicy;
-    const slack = slackFor(policy.input, guard.settings.margin, guard.settings.headMargin);
-    const hipSlack = hipSlackFor(policy.input, guard.settings.margin, guard.settings.hipMargin);
-    if (uprightMargin(this.leaderOutput, 0, guard.ranges, offsets, slack, hipSlack) >= guard.settings.margin) return;
-    const k = guard.settings.samples;
+    const { margin, headMargin, hipMargin, keepPlan, samples: k } = guard.settings;
+    const slack = slackFor(policy.input, margin, headMargin);
+    const hipSlack = hipSlackFor(policy.input, margin, hipMargin);
+    const plan = keepPlan === true && showsPlan(policy.input);
+    if (!plan) {
+      const result = await policy.run(temperature);
+      this.leaderOutput.set(result.output);
+      if (uprightMargin(this.leaderOutput, 0, guard.ranges, offsets, slack, hipSlack) >= margin) return;
+    }
     const input = policy.batchInput(k);
     for (let n = 0; n < k; n++) input.set(policy.input, n * policy.input.length);
     const { output } = await policy.runBatch(k, temperature);
-    const best = mostUpright(output, k, OUTPUT_SIZE, guard.ranges, offsets, slack, hipSlack);
+    const best = plan
+      ? nearestPlan(output, k, OUTPUT_SIZE, policy.input, guard.ranges, offsets, margin, slack, hipSlack)
+      : mostUpright(output, k, OUTPUT_SIZE, guard.ranges, offsets, slack, hipSlack);
     this.leaderOutput.set(output.subarray(best * OUTPUT_SIZE, (best + 1) * OUTPUT_SIZE));
-    this.upright++;
+    if (!plan || uprightMargin(this.leaderOutput, 0, guard.ranges, offsets, slack, hipSlack) < margin) this.upright++;
   }
 
   /**
