@@ -207,3 +207,36 @@ def test_recorded_leads_names_a_folder_without_takes(tmp_path, capsys):
     from training.evaluation import recorded_leads
     assert recorded_leads.main(["--data", str(tmp_path)]) == 2
     assert "error" in capsys.readouterr().err
+
+
+def test_page_figures_measures_a_dump_as_figures_measures_the_recording(data3, tmp_path, capsys):
+    """training.evaluation.page_figures on a dump of the recorded take 06 itself (as the probe writes
+    the page's duets): every rate is 1.0x the recording of take 06, and bad dumps are named."""
+    import json
+
+    import numpy as np
+
+    from training.evaluation import page_figures
+    from training.evaluation.evaluate_inputs import load_eval_takes
+
+    take = load_eval_takes(str(data3), ["06"], None, None)[0]
+    seed = {"seed": 7, "leader": take.lead.positions.reshape(len(take.lead.positions), -1).tolist(),
+            "follower": take.follow.positions.reshape(len(take.follow.positions), -1).tolist()}
+    dump = tmp_path / "probe.json"
+    dump.write_text(json.dumps({"fps": 30, "seconds": len(take.lead.positions) / 30, "seeds": [seed]}))
+    assert page_figures.main([str(dump), "--data", str(data3), "--takes", "06", "--out", str(tmp_path / "out")]) == 0
+    res = json.loads((tmp_path / "out" / "page_figures.json").read_text())
+    for who in ("leader", "follower"):
+        for k, v in res["summary"][who]["ratio"].items():
+            assert v is None or np.isnan(v) or v == pytest.approx(1.0), (who, k, v)
+        assert res["summary"][who]["worst_seed"] == 7
+    assert "seed 7" in capsys.readouterr().out
+    far = np.linalg.norm(take.lead.positions[:, 0, [0, 2]] - take.lead.positions[0, 0, [0, 2]], axis=-1).max()
+    assert res["summary"]["leader_from_start_m"]["max"] == pytest.approx(far)
+
+    short = tmp_path / "short.json"
+    short.write_text(json.dumps({"fps": 30, "seeds": [{**seed, "leader": seed["leader"][:20]}]}))
+    assert page_figures.main([str(short), "--data", str(data3)]) == 2
+    assert "at least 5 s" in capsys.readouterr().err
+    assert page_figures.main([str(tmp_path / "none.json"), "--data", str(data3)]) == 2
+    assert "figures_probe.mjs" in capsys.readouterr().err

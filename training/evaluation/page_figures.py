@@ -1,0 +1,131 @@
+"""The page's own duets against the recording: the figures of what scripts/figures_probe.mjs saw.
+
+    node scripts/figures_probe.mjs 1,2,...,20          # the page dances each seed 30 s, nobody steering
+    python -m training.evaluation.page_figures runs/figures_probe.json
+
+The probe records both dancers' joints at every step as the page draws them (after the contact
+layer), nobody steering and nobody asking for a turn. This measures them with figures.py as
+training.evaluation.lead measures its "Dancing unasked" duets in Python: turns a minute, spin frames,
+body motion and travel of each dancer against the recorded couple of the test takes, the
+least-turning seed of each, and the leader's largest distance from his spot (where the page started
+him; lead measures it from where its duets start him).
+Issue 30 asks these in the page as well as in Python (items 1 and 4).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from ..data.dataset import DataError, TEST_TAKES
+from ..data.folders import add_folder
+from ..mirror.skeleton import FPS
+from . import figures as Fg
+from .evaluate_inputs import EvalError
+from .lead import recording
+
+ROLES = ("leader", "follower")
+
+
+def load(path: Path) -> dict:
+    """The probe's file, checked: one entry per seed, each dancer [steps, 17 * 3] at the model's rate."""
+    try:
+        dump = json.loads(Path(path).read_text())
+    except FileNotFoundError:
+        raise EvalError(f"{path}: no such file (write it with node scripts/figures_probe.mjs)") from None
+    except json.JSONDecodeError as e:
+        raise EvalError(f"{path}: not JSON ({e})") from None
+    if dump.get("fps") != FPS:
+        raise EvalError(f"{path}: recorded at {dump.get('fps')} steps a second, the models step at {FPS}")
+    if not dump.get("seeds"):
+        raise EvalError(f"{path}: no seeds")
+    for s in dump["seeds"]:
+        for who in ROLES:
+            p = np.asarray(s[who], float)
+            if p.ndim != 2 or p.shape[1] != 51 or len(p) < 5 * FPS or not np.isfinite(p).all():
+                raise EvalError(f"{path}: seed {s['seed']}'s {who} is not at least 5 s of 17 finite joints "
+                                f"(shape {p.shape})")
+    return dump
+
+
+def one_seed(s: dict) -> dict:
+    """figures.dancer of both dancers of one seed, and the leader's largest distance from his start:
+    the seed's `start` (x, z) when the dump has it (the page's probe: where the page put him), else
+    where the recording began."""
+    pos = {who: np.asarray(s[who], float).reshape(-1, 17, 3) for who in ROLES}
+    strip = lambda d: {k: v for k, v in d.items() if not isinstance(v, list)}
+    lead = pos["leader"]
+    start = np.asarray(s["start"], float) if "start" in s else lead[0, 0, [0, 2]]
+    return {"seed": s["seed"], **{who: strip(Fg.dancer(pos[who])) for who in ROLES},
+            "leader_from_start_m": float(np.linalg.norm(lead[:, 0, [0, 2]] - start, axis=-1).max())}
+
+
+def summary(per_seed: list[dict], ref: dict) -> dict:
+    out = {}
+    for who in ROLES:
+        items = [s[who] for s in per_seed]
+        pooled = Fg.summarize(items)
+        worst = min(range(len(items)), key=lambda i: items[i]["turns_per_min"])
+        out[who] = {**pooled, "ratio": Fg.ratios(pooled, ref[who]), "worst_seed": per_seed[worst]["seed"],
+                    "worst_turns_per_min": items[worst]["turns_per_min"]}
+    far = [s["leader_from_start_m"] for s in per_seed]
+    out["leader_from_start_m"] = {"median": float(np.median(far)), "max": float(np.max(far)),
+                                  "worst_seed": per_seed[int(np.argmax(far))]["seed"]}
+    return out
+
+
+def markdown(res: dict) -> str:
+    s, ref = res["summary"], res["recording"]
+    L = [f"# The page's duets, nobody steering: {len(res['per_seed'])} seeds × {res['seconds']:g} s "
+         f"(scripts/figures_probe.mjs, as drawn after the contact layer)", "",
+         "| dancer | turns/min | spin frames | body motion m/s | travel m/s | least-turning seed |", "|---|---|---|---|---|---|"]
+    for who in ROLES:
+        r, q, f0 = s[who], s[who]["ratio"], ref[who]
+        L.append(f"| recorded {who} (takes {', '.join(res['takes'])}) | {f0['turns_per_min']:.1f} | "
+                 f"{100 * f0['spin_frames']:.1f} % | {f0['body_motion']:.2f} | {f0['travel']:.2f} | – |")
+        L.append(f"| {who} | {r['turns_per_min']:.1f} ({q['turns_per_min']:.2f}×) | {100 * r['spin_frames']:.1f} % "
+                 f"({q['spin_frames']:.2f}×) | {r['body_motion']:.2f} ({q['body_motion']:.2f}×) | {r['travel']:.2f} "
+                 f"({q['travel']:.2f}×) | seed {r['worst_seed']}: {r['worst_turns_per_min']:.1f}/min |")
+    far = s["leader_from_start_m"]
+    L += ["", f"The leader's largest distance from his start: median {far['median']:.2f} m, "
+              f"worst {far['max']:.2f} m (seed {far['worst_seed']})."]
+    return "\n".join(L) + "\n"
+
+
+def run(args) -> dict:
+    dump = load(args.dump)
+    takes = [t for t in args.takes.split(",") if t]
+    per_seed = [one_seed(s) for s in dump["seeds"]]
+    ref = recording(args.data, takes)
+    return {"takes": takes, "recording": ref, "seconds": dump.get("seconds", 0), "per_seed": per_seed,
+            "summary": summary(per_seed, ref)}
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m training.evaluation.page_figures", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("dump", type=Path, help="the JSON file scripts/figures_probe.mjs wrote")
+    add_folder(ap, "data", "read: the recorded dancers to compare with")
+    ap.add_argument("--takes", default=",".join(TEST_TAKES))
+    ap.add_argument("--out", default=None, help="also write the table and the numbers here (a folder)")
+    args = ap.parse_args(argv)
+    try:
+        res = run(args)
+    except (EvalError, DataError) as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+    text = markdown(res)
+    if args.out:
+        out = Path(args.out)
+        out.mkdir(parents=True, exist_ok=True)
+        (out / "page_figures.json").write_text(json.dumps(res, indent=1))
+        (out / "page_figures.md").write_text(text)
+    print(text)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
