@@ -155,8 +155,9 @@ export function leaderDivergence(asked, control) {
  * right after the page has drawn; compose the copies into a grid with captions and return it as a
  * PNG data URL, with a snapshot of window.duet per frame and each cell's luminance variance.
  * Pass this function to page.evaluate (it is serialized: it uses nothing from this module).
+ * `since` names the first step in the captions (a strip of a duet nobody leads: 'from its first frame').
  */
-export function captureLedTurn({ askAt, frames, every, crop, scale, columns, title, timeoutMs }) {
+export function captureLedTurn({ askAt, frames, every, crop, scale, columns, title, timeoutMs, since = 'after the request' }) {
   return (async () => {
     const stage = document.querySelector('canvas.stage');
     const w = Math.round(crop.width * scale);
@@ -192,7 +193,7 @@ export function captureLedTurn({ askAt, frames, every, crop, scale, columns, tit
       c.fillRect(x + 4, y + 4, 170, 22);
       c.fillStyle = '#222';
       c.font = '14px sans-serif';
-      c.fillText(`+${((state.frame - askAt) / 30).toFixed(2)} s after the request`, x + 10, y + 20);
+      c.fillText(`+${((state.frame - askAt) / 30).toFixed(2)} s ${since}`, x + 10, y + 20);
     }
     const variances = [];
     for (let k = 0; k < frames; k++) {
