@@ -126,9 +126,16 @@ def one_duet(manifest, leader, follower, temperature: float, seed: int, seconds:
                              "lead_seen_unasked": lead_seen(detector, body_unasked, direction)})
         step(duet, leader, follower, np.zeros(2), temperature, rng)
         lead[f], follow[f] = duet.leader.track.positions[NOW], duet.follower.track.positions[NOW]
+    return {"seed": seed, "requests": requests, **dancing(lead, follow)}
+
+
+def dancing(lead: np.ndarray, follow: np.ndarray, start: np.ndarray | None = None) -> dict:
+    """figures.dancer of both dancers [frames, 17, 3] (without its per-turn lists), and the leader's
+    largest distance (m) from `start` (x, z on the floor; default: where his hips are at the first frame)."""
     strip = lambda d: {k: v for k, v in d.items() if not isinstance(v, list)}
-    return {"seed": seed, "requests": requests, "leader": strip(Fg.dancer(lead)), "follower": strip(Fg.dancer(follow)),
-            "leader_from_start_m": float(np.linalg.norm(lead[:, 0, [0, 2]] - lead[0, 0, [0, 2]], axis=-1).max())}
+    start = lead[0, 0, [0, 2]] if start is None else np.asarray(start, float)
+    return {"leader": strip(Fg.dancer(lead)), "follower": strip(Fg.dancer(follow)),
+            "leader_from_start_m": float(np.linalg.norm(lead[:, 0, [0, 2]] - start, axis=-1).max())}
 
 
 def unasked_duet(manifest, leader, follower, temperature: float, seed: int, seconds: float,
@@ -167,18 +174,43 @@ def summary(per_seed: list[dict], ref: dict) -> dict:
            if any(r["turned"] for r in req) else None}
     if n and req[0]["lead_seen"] is not None:
         out["lead_seen"], out["lead_seen_unasked"] = share("lead_seen"), share("lead_seen_unasked")
-    for who in ("leader", "follower"):
-        items = [s[who] for s in per_seed]
-        worst = min(range(len(items)), key=lambda i: items[i]["turns_per_min"])
-        out[who] = {**Fg.summarize(items), "ratio": Fg.ratios(Fg.summarize(items), ref[who]),
-                    "worst_seed": per_seed[worst]["seed"], "worst_turns_per_min": items[worst]["turns_per_min"]}
-    far = [s["leader_from_start_m"] for s in per_seed]
-    out["leader_from_start_m"] = {"median": float(np.median(far)), "max": float(np.max(far)),
-                                  "worst_seed": per_seed[int(np.argmax(far))]["seed"]}
+    out.update(dancing_summary(per_seed, ref))
     # The seed whose requests worked least often: the one to look at.
     by_seed = [(sum(r["turned"] for r in s["requests"]) / max(1, len(s["requests"])), s["seed"]) for s in per_seed]
     out["worst_request_seed"] = min(by_seed)[1]
     return out
+
+
+def dancing_summary(per_seed: list[dict], ref: dict) -> dict:
+    """Each dancer's figures pooled over seeds (dancing()), with ratios to the recording `ref` and the
+    least-turning seed, and the leader's distance from his start: median and worst over seeds."""
+    out = {}
+    for who in ("leader", "follower"):
+        items = [s[who] for s in per_seed]
+        pooled = Fg.summarize(items)
+        worst = min(range(len(items)), key=lambda i: items[i]["turns_per_min"])
+        out[who] = {**pooled, "ratio": Fg.ratios(pooled, ref[who]),
+                    "worst_seed": per_seed[worst]["seed"], "worst_turns_per_min": items[worst]["turns_per_min"]}
+    far = [s["leader_from_start_m"] for s in per_seed]
+    out["leader_from_start_m"] = {"median": float(np.median(far)), "max": float(np.max(far)),
+                                  "worst_seed": per_seed[int(np.argmax(far))]["seed"]}
+    return out
+
+
+def dancing_table(s: dict, ref: dict) -> list[str]:
+    """Markdown lines of dancing_summary `s` beside the recording `ref`: the table and the leader's distance."""
+    L = ["| dancer | turns/min | spin frames | body motion m/s | travel m/s | least-turning seed |",
+         "|---|---|---|---|---|---|"]
+    for who in ("leader", "follower"):
+        r, q, f0 = s[who], s[who]["ratio"], ref[who]
+        L.append(f"| recorded {who} | {f0['turns_per_min']:.1f} | {100 * f0['spin_frames']:.1f} % | "
+                 f"{f0['body_motion']:.2f} | {f0['travel']:.2f} | – |")
+        L.append(f"| {who} | {r['turns_per_min']:.1f} ({q['turns_per_min']:.2f}×) | {100 * r['spin_frames']:.1f} % "
+                 f"({q['spin_frames']:.2f}×) | {r['body_motion']:.2f} ({q['body_motion']:.2f}×) | {r['travel']:.2f} "
+                 f"({q['travel']:.2f}×) | seed {r['worst_seed']}: {r['worst_turns_per_min']:.1f}/min |")
+    far = s["leader_from_start_m"]
+    return L + ["", f"The leader's largest distance from where he started: median {far['median']:.2f} m, "
+                    f"worst {far['max']:.2f} m (seed {far['worst_seed']})."]
 
 
 def recording(data: str, takes: list[str]) -> dict:
@@ -210,18 +242,7 @@ def write_markdown(path: Path, res: dict) -> None:
          f"Seed whose requests worked least often: {s['worst_request_seed']}." if s["median_seconds"] is not None else
          "No request was followed by a turn.", "",
          "## Dancing unasked (figures.py), against the recording of takes " + ", ".join(res["takes"]), "",
-         "| dancer | turns/min | spin frames | body motion m/s | travel m/s | least-turning seed |",
-         "|---|---|---|---|---|---|"]
-    for who in ("leader", "follower"):
-        r, q, f0 = s[who], s[who]["ratio"], ref[who]
-        L.append(f"| recorded {who} | {f0['turns_per_min']:.1f} | {100 * f0['spin_frames']:.1f} % | "
-                 f"{f0['body_motion']:.2f} | {f0['travel']:.2f} | – |")
-        L.append(f"| {who} | {r['turns_per_min']:.1f} ({q['turns_per_min']:.2f}×) | {100 * r['spin_frames']:.1f} % "
-                 f"({q['spin_frames']:.2f}×) | {r['body_motion']:.2f} ({q['body_motion']:.2f}×) | {r['travel']:.2f} "
-                 f"({q['travel']:.2f}×) | seed {r['worst_seed']}: {r['worst_turns_per_min']:.1f}/min |")
-    far = s["leader_from_start_m"]
-    L += ["", f"The leader's largest distance from where he started: median {far['median']:.2f} m, "
-              f"worst {far['max']:.2f} m (seed {far['worst_seed']})."]
+         *dancing_table(s, ref)]
     path.write_text("\n".join(L) + "\n")
 
 

@@ -23,9 +23,8 @@ import numpy as np
 from ..data.dataset import DataError, TEST_TAKES
 from ..data.folders import add_folder
 from ..mirror.skeleton import FPS
-from . import figures as Fg
 from .evaluate_inputs import EvalError
-from .lead import recording
+from .lead import dancing, dancing_summary, dancing_table, recording
 
 ROLES = ("leader", "follower")
 
@@ -52,47 +51,16 @@ def load(path: Path) -> dict:
 
 
 def one_seed(s: dict) -> dict:
-    """figures.dancer of both dancers of one seed, and the leader's largest distance from his start:
-    the seed's `start` (x, z) when the dump has it (the page's probe: where the page put him), else
-    where the recording began."""
-    pos = {who: np.asarray(s[who], float).reshape(-1, 17, 3) for who in ROLES}
-    strip = lambda d: {k: v for k, v in d.items() if not isinstance(v, list)}
-    lead = pos["leader"]
-    start = np.asarray(s["start"], float) if "start" in s else lead[0, 0, [0, 2]]
-    return {"seed": s["seed"], **{who: strip(Fg.dancer(pos[who])) for who in ROLES},
-            "leader_from_start_m": float(np.linalg.norm(lead[:, 0, [0, 2]] - start, axis=-1).max())}
-
-
-def summary(per_seed: list[dict], ref: dict) -> dict:
-    out = {}
-    for who in ROLES:
-        items = [s[who] for s in per_seed]
-        pooled = Fg.summarize(items)
-        worst = min(range(len(items)), key=lambda i: items[i]["turns_per_min"])
-        out[who] = {**pooled, "ratio": Fg.ratios(pooled, ref[who]), "worst_seed": per_seed[worst]["seed"],
-                    "worst_turns_per_min": items[worst]["turns_per_min"]}
-    far = [s["leader_from_start_m"] for s in per_seed]
-    out["leader_from_start_m"] = {"median": float(np.median(far)), "max": float(np.max(far)),
-                                  "worst_seed": per_seed[int(np.argmax(far))]["seed"]}
-    return out
+    """lead.dancing of one seed: the leader's distance from the seed's `start` (x, z) when the dump
+    has it (the probe: where the page put him), else from where the recording began."""
+    lead, follow = (np.asarray(s[who], float).reshape(-1, 17, 3) for who in ROLES)
+    return {"seed": s["seed"], **dancing(lead, follow, s.get("start"))}
 
 
 def markdown(res: dict) -> str:
-    s, ref = res["summary"], res["recording"]
-    L = [f"# The page's duets, nobody steering: {len(res['per_seed'])} seeds × {res['seconds']:g} s "
-         f"(scripts/figures_probe.mjs, as drawn after the contact layer)", "",
-         "| dancer | turns/min | spin frames | body motion m/s | travel m/s | least-turning seed |", "|---|---|---|---|---|---|"]
-    for who in ROLES:
-        r, q, f0 = s[who], s[who]["ratio"], ref[who]
-        L.append(f"| recorded {who} (takes {', '.join(res['takes'])}) | {f0['turns_per_min']:.1f} | "
-                 f"{100 * f0['spin_frames']:.1f} % | {f0['body_motion']:.2f} | {f0['travel']:.2f} | – |")
-        L.append(f"| {who} | {r['turns_per_min']:.1f} ({q['turns_per_min']:.2f}×) | {100 * r['spin_frames']:.1f} % "
-                 f"({q['spin_frames']:.2f}×) | {r['body_motion']:.2f} ({q['body_motion']:.2f}×) | {r['travel']:.2f} "
-                 f"({q['travel']:.2f}×) | seed {r['worst_seed']}: {r['worst_turns_per_min']:.1f}/min |")
-    far = s["leader_from_start_m"]
-    L += ["", f"The leader's largest distance from his start: median {far['median']:.2f} m, "
-              f"worst {far['max']:.2f} m (seed {far['worst_seed']})."]
-    return "\n".join(L) + "\n"
+    return "\n".join([f"# The page's duets, nobody steering: {len(res['per_seed'])} seeds × {res['seconds']:g} s "
+                      f"(scripts/figures_probe.mjs, as drawn after the contact layer), against the recording "
+                      f"of takes {', '.join(res['takes'])}", "", *dancing_table(res["summary"], res["recording"])]) + "\n"
 
 
 def run(args) -> dict:
@@ -101,7 +69,7 @@ def run(args) -> dict:
     per_seed = [one_seed(s) for s in dump["seeds"]]
     ref = recording(args.data, takes)
     return {"takes": takes, "recording": ref, "seconds": dump.get("seconds", 0), "per_seed": per_seed,
-            "summary": summary(per_seed, ref)}
+            "summary": dancing_summary(per_seed, ref)}
 
 
 def main(argv=None) -> int:

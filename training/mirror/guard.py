@@ -125,6 +125,11 @@ def upright_margin(outputs: np.ndarray, r: dict, offsets: np.ndarray | None = No
         joints = np.atleast_2d(outputs)[:, POSE].reshape(-1, feat.N_JOINTS, 12)[..., :3]
     else:
         joints = drawn_joints(outputs, offsets)
+    return drawn_margin(joints, r, head_slack, hip_slack)
+
+
+def drawn_margin(joints: np.ndarray, r: dict, head_slack: float = 0.0, hip_slack: float = 0.0) -> np.ndarray:
+    """upright_margin of bodies already drawn [B, 17, 3] (drawn_joints)."""
     hip, head = joints[:, 0, 1], joints[:, HEAD, 1]
     feet = np.linalg.norm(joints[:, FEET[0]] - joints[:, FEET[1]], axis=-1)
     torso = joints[:, CHEST] - joints[:, 0]
@@ -151,21 +156,28 @@ def lead_hand_miss(outputs: np.ndarray, x: np.ndarray, offsets: np.ndarray) -> n
     lead hand each output draws misses the height the plan puts it at one step on (a KEY_STEP-th of
     its move to the first key). The lead hand is the one the plan puts higher at that key. Height
     alone: it is the same in this root's space and the next one's, and it is what she sees rise."""
+    return drawn_miss(drawn_joints(outputs, offsets), x)
+
+
+def drawn_miss(joints: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """lead_hand_miss of bodies already drawn [B, 17, 3] (drawn_joints)."""
     first = np.atleast_2d(x)[0]
     now, move = first[HAND_HEIGHTS], first[HAND_PLAN_FIRST]
     lead = int(np.argmax(now + move))
     target = now[lead] + move[lead] / feat.KEY_STEP
-    return np.abs(drawn_joints(outputs, offsets)[:, HANDS[lead], 1] - target)
+    return np.abs(joints[:, HANDS[lead], 1] - target)
 
 
 def nearest_plan(outputs: np.ndarray, x: np.ndarray, r: dict, offsets: np.ndarray, margin: float,
                  head_slack: float = 0.0, hip_slack: float = 0.0) -> int:
     """The index of the output [B, 323] whose lead hand is nearest the plan (lead_hand_miss) among
-    those standing at least `margin` inside the range; the most upright when none does."""
-    standing = upright_margin(outputs, r, offsets, head_slack, hip_slack)
+    those standing at least `margin` inside the range; the most upright when none does. Each body
+    is drawn once for both judgements."""
+    joints = drawn_joints(outputs, offsets)
+    standing = drawn_margin(joints, r, head_slack, hip_slack)
     if not (standing >= margin).any():
         return int(np.argmax(standing))
-    return int(np.argmin(np.where(standing >= margin, lead_hand_miss(outputs, x, offsets), np.inf)))
+    return int(np.argmin(np.where(standing >= margin, drawn_miss(joints, x), np.inf)))
 
 
 def slack_for(x: np.ndarray, margin: float, head_margin: float | None) -> float:

@@ -90,7 +90,11 @@ function drawnJoints(output: ArrayLike<number>, at: number, offsets: ArrayLike<n
 export function uprightMargin(
   output: ArrayLike<number>, at: number, r: Ranges, offsets: ArrayLike<number>, headSlack = 0, hipSlack = 0,
 ): number {
-  const lift = drawnJoints(output, at, offsets);
+  return drawnMargin(drawnJoints(output, at, offsets), r, headSlack, hipSlack);
+}
+
+/** uprightMargin of the body drawnJoints last left in `joints`, lifted by `lift`. */
+function drawnMargin(lift: number, r: Ranges, headSlack: number, hipSlack: number): number {
   const hip = joints[1] + lift;
   const head = joints[3 * HEAD + 1] + lift;
   const feet = Math.hypot(
@@ -118,16 +122,20 @@ export function showsPlan(input: ArrayLike<number>): boolean {
  * space and the next one's, and it is what she sees rise.
  */
 export function leadHandMiss(output: ArrayLike<number>, at: number, input: ArrayLike<number>, offsets: ArrayLike<number>): number {
+  return drawnMiss(drawnJoints(output, at, offsets), input);
+}
+
+/** leadHandMiss of the body drawnJoints last left in `joints`, lifted by `lift`. */
+function drawnMiss(lift: number, input: ArrayLike<number>): number {
   const lead = input[HAND_HEIGHTS[1]] + input[HAND_PLAN_FIRST[1]] > input[HAND_HEIGHTS[0]] + input[HAND_PLAN_FIRST[0]] ? 1 : 0;
   const target = input[HAND_HEIGHTS[lead]] + input[HAND_PLAN_FIRST[lead]] / KEY_STEP;
-  const lift = drawnJoints(output, at, offsets);
   return Math.abs(joints[3 * HANDS[lead] + 1] + lift - target);
 }
 
 /**
  * The index of the `count` outputs from output[0..] whose lead hand is nearest the plan
  * (leadHandMiss) among those standing at least `margin` inside the range; the most upright when
- * none does.
+ * none does. Each sample's body is drawn once for both judgements (this runs every step of a request).
  */
 export function nearestPlan(
   output: ArrayLike<number>, count: number, size: number, input: ArrayLike<number>, r: Ranges, offsets: ArrayLike<number>,
@@ -136,8 +144,9 @@ export function nearestPlan(
   let best = -1;
   let bestMiss = Infinity;
   for (let i = 0; i < count; i++) {
-    if (uprightMargin(output, i * size, r, offsets, headSlack, hipSlack) < margin) continue;
-    const miss = leadHandMiss(output, i * size, input, offsets);
+    const lift = drawnJoints(output, i * size, offsets);
+    if (drawnMargin(lift, r, headSlack, hipSlack) < margin) continue;
+    const miss = drawnMiss(lift, input);
     if (miss < bestMiss) {
       best = i;
       bestMiss = miss;
