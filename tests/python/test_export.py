@@ -265,3 +265,21 @@ def test_int8_weights_lie_on_the_coarse_grid(exported):
             on_grid = ((q - zp) % E.WEIGHT_STEP == 0) | (q == info.min) | (q == info.max)
             assert on_grid.all(), f"{name} {k}: {np.count_nonzero(~on_grid)} weights off the grid"
             assert len(np.unique(q)) <= 256 // E.WEIGHT_STEP + 2, f"{name} {k}: {len(np.unique(q))} levels"
+
+
+def test_exporting_one_model_keeps_the_others_in_the_manifest(exported, data3, tmp_path, capsys):
+    """`export --model follower` into a folder that already holds the shipped set (after retraining
+    the follower alone) rewrites the follower and keeps the leader's and CCM's entries, in place;
+    an entry whose file is gone is dropped."""
+    out = tmp_path / "models"
+    shutil.copytree(exported["models"], out)
+    before = json.loads((out / "manifest.json").read_text())["models"]
+    (out / "follower_ccm.onnx").unlink()
+    args = ["--runs", str(exported["runs"]), "--prepared", str(exported["prepared"]), "--data", str(data3),
+            "--models", str(out), "--fp32", str(tmp_path / "fp32"), "--model", "follower"]
+    assert E.main(args) == 0
+    assert "kept from the manifest there: leader" in capsys.readouterr().out
+    after = json.loads((out / "manifest.json").read_text())["models"]
+    assert list(after) == [k for k in before if k != "follower_ccm"]
+    assert after["leader"] == before["leader"]
+    assert after["follower"]["fingerprint"] == before["follower"]["fingerprint"]   # the same training

@@ -172,6 +172,12 @@ def summary(per_seed: list[dict], ref: dict) -> dict:
            "hand_raised": share("hand_raised"), "hand_raised_unasked": share("hand_raised_unasked"),
            "median_seconds": float(np.median([r["seconds"] for r in req if r["seconds"] is not None]))
            if any(r["turned"] for r in req) else None}
+    # Unasked, how often she turns in the windows where his hand went up and where it did not: her
+    # reading of his lead (recorded_leads.windows measures the recorded follower's).
+    up = [r["turned_unasked"] for r in req if r["hand_raised_unasked"]]
+    down = [r["turned_unasked"] for r in req if not r["hand_raised_unasked"]]
+    out["turned_unasked_hand_up"] = sum(up) / len(up) if up else None
+    out["turned_unasked_hand_down"] = sum(down) / len(down) if down else None
     if n and req[0]["lead_seen"] is not None:
         out["lead_seen"], out["lead_seen_unasked"] = share("lead_seen"), share("lead_seen_unasked")
     out.update(dancing_summary(per_seed, ref))
@@ -189,8 +195,11 @@ def dancing_summary(per_seed: list[dict], ref: dict) -> dict:
         items = [s[who] for s in per_seed]
         pooled = Fg.summarize(items)
         worst = min(range(len(items)), key=lambda i: items[i]["turns_per_min"])
+        # The median seed too: a few seeds where the couple spins together like a top can carry the
+        # pooled rate while most seeds hardly turn (the leader of 2026-11-28: pooled 0.67x, median 2/min).
         out[who] = {**pooled, "ratio": Fg.ratios(pooled, ref[who]),
-                    "worst_seed": per_seed[worst]["seed"], "worst_turns_per_min": items[worst]["turns_per_min"]}
+                    "worst_seed": per_seed[worst]["seed"], "worst_turns_per_min": items[worst]["turns_per_min"],
+                    "median_turns_per_min": float(np.median([i["turns_per_min"] for i in items]))}
     far = [s["leader_from_start_m"] for s in per_seed]
     out["leader_from_start_m"] = {"median": float(np.median(far)), "max": float(np.max(far)),
                                   "worst_seed": per_seed[int(np.argmax(far))]["seed"]}
@@ -199,13 +208,14 @@ def dancing_summary(per_seed: list[dict], ref: dict) -> dict:
 
 def dancing_table(s: dict, ref: dict) -> list[str]:
     """Markdown lines of dancing_summary `s` beside the recording `ref`: the table and the leader's distance."""
-    L = ["| dancer | turns/min | spin frames | body motion m/s | travel m/s | least-turning seed |",
-         "|---|---|---|---|---|---|"]
+    L = ["| dancer | turns/min | median seed | spin frames | body motion m/s | travel m/s | least-turning seed |",
+         "|---|---|---|---|---|---|---|"]
     for who in ("leader", "follower"):
         r, q, f0 = s[who], s[who]["ratio"], ref[who]
-        L.append(f"| recorded {who} | {f0['turns_per_min']:.1f} | {100 * f0['spin_frames']:.1f} % | "
+        L.append(f"| recorded {who} | {f0['turns_per_min']:.1f} | – | {100 * f0['spin_frames']:.1f} % | "
                  f"{f0['body_motion']:.2f} | {f0['travel']:.2f} | – |")
-        L.append(f"| {who} | {r['turns_per_min']:.1f} ({q['turns_per_min']:.2f}×) | {100 * r['spin_frames']:.1f} % "
+        L.append(f"| {who} | {r['turns_per_min']:.1f} ({q['turns_per_min']:.2f}×) | "
+                 f"{r['median_turns_per_min']:.1f} ({r['median_turns_per_min'] / f0['turns_per_min']:.2f}×) | {100 * r['spin_frames']:.1f} % "
                  f"({q['spin_frames']:.2f}×) | {r['body_motion']:.2f} ({q['body_motion']:.2f}×) | {r['travel']:.2f} "
                  f"({q['travel']:.2f}×) | seed {r['worst_seed']}: {r['worst_turns_per_min']:.1f}/min |")
     far = s["leader_from_start_m"]
@@ -234,6 +244,10 @@ def write_markdown(path: Path, res: dict) -> None:
          "| ratio asked / unasked | – (no turn unasked) |", "",
          f"His hand above {HAND_RAISED:g} m within 2.5 s: {100 * s['hand_raised']:.0f} % of the requests, "
          f"{100 * s['hand_raised_unasked']:.0f} % of the same moments unasked.", "",
+         *([f"Her reading of his hand, unasked: she turns in {100 * s['turned_unasked_hand_up']:.0f} % of the moments "
+            f"his hand went up and in {100 * s['turned_unasked_hand_down']:.0f} % of the others "
+            f"(the recorded follower: `python -m training.evaluation.recorded_leads`, its last line).", ""]
+           if s.get("turned_unasked_hand_up") is not None and s.get("turned_unasked_hand_down") is not None else []),
          *([f"Does he lead? A detector of the recorded leads (training.evaluation.turn_cues, leader_body: his "
             f"own body and plan, not where she is; a turn completing {LEGIBILITY_LEAD:g} s later) sees him lead the asked "
             f"way in {100 * s['lead_seen']:.0f} % of the requests and in {100 * s['lead_seen_unasked']:.0f} % "

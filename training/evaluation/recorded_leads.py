@@ -9,7 +9,10 @@ WINDOW[1] seconds around the turn's completion, and reports:
   metres, and how often his hands are that high in any frame;
 - when the peak comes, which hand it is for each direction, and where it is;
 - which way the higher hand winds over the floor plan in the last second (its signed area,
-  lead.winding's sign: negative for her turn to the left).
+  lead.winding's sign: negative for her turn to the left);
+- in windows of REQUEST_SECONDS from every EVERY-th frame (what `lead` reads after a request and at
+  the same moments unasked): how often his hand goes above RAISED metres, and how often she, and
+  he, complete a turn in the windows with it and without it.
 
     python -m training.evaluation.recorded_leads
 """
@@ -25,11 +28,13 @@ from ..data.folders import add_folder
 from ..mirror import features as feat
 from ..mirror.skeleton import FPS, HANDS
 from . import figures as F
+from ..mirror.rollout import REQUEST_SECONDS
 from .lead import HAND_RAISED, winding
 
 WINDOW = (-2.0, 0.5)   # s around the turn's completion
 PEAK = 1.5             # s before completion where the lead's peak is looked for
 WIND = 1.0             # s before completion over which the winding is read
+EVERY = 6              # frames between the windows' starts
 
 
 def hands_around_turns(data: str) -> tuple[dict[int, list[np.ndarray]], np.ndarray]:
@@ -47,6 +52,30 @@ def hands_around_turns(data: str) -> tuple[dict[int, list[np.ndarray]], np.ndarr
                 if idx[0] >= 0 and idx[-1] < lead.frames:
                     around[direction].append(hands[idx])
     return around, np.concatenate(every)
+
+
+def windows(data: str) -> np.ndarray:
+    """[N, 3] bool, a row per REQUEST_SECONDS window from every EVERY-th frame of every take (as
+    recorded and mirrored): his higher hand goes above HAND_RAISED, she completes a turn, he does."""
+    w, rows = int(REQUEST_SECONDS * FPS), []
+    for take in discover_takes(data):
+        lead_m, follow_m = load_pair(take)
+        for mirror in (False, True):
+            lead, follow = pair_tracks(lead_m, follow_m, 0, mirror)
+            hand = lead.positions[:, HANDS, 1].max(-1)
+            for s in range(0, lead.frames - w, EVERY):
+                sl = slice(s, s + w + 1)
+                rows.append((hand[sl].max() > HAND_RAISED, bool(F.turns(F.facing(follow.positions[sl]))),
+                             bool(F.turns(F.facing(lead.positions[sl])))))
+    return np.array(rows, bool).reshape(-1, 3)
+
+
+def windows_report(r: np.ndarray) -> str:
+    up, she, he = r[:, 0], r[:, 1], r[:, 2]
+    pct = lambda x: f"{100 * x.mean():.1f} %" if len(x) else "–"
+    return (f"In {len(r)} windows of {REQUEST_SECONDS:g} s (from every {EVERY}th frame): his hand goes above "
+            f"{HAND_RAISED:g} m in {pct(up)}; she completes a turn in {pct(she)} of them, {pct(she[up])} with his "
+            f"hand up and {pct(she[~up])} without; he completes one in {pct(he)}, {pct(he[up])} and {pct(he[~up])}.")
 
 
 def report(around: dict[int, list[np.ndarray]], every: np.ndarray) -> list[str]:
@@ -88,7 +117,7 @@ def main(argv=None) -> int:
     if not around[1] or not around[-1]:
         print(f"error: {args.data}: no recorded turn of both directions to read a lead from", file=sys.stderr)
         return 2
-    print("\n".join(report(around, every)))
+    print("\n".join(report(around, every) + [windows_report(windows(args.data))]))
     return 0
 
 

@@ -183,6 +183,21 @@ def write_manifest(out: Path, models: dict[str, StepModel], data: str, prepared:
         e = eval_file(out, name)
         if m.cfg.role == "follower" and e.exists():
             entry["eval"] = {"outputEncoder": os.path.relpath(e, out), "bytes": e.stat().st_size}
+    # Models exported before into the same folder and not this time stay in the manifest, in their
+    # place, while their files are there: `--model follower` after retraining the follower leaves the
+    # page its leader.
+    before = out / "manifest.json"
+    if before.exists():
+        try:
+            old = json.loads(before.read_text()).get("models", {})
+            kept = {k for k, v in old.items() if k not in models and (out / v.get("file", "")).is_file()}
+        except (ValueError, AttributeError):
+            old, kept = {}, set()   # not a manifest this code wrote: written anew
+        new = manifest["models"]
+        manifest["models"] = {**{k: new.get(k, v) for k, v in old.items() if k in new or k in kept},
+                              **{k: v for k, v in new.items() if k not in old}}
+        if kept:
+            print(f"kept from the manifest there: {', '.join(sorted(kept))}")
     (out / "manifest.json").write_text(json.dumps(manifest, indent=1))
     return manifest
 
