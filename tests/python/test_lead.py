@@ -146,6 +146,26 @@ def test_turn_onsets_need_a_turn_ahead_and_none_behind():
     assert T.turn_onsets(x, y).tolist() == [c[2] for c in cases]
 
 
+def test_only_the_turns_his_raised_hand_leads_weigh_more_with_unled_turn_weight():
+    """onset_weights: a turn onset whose leader's higher hand goes above LED_HAND in her intention
+    target weighs turn_weight; one he does not lead weighs unled_turn_weight (turn_weight without it)."""
+    si, so = feat.block_slices(feat.FOLLOWER_INPUT_LAYOUT), feat.block_slices(feat.OUTPUT_LAYOUT)
+    fut = np.radians(300) * (np.arange(1, KEYS + 1) / KEYS)
+    x, y = np.zeros((3, feat.INPUT_SIZE)), np.zeros((3, feat.OUTPUT_SIZE))
+    x[:, si["self_trajectory_past"]] = np.tile([0, 0, 0, 1], KEYS)          # facing ahead, no turn behind
+    y[:2, so["trajectory_future"]] = np.stack([0 * fut, 0 * fut, np.sin(fut), np.cos(fut)], -1).ravel()
+    y[2, so["trajectory_future"]] = np.tile([0, 0, 0, 1], KEYS)             # no turn ahead
+    j = np.zeros((3, feat.INTENTION_SIZE)).reshape(3, KEYS, feat.N_KEY_JOINTS, 3)
+    j[:, :, :, 1] = 1.0                                                      # every key joint at 1 m
+    j[0, 3, 2, 1] = T.LED_HAND + 0.1                                         # his right hand up at one key
+    j[2] = j[0]
+    j = j.reshape(3, -1)
+    assert T.led_onsets(j).tolist() == [True, False, True]
+    weights = lambda **kw: T.onset_weights(T.TrainConfig(**kw), x, y, j, "follower").tolist()
+    assert weights(turn_weight=8.0, unled_turn_weight=1.0) == [8.0, 1.0, 1.0]
+    assert weights(turn_weight=4.0) == [4.0, 4.0, 1.0]
+
+
 def test_lead_runs_on_freshly_exported_models(exported, data3, tmp_path, capsys):
     """The tool runs to its report on smoke models (whose dancing means nothing)."""
     out = tmp_path / "lead"
@@ -201,6 +221,11 @@ def test_recorded_leads_reads_his_hands_around_her_turns(data3, capsys):
     assert "Her turns to her left (+1)" in out and "Her turns to her right (-1)" in out
     left, right = (int(line.rsplit("negative in ", 1)[1].split(" %")[0]) for line in out.splitlines() if "winds" in line)
     assert left + right == 100                      # mirrored copies wind the other way
+    # The windows: her turns split by his hand, with shares that add up to the whole.
+    r = recorded_leads.windows(str(data3))
+    up, she = r[:, 0], r[:, 1]
+    assert 0 < up.sum() < len(r) and she.mean() == pytest.approx((she[up].sum() + she[~up].sum()) / len(r))
+    assert f"In {len(r)} windows of 2.5 s" in out
 
 
 def test_recorded_leads_names_a_folder_without_takes(tmp_path, capsys):
@@ -230,6 +255,7 @@ def test_page_figures_measures_a_dump_as_figures_measures_the_recording(data3, t
         for k, v in res["summary"][who]["ratio"].items():
             assert v is None or np.isnan(v) or v == pytest.approx(1.0), (who, k, v)
         assert res["summary"][who]["worst_seed"] == 7
+        assert res["summary"][who]["median_turns_per_min"] == pytest.approx(res["recording"][who]["turns_per_min"])
     assert "seed 7" in capsys.readouterr().out
     far = np.linalg.norm(take.lead.positions[:, 0, [0, 2]] - take.lead.positions[0, 0, [0, 2]], axis=-1).max()
     assert res["summary"]["leader_from_start_m"]["max"] == pytest.approx(far)

@@ -105,6 +105,12 @@ class TrainConfig:
     # minute, but a turn's first frames are few beside the frames that continue one, and a model
     # that reads its own history learns to continue turns far better than to start them.
     turn_weight: float = 1.0
+    # Follower: weight of the turn onsets he does not lead with a raised hand (his higher hand stays
+    # under LED_HAND over the next second, read from her intention target); None weighs them as
+    # turn_weight. The recorded follower completes a turn in 81 % of the 2.5 s windows in which his
+    # hand goes up and in 24 % of the others (recorded_leads): weighing only the led starts asks her
+    # to read his hand.
+    unled_turn_weight: float | None = None
     # Leader: share of samples whose figure block (features.figure_block: the turn the partner
     # really made over the next second) is hidden, as when nobody asks for a figure. Shown, the
     # leader learns what leading that turn looks like; hidden, he learns to lead on his own.
@@ -214,6 +220,16 @@ MODELS = {
     # 20 does down to 0.35, so the page runs her at 0.5 (docs/results.md, "Salsa turns").
     "follower": replace(steady(OURS), state_dropout=0.5, turn_weight=4.0, own_rollouts_from=10),
     "follower_ccm": replace(steady(CCM), state_dropout=0.5, turn_weight=4.0, own_rollouts_from=10),
+    # Measured, not shipped (docs/results.md, "She reads his hand"): only the turn starts his raised
+    # hand leads weigh more (unled_turn_weight). At 8x she reads his hand as the recorded follower
+    # does (unasked she turns in 84 % of the windows with his hand up and 28 % without; recorded 81 %
+    # and 24 %), follows 81 % of 500 requests and turns 1.30x the recorded rate nobody asking, but
+    # the leader beside her turns 0.32x, and she fell in 1 of the 100 soak rollouts (seed 7). At 4x
+    # she follows 65 % of the requests.
+    "follower_led_onsets_8": replace(steady(OURS), state_dropout=0.5, turn_weight=8.0, unled_turn_weight=1.0,
+                                     own_rollouts_from=10),
+    "follower_led_onsets_4": replace(steady(OURS), state_dropout=0.5, turn_weight=4.0, unled_turn_weight=1.0,
+                                     own_rollouts_from=10),
     # Measured, not shipped: the intention also forecasts the turn the leader leads her into over
     # the next second (ModelConfig.turn_keys). A detector reading his body alone finds 52 % of the
     # recorded turns half a second ahead (training.evaluation.turn_cues); cross-validated this follower
@@ -490,6 +506,30 @@ def turn_onsets(x_raw: np.ndarray, y_raw: np.ndarray, role: str = "follower") ->
     return (np.abs(future) >= ONSET_FUTURE_DEGREES) & (np.abs(past) < ONSET_PAST_DEGREES)
 
 
+# The recorded leader's higher hand peaks above this in 84 % of her turns (evaluation/lead.py's
+# HAND_RAISED, docs/results.md "The hands plan").
+LED_HAND = 1.6   # m
+
+
+def led_onsets(intention_raw: np.ndarray) -> np.ndarray:
+    """A follower's raw intention targets [N, 90] -> bool [N]: the leader's higher hand goes above
+    LED_HAND (m over the floor) at some key of the next second."""
+    keys = intention_raw[:, :feat.INTENTION_SIZE].reshape(len(intention_raw), feat.KEYS, feat.N_KEY_JOINTS, 3)
+    return keys[:, :, 1:3, 1].max((1, 2)) > LED_HAND
+
+
+def onset_weights(cfg: "TrainConfig", x_raw: np.ndarray, y_raw: np.ndarray, j_raw: np.ndarray,
+                  role: str) -> torch.Tensor:
+    """Per-sample weights [N]: 1, turn_weight where a turn starts (turn_onsets), and for a follower
+    with unled_turn_weight that weight where a turn starts that his hand does not lead."""
+    w = torch.ones(len(x_raw))
+    onsets = turn_onsets(x_raw, y_raw, role)
+    w[torch.from_numpy(onsets)] = cfg.turn_weight
+    if cfg.unled_turn_weight is not None and role != "leader":
+        w[torch.from_numpy(onsets & ~led_onsets(j_raw))] = cfg.unled_turn_weight
+    return w
+
+
 # ---------------------------------------------------------------- training
 
 def cosine(step: int, total: int, lr: float) -> float:
@@ -519,7 +559,7 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
     y, j = normalize(train["output"], stats, "output"), normalize(train["intention"], stats, "intention")
     sample_weight = torch.ones(len(xr))
     if cfg.turn_weight != 1.0:
-        sample_weight[torch.from_numpy(turn_onsets(train["input"], train["output"], role))] = cfg.turn_weight
+        sample_weight = onset_weights(cfg, train["input"], train["output"], train["intention"], role)
     xv, yv, jv = (normalize(val[k], stats, k) for k in ("input", "output", "intention"))
     mcfg = cfg.model
     predictor = IntentionPredictor(mcfg if cfg.intention_dropout is None
@@ -666,7 +706,7 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
             j = torch.cat([j[:recorded_n], normalize(rolled["intention"], stats, "intention")])
             w_own = torch.ones(len(rolled["input"]))
             if cfg.turn_weight != 1.0:
-                w_own[torch.from_numpy(turn_onsets(rolled["input"], rolled["output"], role))] = cfg.turn_weight
+                w_own = onset_weights(cfg, rolled["input"], rolled["output"], rolled["intention"], role)
             sample_weight = torch.cat([sample_weight[:recorded_n], w_own])
             mirrored = torch.cat([mirrored[:recorded_n], torch.from_numpy(rolled["mirror"]).long()])
             n, made_at = len(xr), epoch
