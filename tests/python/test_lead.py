@@ -147,7 +147,7 @@ def test_turn_onsets_need_a_turn_ahead_and_none_behind():
 
 
 def test_only_the_turns_his_raised_hand_leads_weigh_more_with_unled_turn_weight():
-    """onset_weights: a turn onset whose leader's higher hand goes above LED_HAND in her intention
+    """onset_weights: a turn onset whose leader's higher hand goes above HAND_RAISED in her intention
     target weighs turn_weight; one he does not lead weighs unled_turn_weight (turn_weight without it)."""
     si, so = feat.block_slices(feat.FOLLOWER_INPUT_LAYOUT), feat.block_slices(feat.OUTPUT_LAYOUT)
     fut = np.radians(300) * (np.arange(1, KEYS + 1) / KEYS)
@@ -157,7 +157,7 @@ def test_only_the_turns_his_raised_hand_leads_weigh_more_with_unled_turn_weight(
     y[2, so["trajectory_future"]] = np.tile([0, 0, 0, 1], KEYS)             # no turn ahead
     j = np.zeros((3, feat.INTENTION_SIZE)).reshape(3, KEYS, feat.N_KEY_JOINTS, 3)
     j[:, :, :, 1] = 1.0                                                      # every key joint at 1 m
-    j[0, 3, 2, 1] = T.LED_HAND + 0.1                                         # his right hand up at one key
+    j[0, 3, 2, 1] = T.HAND_RAISED + 0.1                                         # his right hand up at one key
     j[2] = j[0]
     j = j.reshape(3, -1)
     assert T.led_onsets(j).tolist() == [True, False, True]

@@ -33,6 +33,7 @@ from ..mirror.rollout import NOW, REQUEST_SECONDS, ask_turn, start_duet, step
 from ..mirror import features as feat
 from ..mirror.skeleton import FPS, HANDS
 from . import figures as Fg
+from .figures import HAND_RAISED
 from . import turn_cues as C
 from . import options as O
 from .evaluate_inputs import EvalError, find_models, load_eval_takes, load_onnx
@@ -43,9 +44,6 @@ from .evaluate_inputs import EvalError, find_models, load_eval_takes, load_onnx
 LEGIBILITY_LEAD = 0.5
 REQUEST_EVERY = 6.0      # s between requests in one duet (a turn and the time to settle after it)
 WARM_UP = 3.0            # s of dancing before the first request
-# His hand counts as raised above 1.6 m: the recorded leader's higher hand goes above it in 84 %
-# of her turns (1.5 s before the turn completes), and is above it in 17 % of all his frames.
-HAND_RAISED = 1.6
 
 
 def branch(duet, leader, follower, temperature: float, rng: np.random.Generator, direction: int | None,
@@ -196,7 +194,7 @@ def dancing_summary(per_seed: list[dict], ref: dict) -> dict:
         pooled = Fg.summarize(items)
         worst = min(range(len(items)), key=lambda i: items[i]["turns_per_min"])
         # The median seed too: a few seeds where the couple spins together like a top can carry the
-        # pooled rate while most seeds hardly turn (the leader of 2026-11-28: pooled 0.67x, median 2/min).
+        # pooled rate while most seeds hardly turn (the leader of 2026-11-28 over seeds 0-49: pooled 0.67x, median seed 2/min).
         out[who] = {**pooled, "ratio": Fg.ratios(pooled, ref[who]),
                     "worst_seed": per_seed[worst]["seed"], "worst_turns_per_min": items[worst]["turns_per_min"],
                     "median_turns_per_min": float(np.median([i["turns_per_min"] for i in items]))}

@@ -29,7 +29,8 @@ from ..mirror import features as feat
 from ..mirror.skeleton import FPS, HANDS
 from . import figures as F
 from ..mirror.rollout import REQUEST_SECONDS
-from .lead import HAND_RAISED, winding
+from .figures import HAND_RAISED
+from .lead import winding
 
 WINDOW = (-2.0, 0.5)   # s around the turn's completion
 PEAK = 1.5             # s before completion where the lead's peak is looked for
@@ -37,20 +38,25 @@ WIND = 1.0             # s before completion over which the winding is read
 EVERY = 6              # frames between the windows' starts
 
 
+def couples(data: str):
+    """Every recorded couple of `data` as recorded and mirrored: (leader, follower) tracks."""
+    for take in discover_takes(data):
+        lead_m, follow_m = load_pair(take)
+        for mirror in (False, True):
+            yield pair_tracks(lead_m, follow_m, 0, mirror)
+
+
 def hands_around_turns(data: str) -> tuple[dict[int, list[np.ndarray]], np.ndarray]:
     """({direction: [hands [frames, 2, 3] around each turn]}, all his hands [N, 2, 3]), root space."""
     offsets = np.arange(int(WINDOW[0] * FPS), int(WINDOW[1] * FPS) + 1)
     around, every = {1: [], -1: []}, []
-    for take in discover_takes(data):
-        lead_m, follow_m = load_pair(take)
-        for mirror in (False, True):
-            lead, follow = pair_tracks(lead_m, follow_m, 0, mirror)
-            hands = feat.to_root_space_points(lead.positions[:, HANDS], lead.root[:, None], lead.heading[:, None])
-            every.append(hands)
-            for t, direction in F.turns(F.facing(follow.positions)):
-                idx = t + offsets
-                if idx[0] >= 0 and idx[-1] < lead.frames:
-                    around[direction].append(hands[idx])
+    for lead, follow in couples(data):
+        hands = feat.to_root_space_points(lead.positions[:, HANDS], lead.root[:, None], lead.heading[:, None])
+        every.append(hands)
+        for t, direction in F.turns(F.facing(follow.positions)):
+            idx = t + offsets
+            if idx[0] >= 0 and idx[-1] < lead.frames:
+                around[direction].append(hands[idx])
     return around, np.concatenate(every)
 
 
@@ -58,15 +64,12 @@ def windows(data: str) -> np.ndarray:
     """[N, 3] bool, a row per REQUEST_SECONDS window from every EVERY-th frame of every take (as
     recorded and mirrored): his higher hand goes above HAND_RAISED, she completes a turn, he does."""
     w, rows = int(REQUEST_SECONDS * FPS), []
-    for take in discover_takes(data):
-        lead_m, follow_m = load_pair(take)
-        for mirror in (False, True):
-            lead, follow = pair_tracks(lead_m, follow_m, 0, mirror)
-            hand = lead.positions[:, HANDS, 1].max(-1)
-            for s in range(0, lead.frames - w, EVERY):
-                sl = slice(s, s + w + 1)
-                rows.append((hand[sl].max() > HAND_RAISED, bool(F.turns(F.facing(follow.positions[sl]))),
-                             bool(F.turns(F.facing(lead.positions[sl])))))
+    for lead, follow in couples(data):
+        hand = lead.positions[:, HANDS, 1].max(-1)
+        hers, his = F.facing(follow.positions), F.facing(lead.positions)   # unwrapped: a window is a slice
+        for s in range(0, lead.frames - w, EVERY):
+            sl = slice(s, s + w + 1)
+            rows.append((hand[sl].max() > HAND_RAISED, bool(F.turns(hers[sl])), bool(F.turns(his[sl]))))
     return np.array(rows, bool).reshape(-1, 3)
 
 

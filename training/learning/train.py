@@ -29,6 +29,7 @@ from ..mirror import features as feat
 from .distributed import (average_gradients, broadcast_parameters, pick_device, setup_distributed, stop_distributed,
                           wait_for_all)
 from ..data.folders import add_folder
+from ..evaluation.figures import HAND_RAISED
 from ..evaluation.loss_plot import plot_history
 from .models import CodebookMatching, Discriminator, IntentionPredictor, ModelConfig, StepModel, code_logits, sample_codes
 from .own_rollouts import load_couples, own_rollout_samples
@@ -106,7 +107,7 @@ class TrainConfig:
     # that reads its own history learns to continue turns far better than to start them.
     turn_weight: float = 1.0
     # Follower: weight of the turn onsets he does not lead with a raised hand (his higher hand stays
-    # under LED_HAND over the next second, read from her intention target); None weighs them as
+    # under figures.HAND_RAISED over the next second, read from her intention target); None weighs them as
     # turn_weight. The recorded follower completes a turn in 81 % of the 2.5 s windows in which his
     # hand goes up and in 24 % of the others (recorded_leads): weighing only the led starts asks her
     # to read his hand.
@@ -506,16 +507,11 @@ def turn_onsets(x_raw: np.ndarray, y_raw: np.ndarray, role: str = "follower") ->
     return (np.abs(future) >= ONSET_FUTURE_DEGREES) & (np.abs(past) < ONSET_PAST_DEGREES)
 
 
-# The recorded leader's higher hand peaks above this in 84 % of her turns (evaluation/lead.py's
-# HAND_RAISED, docs/results.md "The hands plan").
-LED_HAND = 1.6   # m
-
-
 def led_onsets(intention_raw: np.ndarray) -> np.ndarray:
     """A follower's raw intention targets [N, 90] -> bool [N]: the leader's higher hand goes above
-    LED_HAND (m over the floor) at some key of the next second."""
+    HAND_RAISED (m over the floor, figures.py: the recorded lead) at some key of the next second."""
     keys = intention_raw[:, :feat.INTENTION_SIZE].reshape(len(intention_raw), feat.KEYS, feat.N_KEY_JOINTS, 3)
-    return keys[:, :, 1:3, 1].max((1, 2)) > LED_HAND
+    return keys[:, :, 1:3, 1].max((1, 2)) > HAND_RAISED
 
 
 def onset_weights(cfg: "TrainConfig", x_raw: np.ndarray, y_raw: np.ndarray, j_raw: np.ndarray,
@@ -557,9 +553,8 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
     mirrored = torch.from_numpy(load_mirror_flags(data, cfg.tempo_copies)).long()
     couples = load_couples(data) if cfg.own_rollouts_from is not None else []
     y, j = normalize(train["output"], stats, "output"), normalize(train["intention"], stats, "intention")
-    sample_weight = torch.ones(len(xr))
-    if cfg.turn_weight != 1.0:
-        sample_weight = onset_weights(cfg, train["input"], train["output"], train["intention"], role)
+    sample_weight = (onset_weights(cfg, train["input"], train["output"], train["intention"], role)
+                     if cfg.turn_weight != 1.0 else torch.ones(len(xr)))
     xv, yv, jv = (normalize(val[k], stats, k) for k in ("input", "output", "intention"))
     mcfg = cfg.model
     predictor = IntentionPredictor(mcfg if cfg.intention_dropout is None
@@ -704,9 +699,8 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
             xr = torch.cat([xr[:recorded_n], torch.from_numpy(rolled["input"])])
             y = torch.cat([y[:recorded_n], normalize(rolled["output"], stats, "output")])
             j = torch.cat([j[:recorded_n], normalize(rolled["intention"], stats, "intention")])
-            w_own = torch.ones(len(rolled["input"]))
-            if cfg.turn_weight != 1.0:
-                w_own = onset_weights(cfg, rolled["input"], rolled["output"], rolled["intention"], role)
+            w_own = (onset_weights(cfg, rolled["input"], rolled["output"], rolled["intention"], role)
+                     if cfg.turn_weight != 1.0 else torch.ones(len(rolled["input"])))
             sample_weight = torch.cat([sample_weight[:recorded_n], w_own])
             mirrored = torch.cat([mirrored[:recorded_n], torch.from_numpy(rolled["mirror"]).long()])
             n, made_at = len(xr), epoch
