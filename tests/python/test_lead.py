@@ -166,6 +166,21 @@ def test_only_the_turns_his_raised_hand_leads_weigh_more_with_unled_turn_weight(
     assert weights(turn_weight=4.0) == [4.0, 4.0, 1.0]
 
 
+def test_the_leaders_own_turn_starts_weigh_own_turn_weight():
+    """own_onset_weights: read from his own path (not the figure block, not hers); 1 everywhere
+    for the follower and without the setting."""
+    si, so = feat.block_slices(feat.LEADER_INPUT_LAYOUT), feat.block_slices(feat.OUTPUT_LAYOUT)
+    fut = np.radians(300) * (np.arange(1, KEYS + 1) / KEYS)
+    x, y = np.zeros((3, feat.LEADER_INPUT_SIZE)), np.zeros((3, feat.OUTPUT_SIZE))
+    x[:, si["self_trajectory_past"]] = np.tile([0, 0, 0, 1], KEYS)
+    x[2, si["partner_trajectory_past"]] = np.tile([0, 0, 0, 1], KEYS)       # hers: no bearing on his
+    y[:, so["trajectory_future"]] = np.tile([0, 0, 0, 1], KEYS)
+    y[0, so["trajectory_future"]] = np.stack([0 * fut, 0 * fut, np.sin(fut), np.cos(fut)], -1).ravel()
+    assert T.own_turn_onsets(x, y, "leader").tolist() == [True, False, False]
+    assert T.own_onset_weights(T.TrainConfig(own_turn_weight=4.0), x, y, "leader").tolist() == [4.0, 1.0, 1.0]
+    assert T.own_onset_weights(T.TrainConfig(), x, y, "leader").tolist() == [1.0, 1.0, 1.0]
+
+
 def test_lead_runs_on_freshly_exported_models(exported, data3, tmp_path, capsys):
     """The tool runs to its report on smoke models (whose dancing means nothing)."""
     out = tmp_path / "lead"

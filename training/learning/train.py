@@ -112,6 +112,10 @@ class TrainConfig:
     # hand goes up and in 24 % of the others (recorded_leads): weighing only the led starts asks her
     # to read his hand.
     unled_turn_weight: float | None = None
+    # Leader: weight of the samples where his own turn starts (own_turn_onsets), figure shown or
+    # not. The recorded leader turns 6-7 times a minute, in 10 of 12 takes; turn_weight only weighs
+    # the moments he leads hers, and a leader who turns only beside a spinning partner turns in few seeds.
+    own_turn_weight: float = 1.0
     # Leader: share of samples whose figure block (features.figure_block: the turn the partner
     # really made over the next second) is hidden, as when nobody asks for a figure. Shown, the
     # leader learns what leading that turn looks like; hidden, he learns to lead on his own.
@@ -291,6 +295,11 @@ MODELS = {
     # times a minute but had a bad second in 15 of 100 steered seeds (docs/results.md, "His feet").
     "leader": replace(LEADER_BEFORE_CONTACT, lambda_foot_contact=100.0, recorded_contacts=True,
                       contact_spare_turning=120.0),
+    # Measured, not shipped: the shipped leader with the samples where his own turn starts weighed more.
+    "leader_own_turns_4": replace(LEADER_BEFORE_CONTACT, lambda_foot_contact=100.0, recorded_contacts=True,
+                                  contact_spare_turning=120.0, own_turn_weight=4.0),
+    "leader_own_turns_8": replace(LEADER_BEFORE_CONTACT, lambda_foot_contact=100.0, recorded_contacts=True,
+                                  contact_spare_turning=120.0, own_turn_weight=8.0),
     "leader_recorded_contact": replace(LEADER_BEFORE_CONTACT, lambda_foot_contact=100.0, recorded_contacts=True),
     "leader_recorded_contact_300": replace(LEADER_BEFORE_CONTACT, lambda_foot_contact=300.0, recorded_contacts=True),
     "leader_recorded_contact_30": replace(LEADER_BEFORE_CONTACT, lambda_foot_contact=30.0, recorded_contacts=True),
@@ -501,10 +510,25 @@ def turn_onsets(x_raw: np.ndarray, y_raw: np.ndarray, role: str = "follower") ->
         future = 360.0 * x_raw[:, si["figure"].stop - 1]
         return (x_raw[:, si["figure"].start] > 0) & (np.abs(future) >= ONSET_FUTURE_DEGREES) & \
             (np.abs(past) < ONSET_PAST_DEGREES)
-    si, so = feat.block_slices(feat.FOLLOWER_INPUT_LAYOUT), feat.block_slices(feat.OUTPUT_LAYOUT)
+    return own_turn_onsets(x_raw, y_raw, role)
+
+
+def own_turn_onsets(x_raw: np.ndarray, y_raw: np.ndarray, role: str) -> np.ndarray:
+    """Samples (raw input and output) -> bool [N]: the dancer's own turn starts here, read from
+    the dancer's own path (the same thresholds as turn_onsets)."""
+    layout = feat.LEADER_INPUT_LAYOUT if role == "leader" else feat.FOLLOWER_INPUT_LAYOUT
+    si, so = feat.block_slices(layout), feat.block_slices(feat.OUTPUT_LAYOUT)
     past = key_heading_change(x_raw[:, si["self_trajectory_past"]].reshape(len(x_raw), feat.KEYS, 4), True)
     future = key_heading_change(y_raw[:, so["trajectory_future"]].reshape(len(y_raw), feat.KEYS, 4), False)
     return (np.abs(future) >= ONSET_FUTURE_DEGREES) & (np.abs(past) < ONSET_PAST_DEGREES)
+
+
+def own_onset_weights(cfg: "TrainConfig", x_raw: np.ndarray, y_raw: np.ndarray, role: str) -> torch.Tensor:
+    """Per-sample weights [N]: own_turn_weight where the leader's own turn starts, else 1."""
+    w = torch.ones(len(x_raw))
+    if role == "leader" and cfg.own_turn_weight != 1.0:
+        w[torch.from_numpy(own_turn_onsets(x_raw, y_raw, role))] = cfg.own_turn_weight
+    return w
 
 
 def led_onsets(intention_raw: np.ndarray) -> np.ndarray:
@@ -555,6 +579,8 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
     y, j = normalize(train["output"], stats, "output"), normalize(train["intention"], stats, "intention")
     sample_weight = (onset_weights(cfg, train["input"], train["output"], train["intention"], role)
                      if cfg.turn_weight != 1.0 else torch.ones(len(xr)))
+    own_weight = own_onset_weights(cfg, train["input"], train["output"], role)
+    weighted = cfg.turn_weight != 1.0 or cfg.own_turn_weight != 1.0
     xv, yv, jv = (normalize(val[k], stats, k) for k in ("input", "output", "intention"))
     mcfg = cfg.model
     predictor = IntentionPredictor(mcfg if cfg.intention_dropout is None
@@ -702,6 +728,8 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
             w_own = (onset_weights(cfg, rolled["input"], rolled["output"], rolled["intention"], role)
                      if cfg.turn_weight != 1.0 else torch.ones(len(rolled["input"])))
             sample_weight = torch.cat([sample_weight[:recorded_n], w_own])
+            own_weight = torch.cat([own_weight[:recorded_n],
+                                    own_onset_weights(cfg, rolled["input"], rolled["output"], role)])
             mirrored = torch.cat([mirrored[:recorded_n], torch.from_numpy(rolled["mirror"]).long()])
             n, made_at = len(xr), epoch
             history["own_rollout_samples"].append(len(w_own))
@@ -741,13 +769,14 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
             if mcfg.decoder_state and cfg.state_dropout > 0:
                 state_keep = (torch.rand(len(idx), 1, generator=gen) >= cfg.state_dropout).float().to(device)
             recon, s, s_hat, code, code_hat = matching(x, yb, intention, state_keep=state_keep)
-            if cfg.turn_weight == 1.0:   # the recipes before turn_weight, bit for bit
+            if not weighted:   # the recipes before turn_weight, bit for bit
                 l_r, l_c = F.mse_loss(recon, yb), F.mse_loss(code, code_hat)
             else:
                 w = sample_weight[idx].clone()
-                if role == "leader":     # his turn onsets weigh more only where he is told of them
+                if role == "leader":     # her turn onsets weigh more only where he is told of them
                     fig = slices["figure"]
                     w[x_clean[:, fig.start].cpu() < 0.5] = 1.0
+                w = torch.maximum(w, own_weight[idx])   # his own weigh more always
                 w = w.to(device)[:, None]
                 w = w / w.mean()
                 l_r, l_c = (w * (recon - yb) ** 2).mean(), (w * (code - code_hat) ** 2).mean()
