@@ -201,3 +201,50 @@ describe(`leading a turn (seed ${SEED})`, () => {
     }
   });
 });
+
+// Leading a turn in several seeds: T pressed (askTurn) after 4 s in each of SEEDS, her left on odd
+// seeds and her right on even ones as in scripts/turns_probe.mjs, and her facing recorded for
+// 2.5 s. She is still not told: her network reads his motion. Asserted: she turns 300 degrees or
+// more (either way) within 2.5 s in most of them. The dance of a seed is the same on every run, so
+// this holds the shipped models to what they did when they were shipped: 5 of these 8 (seeds 1, 6
+// and 8 turned 109°, 22° and 294°); over seeds 1-100 the probe found 68 % (docs/results.md, "His lead
+// hand kept to the plan"). Models that lead turns less often fail it.
+const SEEDS = [1, 2, 3, 4, 5, 6, 7, 8];
+const WINDOW = Math.round(2.5 * FPS);
+
+describe(`leading a turn in ${SEEDS.length} seeds`, () => {
+  test('she turns within 2.5 s of T in most of them', async () => {
+    const browser = await launch(DESKTOP.launch);
+    const rows = [];
+    try {
+      const { page, consoleErrors } = browser;
+      page.setDefaultTimeout(READY_MS);
+      for (const seed of SEEDS) {
+        const direction = seed % 2 === 1 ? 1 : -1;
+        let probe = null;
+        for (let attempt = 1; probe === null; attempt++) {
+          try {
+            await page.goto(`${server.url}?seed=${seed}&speed=2`);
+            await waitReady(page, READY_MS);
+            await armProbe(page, { askAt: ASK_AT, direction, until: ASK_AT + WINDOW });
+            probe = await readProbe(page, READY_MS);
+          } catch (error) {
+            if (!(error instanceof Reloaded) || attempt >= 3) throw error;
+          }
+        }
+        assert.equal(probe.took, true, `seed ${seed}: the request was refused (${probe.via})`);
+        assert.ok(probe.steps[0].frame <= ASK_AT, `seed ${seed}: the recording began after the request`);
+        const most = Math.max(followerTurn(probe.steps, ASK_AT, 1).best, followerTurn(probe.steps, ASK_AT, -1).best);
+        const thatWay = followerTurn(probe.steps, ASK_AT, direction);
+        rows.push({ seed, most, thatWay: thatWay.turned });
+      }
+      assert.deepEqual(consoleErrors, [], 'console errors');
+    } finally {
+      await browser.close();
+    }
+    const turned = rows.filter((r) => r.most >= 300);
+    console.log(`led turns: ${rows.map((r) => `seed ${r.seed} ${r.most.toFixed(0)}°${r.thatWay ? ' (the asked way)' : ''}`).join(', ')}; ` +
+      `she turned in ${turned.length} of ${rows.length}`);
+    assert.ok(turned.length > rows.length / 2, `she turned 300° within 2.5 s of the request in only ${turned.length} of ${rows.length} seeds`);
+  });
+});

@@ -225,12 +225,13 @@ MODELS = {
     # 20 does down to 0.35, so the page runs her at 0.5 (docs/results.md, "Salsa turns").
     "follower": replace(steady(OURS), state_dropout=0.5, turn_weight=4.0, own_rollouts_from=10),
     "follower_ccm": replace(steady(CCM), state_dropout=0.5, turn_weight=4.0, own_rollouts_from=10),
-    # Measured, not shipped (docs/results.md, "She reads his hand"): only the turn starts his raised
-    # hand leads weigh more (unled_turn_weight). At 8x she reads his hand as the recorded follower
-    # does (unasked she turns in 84 % of the windows with his hand up and 28 % without; recorded 81 %
-    # and 24 %), follows 81 % of 500 requests and turns 1.30x the recorded rate nobody asking, but
-    # the leader beside her turns 0.32x, and she fell in 1 of the 100 soak rollouts (seed 7). At 4x
-    # she follows 65 % of the requests.
+    # Measured, not shipped (docs/results.md, "She reads his hand" and "He turns on his own"): only
+    # the turn starts his raised hand leads weigh more (unled_turn_weight). At 8x she reads his hand
+    # as the recorded follower does (unasked she turns in 81-84 % of the windows with his hand up and
+    # 28-38 % without; recorded 81 % and 24 %), and beside the leader who turns on his own she
+    # follows 80 % of 500 requests and turns 1.19x the recorded rate nobody asking; but in the soak
+    # she went down into deep lunges with him in 2 of 100 rollouts (1 of 100 beside the leader
+    # before). At 4x she follows 65 % of the requests.
     "follower_led_onsets_8": replace(steady(OURS), state_dropout=0.5, turn_weight=8.0, unled_turn_weight=1.0,
                                      own_rollouts_from=10),
     "follower_led_onsets_4": replace(steady(OURS), state_dropout=0.5, turn_weight=4.0, unled_turn_weight=1.0,
@@ -295,7 +296,13 @@ MODELS = {
     # times a minute but had a bad second in 15 of 100 steered seeds (docs/results.md, "His feet").
     "leader": replace(LEADER_BEFORE_CONTACT, lambda_foot_contact=100.0, recorded_contacts=True,
                       contact_spare_turning=120.0),
-    # Measured, not shipped: the shipped leader with the samples where his own turn starts weighed more.
+    # Measured, not shipped (docs/results.md, "He turns on his own"): the samples where his own turn
+    # starts weigh 4x (own_turn_weight). His turns had come from the few seeds where the couple spins
+    # together (nobody steering, the median seed 0.17x the recorded leader's rate; 10 of 12 recorded
+    # takes have his turns); at 4x the median seed turns 0.52x and 90 of 100 seeds turn, 0.68x
+    # pooled, body motion 0.84x, travel 1.01x, and she spins 0.94x (1.44x before), but she follows
+    # 72 % of the requests and fell in the soak (seed 64) following his lunge. At 8x he turns 1.40x
+    # and she, beside him, 1.64x (seeds 0-49).
     "leader_own_turns_4": replace(LEADER_BEFORE_CONTACT, lambda_foot_contact=100.0, recorded_contacts=True,
                                   contact_spare_turning=120.0, own_turn_weight=4.0),
     "leader_own_turns_8": replace(LEADER_BEFORE_CONTACT, lambda_foot_contact=100.0, recorded_contacts=True,
