@@ -179,6 +179,10 @@ def test_the_leaders_own_turn_starts_weigh_own_turn_weight():
     assert T.own_turn_onsets(x, y, "leader").tolist() == [True, False, False]
     assert T.own_onset_weights(T.TrainConfig(own_turn_weight=4.0), x, y, "leader").tolist() == [4.0, 1.0, 1.0]
     assert T.own_onset_weights(T.TrainConfig(), x, y, "leader").tolist() == [1.0, 1.0, 1.0]
+    xf = np.zeros((3, feat.INPUT_SIZE))
+    xf[:, feat.block_slices(feat.FOLLOWER_INPUT_LAYOUT)["self_trajectory_past"]] = np.tile([0, 0, 0, 1], KEYS)
+    assert T.own_turn_onsets(xf, y, "follower").tolist() == [True, False, False]   # her rule, her blocks
+    assert T.own_onset_weights(T.TrainConfig(own_turn_weight=4.0), xf, y, "follower").tolist() == [1.0, 1.0, 1.0]
 
 
 def test_lead_runs_on_freshly_exported_models(exported, data3, tmp_path, capsys):
