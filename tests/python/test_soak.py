@@ -71,3 +71,34 @@ def test_soak_runs_the_guard_and_refuses_a_guard_of_one(tmp_path, capsys):
     assert summary["guarded"] >= 0 and "upright guard: chose" in capsys.readouterr().out
     assert soak.main(["--models", str(MODELS), "--guard", "1"]) == 2
     assert "--guard 1" in capsys.readouterr().err
+
+
+def _fall_continuations():
+    """scripts/fall_continuations.py as a module (scripts/ is not a package)."""
+    import importlib.util
+    path = Path(__file__).resolve().parents[2] / "scripts" / "fall_continuations.py"
+    spec = importlib.util.spec_from_file_location("fall_continuations", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_fall_continuations_dance_on_from_a_moment_for_each_variant(capsys):
+    """From a moment of a soak rollout, each variant dances the same continuations; a variant
+    changes only the guard it names."""
+    fc = _fall_continuations()
+    assert fc.main(["3", "--models", str(MODELS), "--minutes", "0.2", "--fall", "6", "--back", "2,1",
+                    "--n", "2", "--seconds", "1", "--variants", "base,guard=64+leader.hipMargin=0.2"]) == 0
+    out = capsys.readouterr().out
+    assert "from 4.00 s, 5.00 s, 2 continuations of 1 s each" in out
+    assert "base: she fell in 0 of 4" in out and "guard=64+leader.hipMargin=0.2: she fell in" in out
+    manifest = json.loads((MODELS / "manifest.json").read_text())
+    lead, follow, _ = fc.policies(manifest, None, None, "guard=64+leader.hipMargin=0.2")
+    assert (follow.samples, lead.hip_margin) == (64, 0.2)
+    assert manifest["leaderGuard"]["hipMargin"] != 0.2           # the manifest itself is untouched
+
+
+def test_fall_continuations_refuse_an_unknown_setting():
+    fc = _fall_continuations()
+    with pytest.raises(SystemExit, match="unknown setting 'guard_size'"):
+        fc.main(["3", "--models", str(MODELS), "--variants", "guard_size=8"])

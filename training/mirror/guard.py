@@ -30,7 +30,10 @@ from ..evaluation.plausibility import CHEST
 # leader who lunges (LEADER_HEAD_MARGIN below) they do: continued 20 times each from four moments
 # just before the soak's falls of seeds 49 and 86, she fell in 20 of 80 with 8 samples, 13 with
 # 16, 5 with 32 and 3 with 64 (docs/results.md, "Her guard beside his lunge"). The guard acts in
-# under 1 % of her steps, so the larger batch costs the page nothing in the median step.
+# under 1 % of her steps, so the larger batch costs the page nothing in the median step. Beside the
+# leader who turns on his own (not shipped), 128 samples took her falls from 11 to 2 of 30
+# continuations of one soak fall (scripts/fall_continuations.py), yet the soak still lost a seed
+# (docs/results.md, "Her guard of 128 samples").
 SAMPLES = 32
 MARGIN = 0.05   # m
 # Her hips, though, go down fast once she falls (0.39 m in a quarter second before the soak's fall
