@@ -15,7 +15,8 @@ matters, in minutes instead of a 40-minute soak each.
 A variant is `base` (the manifest as it is) or options joined by `+`: an evaluation option by its
 attribute name (guard, guard_margin, guard_hip_margin, guard_partner_low,
 guard_partner_low_hip_margin, leader_guard: training/evaluation/options.py) or a leader guard
-field of the manifest as `leader.FIELD` (margin, headMargin, hipMargin).
+field of the manifest as `leader.FIELD` (margin, headMargin, hipMargin). --rollout VARIANT dances
+the rollout up to the moments with that setting (a soak run with options: its fall is found there).
 """
 from __future__ import annotations
 
@@ -73,6 +74,8 @@ def main(argv=None) -> int:
     ap.add_argument("--n", type=int, default=20, help="continuations from each moment")
     ap.add_argument("--seconds", type=float, default=4.0, help="length of each continuation")
     ap.add_argument("--variants", default="base")
+    ap.add_argument("--rollout", default="base", metavar="VARIANT",
+                    help="the setting the rollout is danced with up to the moments (default: the manifest's)")
     a = ap.parse_args(argv)
     path = Path(a.models) / "manifest.json"
     if not path.exists():
@@ -85,14 +88,14 @@ def main(argv=None) -> int:
     frames = int(a.minutes * 60 * FPS)
     backs = [float(b) for b in a.back.split(",")]
     variants = a.variants.split(",")
-    for v in variants:   # refuse a bad variant before minutes of dancing
+    for v in variants + [a.rollout]:   # refuse a bad variant before minutes of dancing
         policies(manifest, leader, follower, v)
 
     def rollout():
         rng = np.random.default_rng(a.seed)   # the soak's: its steering script first, then the steps
         return rng, steering_script(rng, frames), start_duet(manifest)
 
-    lp, fp, temperature = policies(manifest, leader, follower, "base")
+    lp, fp, temperature = policies(manifest, leader, follower, a.rollout)
     fall = a.fall
     if fall is None:
         rng, sticks, duet = rollout()

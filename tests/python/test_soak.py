@@ -87,7 +87,7 @@ def test_fall_continuations_dance_on_from_a_moment_for_each_variant(capsys):
     """From a moment of a soak rollout, each variant dances the same continuations; a variant
     changes only the guard it names."""
     fc = _fall_continuations()
-    assert fc.main(["3", "--models", str(MODELS), "--minutes", "0.2", "--fall", "6", "--back", "2,1",
+    assert fc.main(["3", "--models", str(MODELS), "--minutes", "0.2", "--fall", "6", "--back", "2,1", "--rollout", "guard=64",
                     "--n", "2", "--seconds", "1", "--variants", "base,guard=64+leader.hipMargin=0.2"]) == 0
     out = capsys.readouterr().out
     assert "from 4.00 s, 5.00 s, 2 continuations of 1 s each" in out
