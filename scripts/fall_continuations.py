@@ -103,14 +103,14 @@ def main(argv=None) -> int:
         for f in range(frames):
             step(duet, lp, fp, sticks[f], temperature, rng)
             hers[f] = duet.follower.track.positions[NOW]
-        share = np.convolve(P.body_flagged(P.frame_flags(hers, ranges)).astype(float), np.ones(FPS) / FPS, "valid")
-        if share.max() <= P.BAD_SECOND:
+        first = P.first_bad_second(P.frame_flags(hers, ranges))
+        if first is None:
             print(f"seed {a.seed}: no fall in {a.minutes:g} min")
             return 0
-        fall = int(np.argmax(share > P.BAD_SECOND)) / FPS
+        fall = first / FPS
         print(f"seed {a.seed}: the first failing second starts at {fall:.2f} s")
     stops = {int(round((fall - b) * FPS)): b for b in backs}
-    if min(stops) < 1 or max(stops) > frames:
+    if min(stops) < 1 or max(stops) >= frames:   # at least one step to continue
         print(f"error: --back {a.back} from {fall:g} s leaves the rollout", file=sys.stderr)
         return 2
     rng, sticks, duet = rollout()

@@ -51,6 +51,9 @@ def test_lying_on_the_floor_is_flagged_and_a_long_one_is_a_collapse():
     assert flags["angles_out"][lying_frames].all()    # the torso's lean
     assert P.collapsed(motion, r)
     assert abs(P.worst_second(flags) - 1.0) < 1e-9
+    first = P.first_bad_second(flags)                 # the first second mostly on the floor
+    assert FPS // 2 <= first <= FPS and P.second_shares(flags)[first] > P.BAD_SECOND
+    assert P.first_bad_second(P.frame_flags(standing(3 * FPS), r)) is None
     short = np.concatenate([standing(FPS), lying[:FPS // 2], standing(FPS)])
     assert not P.collapsed(short, r)
 

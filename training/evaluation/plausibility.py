@@ -148,12 +148,24 @@ def body_flagged(flags: dict[str, np.ndarray]) -> np.ndarray:
     return np.any([flags[k] for k in BODY_FLAGS], axis=0)
 
 
-def worst_second(flags: dict[str, np.ndarray]) -> float:
-    """The largest share of frames in any one second with the body low, folded or split."""
+def second_shares(flags: dict[str, np.ndarray]) -> np.ndarray:
+    """[T - FPS + 1] the share of frames with the body low, folded or split in the second starting
+    at each frame (one share over all frames when there is less than a second)."""
     bad = body_flagged(flags).astype(float)
     if len(bad) < FPS:
-        return float(bad.mean()) if len(bad) else 0.0
-    return float(np.convolve(bad, np.ones(FPS) / FPS, "valid").max())
+        return np.array([bad.mean() if len(bad) else 0.0])
+    return np.convolve(bad, np.ones(FPS) / FPS, "valid")
+
+
+def worst_second(flags: dict[str, np.ndarray]) -> float:
+    """The largest share of frames in any one second with the body low, folded or split."""
+    return float(second_shares(flags).max())
+
+
+def first_bad_second(flags: dict[str, np.ndarray]) -> int | None:
+    """The frame where the first bad second (a share over BAD_SECOND) starts; None without one."""
+    shares = second_shares(flags)
+    return int(np.argmax(shares > BAD_SECOND)) if shares.max() > BAD_SECOND else None
 
 
 def dancer(positions: np.ndarray, r: dict) -> dict:
