@@ -15,8 +15,10 @@ matters, in minutes instead of a 40-minute soak each.
 A variant is `base` (the manifest as it is) or options joined by `+`: an evaluation option by its
 attribute name (guard, guard_margin, guard_hip_margin, guard_partner_low,
 guard_partner_low_hip_margin, leader_guard: training/evaluation/options.py) or a leader guard
-field of the manifest as `leader.FIELD` (margin, headMargin, hipMargin). --rollout VARIANT dances
-the rollout up to the moments with that setting (a soak run with options: its fall is found there).
+field of the manifest as `leader.FIELD` (margin, headMargin, hipMargin), or `follower=FILE.onnx`:
+another follower network dances on from the same moments (the duet up to them is the --models
+pair's), which compares trained followers where the fall was made. --rollout VARIANT dances the
+rollout up to the moments with that setting (a soak run with options: its fall is found there).
 """
 from __future__ import annotations
 
@@ -47,12 +49,16 @@ def policies(manifest: dict, leader, follower, variant: str):
         if change == "base":
             continue
         key, _, value = change.partition("=")
-        if key.startswith("leader."):
+        if key == "follower":
+            if not Path(value).is_file():
+                raise SystemExit(f"error: variant {variant!r}: {value} not found")
+            follower = OnnxPolicy(Path(value))
+        elif key.startswith("leader."):
             m.setdefault("leaderGuard", {})[key[len("leader."):]] = float(value)
         elif key in OPTIONS:
             setattr(args, key, int(value) if key in ("guard", "leader_guard") else float(value))
         else:
-            raise SystemExit(f"error: variant {variant!r}: unknown setting {key!r} (one of {', '.join(OPTIONS)}, leader.FIELD)")
+            raise SystemExit(f"error: variant {variant!r}: unknown setting {key!r} (one of {', '.join(OPTIONS)}, leader.FIELD, follower)")
     error = O.resolve(args, m)
     if error:
         raise SystemExit(f"error: variant {variant!r}: {error}")
@@ -71,12 +77,14 @@ def main(argv=None) -> int:
     ap.add_argument("--minutes", type=float, default=10.0, help="the soak's rollout length (its steering script)")
     ap.add_argument("--fall", type=float, default=None, help="seconds: the fall (default: found by dancing the rollout)")
     ap.add_argument("--back", default="1.5,0.8", help="seconds before the fall to continue from, comma-separated")
-    ap.add_argument("--n", type=int, default=20, help="continuations from each moment")
+    ap.add_argument("--n", type=int, default=20, help="continuations from each moment (0: only find the fall)")
     ap.add_argument("--seconds", type=float, default=4.0, help="length of each continuation")
     ap.add_argument("--variants", default="base")
     ap.add_argument("--rollout", default="base", metavar="VARIANT",
                     help="the setting the rollout is danced with up to the moments (default: the manifest's)")
     a = ap.parse_args(argv)
+    if a.n < 0:
+        ap.error(f"--n {a.n}: a count of continuations (0: only find the fall)")
     path = Path(a.models) / "manifest.json"
     if not path.exists():
         print(f"error: {path} not found", file=sys.stderr)
@@ -109,6 +117,8 @@ def main(argv=None) -> int:
             return 0
         fall = first / FPS
         print(f"seed {a.seed}: the first failing second starts at {fall:.2f} s")
+    if a.n < 1:
+        return 0
     stops = {int(round((fall - b) * FPS)): b for b in backs}
     if min(stops) < 1 or max(stops) >= frames:   # at least one step to continue
         print(f"error: --back {a.back} from {fall:g} s leaves the rollout", file=sys.stderr)

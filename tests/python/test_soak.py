@@ -98,6 +98,22 @@ def test_fall_continuations_dance_on_from_a_moment_for_each_variant(capsys):
     assert manifest["leaderGuard"]["hipMargin"] != 0.2           # the manifest itself is untouched
 
 
+def test_fall_continuations_swap_in_another_follower(capsys):
+    """`follower=FILE` dances on with that network: the page's own follower file by another path
+    dances exactly the base's continuations; a file that is not there is refused before dancing."""
+    fc = _fall_continuations()
+    manifest = json.loads((MODELS / "manifest.json").read_text())
+    same = MODELS / manifest["models"]["follower"]["file"]
+    assert fc.main(["3", "--models", str(MODELS), "--minutes", "0.2", "--fall", "6", "--back", "1",
+                    "--n", "2", "--seconds", "1", "--variants", f"base,follower={same}"]) == 0
+    lines = [l.split(": ", 1)[1] for l in capsys.readouterr().out.splitlines() if "she fell" in l]
+    assert len(lines) == 2 and lines[0] == lines[1]
+    _, follow, _ = fc.policies(manifest, None, None, f"follower={same}")
+    assert follow is not None
+    with pytest.raises(SystemExit, match="missing.onnx not found"):
+        fc.main(["3", "--models", str(MODELS), "--variants", "follower=missing.onnx"])
+
+
 def test_fall_continuations_refuse_an_unknown_setting():
     fc = _fall_continuations()
     with pytest.raises(SystemExit, match="unknown setting 'guard_size'"):
