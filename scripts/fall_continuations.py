@@ -15,9 +15,9 @@ matters, in minutes instead of a 40-minute soak each.
 A variant is `base` (the manifest as it is) or options joined by `+`: an evaluation option by its
 attribute name (guard, guard_margin, guard_hip_margin, guard_partner_low,
 guard_partner_low_hip_margin, leader_guard: training/evaluation/options.py) or a leader guard
-field of the manifest as `leader.FIELD` (margin, headMargin, hipMargin), or `follower=FILE.onnx`:
-another follower network dances on from the same moments (the duet up to them is the --models
-pair's), which compares trained followers where the fall was made. --rollout VARIANT dances the
+field of the manifest as `leader.FIELD` (margin, headMargin, hipMargin), or `follower=FILE.onnx` /
+`leader=FILE.onnx`: another network dances on from the same moments (the duet up to them is the
+--models pair's), which compares trained networks (another --seed) where the fall was made. --rollout VARIANT dances the
 rollout up to the moments with that setting (a soak run with options: its fall is found there).
 """
 from __future__ import annotations
@@ -49,16 +49,19 @@ def policies(manifest: dict, leader, follower, variant: str):
         if change == "base":
             continue
         key, _, value = change.partition("=")
-        if key == "follower":
+        if key in ("leader", "follower"):
             if not Path(value).is_file():
                 raise SystemExit(f"error: variant {variant!r}: {value} not found")
-            follower = OnnxPolicy(Path(value))
+            if key == "leader":
+                leader = OnnxPolicy(Path(value))
+            else:
+                follower = OnnxPolicy(Path(value))
         elif key.startswith("leader."):
             m.setdefault("leaderGuard", {})[key[len("leader."):]] = float(value)
         elif key in OPTIONS:
             setattr(args, key, int(value) if key in ("guard", "leader_guard") else float(value))
         else:
-            raise SystemExit(f"error: variant {variant!r}: unknown setting {key!r} (one of {', '.join(OPTIONS)}, leader.FIELD, follower)")
+            raise SystemExit(f"error: variant {variant!r}: unknown setting {key!r} (one of {', '.join(OPTIONS)}, leader.FIELD, leader, follower)")
     error = O.resolve(args, m)
     if error:
         raise SystemExit(f"error: variant {variant!r}: {error}")
@@ -82,6 +85,7 @@ def main(argv=None) -> int:
     ap.add_argument("--variants", default="base")
     ap.add_argument("--rollout", default="base", metavar="VARIANT",
                     help="the setting the rollout is danced with up to the moments (default: the manifest's)")
+    ap.add_argument("--out", default=None, help="write {variant: {falls, continuations}} (and the fall) as JSON here")
     a = ap.parse_args(argv)
     if a.n < 0:
         ap.error(f"--n {a.n}: a count of continuations (0: only find the fall)")
@@ -131,6 +135,7 @@ def main(argv=None) -> int:
             saved.append((f + 1, copy.deepcopy(duet)))
     n = int(a.seconds * FPS)
     print(f"from {', '.join(f'{f / FPS:.2f} s' for f, _ in saved)}, {a.n} continuations of {a.seconds:g} s each")
+    results = {}
     for v in variants:
         lp, fp, temperature = policies(manifest, leader, follower, v)
         falls, his_lowest = 0, []
@@ -145,6 +150,9 @@ def main(argv=None) -> int:
                 his_lowest.append(his[:k + 1].min())
         print(f"{v}: she fell in {falls} of {a.n * len(saved)}; her guard chose in {getattr(fp, 'guarded', 0)} steps; "
               f"his lowest hips per continuation: median {np.median(his_lowest):.3f} m, lowest {np.min(his_lowest):.3f} m")
+        results[v] = {"falls": int(falls), "continuations": a.n * len(saved)}
+    if a.out:
+        Path(a.out).write_text(json.dumps({"seed": a.seed, "fall": fall, "variants": results}, indent=1))
     return 0
 
 

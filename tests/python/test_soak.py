@@ -73,14 +73,18 @@ def test_soak_runs_the_guard_and_refuses_a_guard_of_one(tmp_path, capsys):
     assert "--guard 1" in capsys.readouterr().err
 
 
-def _fall_continuations():
-    """scripts/fall_continuations.py as a module (scripts/ is not a package)."""
+def _script(name: str):
+    """scripts/NAME.py as a module (scripts/ is not a package)."""
     import importlib.util
-    path = Path(__file__).resolve().parents[2] / "scripts" / "fall_continuations.py"
-    spec = importlib.util.spec_from_file_location("fall_continuations", path)
+    path = Path(__file__).resolve().parents[2] / "scripts" / f"{name}.py"
+    spec = importlib.util.spec_from_file_location(name, path)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
+
+
+def _fall_continuations():
+    return _script("fall_continuations")
 
 
 def test_fall_continuations_dance_on_from_a_moment_for_each_variant(capsys):
@@ -98,23 +102,48 @@ def test_fall_continuations_dance_on_from_a_moment_for_each_variant(capsys):
     assert manifest["leaderGuard"]["hipMargin"] != 0.2           # the manifest itself is untouched
 
 
-def test_fall_continuations_swap_in_another_follower(capsys):
-    """`follower=FILE` dances on with that network: the page's own follower file by another path
-    dances exactly the base's continuations; a file that is not there is refused before dancing."""
+def test_fall_continuations_swap_in_another_network(capsys):
+    """`follower=FILE` / `leader=FILE` dance on with that network: the page's own files by another
+    path dance exactly the base's continuations; a file that is not there is refused before dancing."""
     fc = _fall_continuations()
     manifest = json.loads((MODELS / "manifest.json").read_text())
-    same = MODELS / manifest["models"]["follower"]["file"]
-    assert fc.main(["3", "--models", str(MODELS), "--minutes", "0.2", "--fall", "6", "--back", "1",
-                    "--n", "2", "--seconds", "1", "--variants", f"base,follower={same}"]) == 0
+    files = {role: MODELS / manifest["models"][role]["file"] for role in ("leader", "follower")}
+    assert fc.main(["3", "--models", str(MODELS), "--minutes", "0.2", "--fall", "6", "--back", "1", "--n", "2",
+                    "--seconds", "1", "--variants", f"base,follower={files['follower']},leader={files['leader']}"]) == 0
     lines = [l.split(": ", 1)[1] for l in capsys.readouterr().out.splitlines() if "she fell" in l]
-    assert len(lines) == 2 and lines[0] == lines[1]
-    _, follow, _ = fc.policies(manifest, None, None, f"follower={same}")
-    assert follow is not None
+    assert len(lines) == 3 and lines[0] == lines[1] == lines[2]
+    lead, follow, _ = fc.policies(manifest, None, None, f"follower={files['follower']}+leader={files['leader']}")
+    assert lead is not None and follow is not None
     with pytest.raises(SystemExit, match="missing.onnx not found"):
-        fc.main(["3", "--models", str(MODELS), "--variants", "follower=missing.onnx"])
+        fc.main(["3", "--models", str(MODELS), "--variants", "leader=missing.onnx"])
 
 
 def test_fall_continuations_refuse_an_unknown_setting():
     fc = _fall_continuations()
     with pytest.raises(SystemExit, match="unknown setting 'guard_size'"):
         fc.main(["3", "--models", str(MODELS), "--variants", "guard_size=8"])
+
+
+def test_screen_networks_counts_each_candidate_at_each_moment(tmp_path, capsys):
+    """One row per moment, one column per candidate and the reference; the page's own follower
+    under another name falls exactly as the reference does; bad moments and candidates are refused."""
+    sn = _script("screen_networks")
+    manifest = json.loads((MODELS / "manifest.json").read_text())
+    same = MODELS / manifest["models"]["follower"]["file"]
+    moments = tmp_path / "moments.json"
+    moments.write_text(json.dumps([{"seed": 3, "models": str(MODELS), "fall": 6},
+                                   {"seed": 4, "models": str(MODELS), "fall": 5, "rollout": "guard=64"}]))
+    out = tmp_path / "screen.json"
+    assert sn.main([str(moments), "--candidates", f"same={'follower=' + str(same)}", "--setting", "guard=64",
+                    "--minutes", "0.2", "--back", "1", "--n", "1", "--seconds", "0.5", "--out", str(out)]) == 0
+    table = json.loads(out.read_text())
+    assert table["candidates"] == {"base": "guard=64", "same": f"guard=64+follower={same}"}
+    assert [r["seed"] for r in table["rows"]] == [3, 4]
+    assert all(r["falls"]["base"] == r["falls"]["same"] and r["continuations"] == 1 for r in table["rows"])
+    assert "| **in all, of 2** |" in capsys.readouterr().out
+    moments.write_text(json.dumps([{"seed": 3, "models": str(MODELS)}]))
+    assert sn.main([str(moments), "--candidates", "a=guard=64"]) == 2
+    assert "moment 0 lacks fall" in capsys.readouterr().err
+    moments.write_text(json.dumps([{"seed": 3, "models": str(MODELS), "fall": 6}]))
+    assert sn.main([str(moments), "--candidates", "follower.onnx"]) == 2
+    assert "NAME=VARIANT" in capsys.readouterr().err

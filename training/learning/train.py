@@ -231,7 +231,9 @@ MODELS = {
     # 28-38 % without; recorded 81 % and 24 %), and beside the leader who turns on his own she
     # follows 80 % of 500 requests and turns 1.19x the recorded rate nobody asking; but in the soak
     # she went down into deep lunges with him in 2 of 100 rollouts (1 of 100 beside the leader
-    # before). At 4x she follows 65 % of the requests.
+    # before). At 4x she follows 65 % of the requests. Its seeds 2-5 (docs/results.md, "Five seeds of
+    # one follower"): seed 5 fell in 3 of 12 soak rollouts, seed 4 in 1 of 57, and each dances
+    # the requests and his turns differently (seed 4: 78 %, his turns 0.45x).
     "follower_led_onsets_8": replace(steady(OURS), state_dropout=0.5, turn_weight=8.0, unled_turn_weight=1.0,
                                      own_rollouts_from=10),
     "follower_led_onsets_4": replace(steady(OURS), state_dropout=0.5, turn_weight=4.0, unled_turn_weight=1.0,
