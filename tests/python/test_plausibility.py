@@ -417,3 +417,50 @@ def test_the_leaders_guard_keeps_his_lead_hand_to_a_requests_plan():
     assert UprightGuard(policy, r, samples=4, offsets=offsets)(x, 0.7, rng) is not None and calls[-1] == 1
     with pytest.raises(ValueError, match="bones"):
         UprightGuard(policy, r, samples=4, keep_plan=True)
+
+
+def test_her_guard_can_judge_how_fast_her_hips_go_down():
+    """guard.drops and UprightGuard(hip_drop=...): a step that takes her hips down by more than
+    hip_drop, to below the height given, makes the guard choose; a slower or higher step, a guard
+    without hip_drop, and a leader's input do not."""
+    import json
+    from pathlib import Path
+
+    from training.mirror.guard import SELF_HIPS, UprightGuard, drawn_joints, drops
+    from training.mirror.rollout import OnnxPolicy, start_duet, step
+
+    models = Path(__file__).parents[2] / "public/models"
+    m = json.loads((models / "manifest.json").read_text())
+    offsets = np.asarray(m["skeleton"]["offsets"]["follower"], float)
+    follower, leader = (OnnxPolicy(models / m["models"][k]["file"]) for k in ("follower", "leader"))
+    seen = {}
+
+    def spy(x, temperature, rng):
+        seen["x"], seen["out"] = np.atleast_2d(x)[0].copy(), follower(x, temperature, rng)["output"]
+        return {"output": seen["out"]}
+
+    step(start_duet(m), leader, spy, np.zeros(2), 0.5, np.random.default_rng(0))
+    x, out = seen["x"], seen["out"]
+    hips = float(drawn_joints(out[:1], offsets)[0, 0, 1])
+    x[SELF_HIPS] = hips + 0.02                                    # 2 cm down in this step
+    assert drops(x, out, offsets, 0.015, below=hips + 0.01)
+    assert not drops(x, out, offsets, 0.015, below=hips - 0.01)   # still above the height watched
+    assert not drops(x, out, offsets, 0.03, below=hips + 0.01)    # slower than hip_drop
+    assert not drops(x, out, offsets, None, below=hips + 0.01)
+    assert not drops(np.zeros(feat.LEADER_INPUT_SIZE), out, offsets, 0.015, below=hips + 0.01)
+
+    def policy(xs, temperature, rng):
+        return {"output": np.repeat(out[:1], len(np.atleast_2d(xs)), 0)}
+
+    r = {"hip_low": 0.0, "head_above_hip_low": -1.0, "feet_wide": 9.0, "angle_high": [1.5, 1.5]}   # all stands
+    plain = UprightGuard(policy, r, samples=4, margin=0.05, offsets=offsets)
+    plain(x, 0.5, np.random.default_rng(0))
+    assert plain.guarded == 0
+    guard = UprightGuard(policy, r, samples=4, margin=0.05, offsets=offsets, hip_drop=0.015, hip_drop_below=hips + 0.01)
+    guard(x, 0.5, np.random.default_rng(0))
+    assert guard.guarded == 1
+    x[SELF_HIPS] = hips + 0.005
+    guard(x, 0.5, np.random.default_rng(0))
+    assert guard.guarded == 1                                     # 5 mm: no choice
+    with pytest.raises(ValueError, match="bones"):
+        UprightGuard(policy, r, samples=4, hip_drop=0.015)

@@ -37,6 +37,10 @@ def add_options(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--guard-partner-low-hip-margin", type=float, default=None, metavar="M",
                     help="metres before the hips' edge her guard acts while his hips are low "
                          "(default: the manifest's guard.partnerLowHipMargin)")
+    ap.add_argument("--guard-hip-drop", type=float, default=None, metavar="M",
+                    help="her guard also chooses when a step would take her hips down more than M metres "
+                         "(to below guard.HIP_DROP_BELOW; measured, not in the page; default: the manifest's "
+                         "guard.hipDrop, else never)")
     ap.add_argument("--leader-guard", type=int, default=None, metavar="K",
                     help="the leader's upright guard with K samples (0: off; default: the manifest's "
                          "leaderGuard, acting at its margin)")
@@ -67,6 +71,10 @@ def resolve(args, manifest: dict) -> str | None:
         return "the guard's partnerLow needs a partnerLowHipMargin (--guard-partner-low-hip-margin)"
     if args.guard_partner_low_hip_margin is not None and args.guard_partner_low_hip_margin < 0:
         return f"--guard-partner-low-hip-margin {args.guard_partner_low_hip_margin}: metres, 0 or more"
+    if getattr(args, "guard_hip_drop", None) is None:
+        args.guard_hip_drop = guard.get("hipDrop")
+    if args.guard_hip_drop is not None and args.guard_hip_drop <= 0:
+        return f"--guard-hip-drop {args.guard_hip_drop}: metres a step, more than 0"
     if getattr(args, "leader_guard", None) is None:
         args.leader_guard = int((manifest.get("leaderGuard") or {}).get("samples", 0))
     if args.leader_guard < 0 or args.leader_guard == 1:
@@ -89,10 +97,12 @@ def follower_policy(policy, manifest: dict, args, leader_temperature: float):
         hips = getattr(args, "guard_hip_margin", None)
         low = getattr(args, "guard_partner_low", None) or None          # 0: never
         low_margin = getattr(args, "guard_partner_low_hip_margin", None)
+        drop = getattr(args, "guard_hip_drop", None)
         return UprightGuard(policy, manifest["plausibility"], args.guard, temperature, args.guard_margin,
                             manifest["skeleton"]["offsets"]["follower"], hip_margin=None if hips is None else float(hips),
                             partner_low=None if low is None else float(low),
-                            partner_low_hip_margin=None if low is None or low_margin is None else float(low_margin))
+                            partner_low_hip_margin=None if low is None or low_margin is None else float(low_margin),
+                            hip_drop=None if drop is None else float(drop))
     return policy if temperature is None else Variety(policy, temperature)
 
 
