@@ -441,13 +441,14 @@ def test_her_guard_can_judge_how_fast_her_hips_go_down():
 
     step(start_duet(m), leader, spy, np.zeros(2), 0.5, np.random.default_rng(0))
     x, out = seen["x"], seen["out"]
-    hips = float(drawn_joints(out[:1], offsets)[0, 0, 1])
+    joints = drawn_joints(out[:1], offsets)
+    hips = float(joints[0, 0, 1])
     x[SELF_HIPS] = hips + 0.02                                    # 2 cm down in this step
-    assert drops(x, out, offsets, 0.015, below=hips + 0.01)
-    assert not drops(x, out, offsets, 0.015, below=hips - 0.01)   # still above the height watched
-    assert not drops(x, out, offsets, 0.03, below=hips + 0.01)    # slower than hip_drop
-    assert not drops(x, out, offsets, None, below=hips + 0.01)
-    assert not drops(np.zeros(feat.LEADER_INPUT_SIZE), out, offsets, 0.015, below=hips + 0.01)
+    assert drops(x, joints, 0.015, below=hips + 0.01)
+    assert not drops(x, joints, 0.015, below=hips - 0.01)   # still above the height watched
+    assert not drops(x, joints, 0.03, below=hips + 0.01)    # slower than hip_drop
+    assert not drops(x, joints, None, below=hips + 0.01)
+    assert not drops(np.zeros(feat.LEADER_INPUT_SIZE), joints, 0.015, below=hips + 0.01)
 
     def policy(xs, temperature, rng):
         return {"output": np.repeat(out[:1], len(np.atleast_2d(xs)), 0)}

@@ -63,9 +63,8 @@ PARTNER_LOW_HIP_MARGIN = 0.20      # m
 # hip_drop metres to below HIP_DROP_BELOW. The recorded follower's hips do that in 1.1 % of her
 # frames (1.5 cm, 0.93 m). At 0.015 m, continued from the five soak falls of that pair, she fell in
 # 1 of 150 instead of 4, and the least steady seed of her recipe in 26 instead of 37: it helps, it
-# does not cure (docs/results.md, "Five seeds of one follower"). Evaluation: --guard-hip-drop.
-FOLLOWER_HIP_DROP: float | None = None   # m a step
-HIP_DROP_BELOW = 0.93                    # m
+# does not cure (docs/results.md, "Five seeds of one follower"). Evaluation: --guard-hip-drop M.
+HIP_DROP_BELOW = 0.93   # m
 # The leader trained on his own rollouts dances (steered, body motion 0.54 m/s over 100 seeds against 0.33 before) but,
 # steered, a few seeds had a second with his hips low. The same guard, acting from LEADER_MARGIN
 # before the range's edge (40 steered seeds): 0.05 m acted in 3.9 % of his steps and left 1 seed
@@ -215,14 +214,14 @@ def hip_slack_for(x: np.ndarray, margin: float, hip_margin: float | None, partne
     return 0.0 if hip_margin is None else margin - hip_margin
 
 
-def drops(x: np.ndarray, outputs: np.ndarray, offsets: np.ndarray, hip_drop: float | None,
-          below: float = HIP_DROP_BELOW) -> bool:
-    """Whether the first output [B, 323] draws a follower (input x) whose hips are more than
-    `hip_drop` metres lower than now and under `below` (never without hip_drop, or for a leader)."""
+def drops(x: np.ndarray, joints: np.ndarray, hip_drop: float | None, below: float = HIP_DROP_BELOW) -> bool:
+    """Whether the first body drawn [B, 17, 3] (drawn_joints) takes a follower (input x) whose hips
+    are now at x's height more than `hip_drop` metres down, to under `below` (never without
+    hip_drop, or for a leader's input)."""
     first = np.atleast_2d(x)[0]
     if hip_drop is None or len(first) != feat.INPUT_SIZE:
         return False
-    hips = drawn_joints(np.atleast_2d(outputs)[:1], offsets)[0, 0, 1]
+    hips = joints[0, 0, 1]
     return bool(hips < below and first[SELF_HIPS] - hips > hip_drop)
 
 
@@ -234,9 +233,10 @@ class UprightGuard:
     input shows a hands plan. `hip_margin` (both dancers'): the hips are judged from that margin;
     `partner_low`, `partner_low_hip_margin` (hers): from that one while her input shows his hips
     below that height. `hip_drop` (hers, measured, not in the page): it also chooses when the
-    drawn step takes her hips down faster than that, to below `hip_drop_below` (drops). `keep_plan` (his): while his input shows a hands plan, every step draws the
-    samples and takes the standing one whose lead hand is nearest the plan (nearest_plan); `kept`
-    counts those steps, `guarded` the ones among them where none stood."""
+    drawn step takes her hips down by more than that, to below `hip_drop_below` (drops).
+    `keep_plan` (his): while his input shows a hands plan, every step draws the samples and takes
+    the standing one whose lead hand is nearest the plan (nearest_plan); `kept` counts those
+    steps, `guarded` the ones among them where none stood."""
 
     def __init__(self, policy, ranges: dict, samples: int = SAMPLES, temperature: float | None = None,
                  margin: float = MARGIN, offsets: np.ndarray | None = None, head_margin: float | None = None,
@@ -268,8 +268,13 @@ class UprightGuard:
                 self.guarded += 1
             return {k: v[best:best + 1] for k, v in many.items()}
         out = self.policy(x, t, rng)
-        if (upright_margin(out["output"], self.ranges, self.offsets, slack, hips)[0] >= self.margin
-                and not drops(x, out["output"], self.offsets, self.hip_drop, self.hip_drop_below)):
+        if self.hip_drop is None:
+            stands = upright_margin(out["output"], self.ranges, self.offsets, slack, hips)[0] >= self.margin
+        else:   # the body drawn once for both judgements (hip_drop needs the bones: __init__)
+            joints = drawn_joints(out["output"], self.offsets)
+            stands = (drawn_margin(joints, self.ranges, slack, hips)[0] >= self.margin
+                      and not drops(x, joints, self.hip_drop, self.hip_drop_below))
+        if stands:
             return out
         self.guarded += 1
         many = self.policy(np.repeat(np.atleast_2d(x), self.samples, 0), t, rng)
