@@ -245,6 +245,12 @@ def test_recorded_leads_reads_his_hands_around_her_turns(data3, capsys):
     up, she = r[:, 0], r[:, 1]
     assert 0 < up.sum() < len(r) and she.mean() == pytest.approx((she[up].sum() + she[~up].sum()) / len(r))
     assert f"In {len(r)} windows of 2.5 s" in out
+    # The recorded couple read as requests: with his hand up against all windows, and a follower
+    # who turned after every raise: never below her share with his hand up.
+    recorded, every = recorded_leads.request_contrast(r)
+    assert recorded == pytest.approx(she[up].mean() / she.mean()) and every >= recorded
+    assert f"she turns {recorded:.2f}x as often" in out
+    assert np.isnan(recorded_leads.request_contrast(r[~r[:, 1]])[0])     # no turn: no ratio
 
 
 def test_recorded_leads_names_a_folder_without_takes(tmp_path, capsys):

@@ -12,7 +12,9 @@ WINDOW[1] seconds around the turn's completion, and reports:
   lead.winding's sign: negative for her turn to the left);
 - in windows of REQUEST_SECONDS from every EVERY-th frame (what `lead` reads after a request and at
   the same moments unasked): how often his hand goes above RAISED metres, and how often she, and
-  he, complete a turn in the windows with it and without it.
+  he, complete a turn in the windows with it and without it; and the ratio `lead` reports (asked /
+  unasked) as the recorded couple scores it (request_contrast): beside a leader who raises his hand
+  as often as this one, the unasked moments already hold her turns in most windows.
 
     python -m training.evaluation.recorded_leads
 """
@@ -73,12 +75,26 @@ def windows(data: str) -> np.ndarray:
     return np.array(rows, bool).reshape(-1, 3)
 
 
+def request_contrast(r: np.ndarray) -> tuple[float, float]:
+    """lead's asked / unasked ratio read on the recording (rows of windows()): how much more often
+    she turns in the windows his hand goes up than in all windows (a raise is what a request asks of
+    him, and all windows are the unasked moments of a leader who leads as he does), and the same for
+    a follower who turned after every raise (1 / her share of all windows). (nan, nan): no turn."""
+    up, she = r[:, 0], r[:, 1]
+    if not she.any() or not up.any():
+        return float("nan"), float("nan")
+    return float(she[up].mean() / she.mean()), float(1.0 / she.mean())
+
+
 def windows_report(r: np.ndarray) -> str:
     up, she, he = r[:, 0], r[:, 1], r[:, 2]
     pct = lambda x: f"{100 * x.mean():.1f} %" if len(x) else "–"
+    recorded, every = request_contrast(r)
     return (f"In {len(r)} windows of {REQUEST_SECONDS:g} s (from every {EVERY}th frame): his hand goes above "
             f"{HAND_RAISED:g} m in {pct(up)}; she completes a turn in {pct(she)} of them, {pct(she[up])} with his "
-            f"hand up and {pct(she[~up])} without; he completes one in {pct(he)}, {pct(he[up])} and {pct(he[~up])}.")
+            f"hand up and {pct(she[~up])} without; he completes one in {pct(he)}, {pct(he[up])} and {pct(he[~up])}. "
+            f"Read as lead's requests against the same moments unasked: she turns {recorded:.2f}x as often "
+            f"with his hand up as in all windows; a follower who turned after every raise, {every:.2f}x.")
 
 
 def report(around: dict[int, list[np.ndarray]], every: np.ndarray) -> list[str]:

@@ -197,7 +197,9 @@ def main(argv=None) -> int:
           (f"upright guard of {args.guard} samples, margin {args.guard_margin:g} m" +
            (f" (her hips {args.guard_hip_margin:g} m)" if args.guard_hip_margin is not None else "") +
            (f" (her hips {args.guard_partner_low_hip_margin:g} m while his are below {args.guard_partner_low:g} m)"
-            if args.guard_partner_low else "")
+            if args.guard_partner_low else "") +
+           (f" (and a step taking her hips down more than {args.guard_hip_drop:g} m)"
+            if getattr(args, "guard_hip_drop", None) else "")
            if args.guard else "no upright guard"))
     print(" seed  nonfinite  max dist m  bone err mm  min foot cm  frozen L  frozen F  resets  result")
     for i in tqdm(range(args.rollouts), desc="soak", unit="rollout", leave=False):
