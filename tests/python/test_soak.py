@@ -44,6 +44,18 @@ def test_short_soak_of_the_shipped_models_passes(tmp_path, capsys):
     assert "summary: 0 of 2 rollouts failed" in capsys.readouterr().out
 
 
+def test_soak_out_may_name_a_folder_and_a_missing_one_is_refused_first(tmp_path, capsys):
+    """--out DIR writes DIR/soak.json; --out in a folder that does not exist is refused before
+    any dancing, not after an hour of it."""
+    assert soak.main(["--models", str(MODELS), "--rollouts", "1", "--minutes", "0.05",
+                      "--out", str(tmp_path)]) in (0, 1)
+    assert json.loads((tmp_path / "soak.json").read_text())["summary"]
+    capsys.readouterr()
+    assert soak.main(["--models", str(MODELS), "--out", str(tmp_path / "nowhere" / "soak.json")]) == 2
+    printed = capsys.readouterr()
+    assert "no folder" in printed.err and "rollouts x" not in printed.out    # refused before the first rollout
+
+
 def test_missing_models_is_a_clear_error(tmp_path, capsys):
     assert soak.main(["--models", str(tmp_path)]) == 2
     assert "manifest.json not found" in capsys.readouterr().err

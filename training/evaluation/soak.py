@@ -168,7 +168,8 @@ def main(argv=None) -> int:
     ap.add_argument("--rollouts", type=int, default=100)
     ap.add_argument("--minutes", type=float, default=10.0)
     ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--out", default=None, help="write the table as JSON here")
+    ap.add_argument("--out", default=None,
+                    help="write the table as JSON to this file (a folder: soak.json in it)")
     O.add_options(ap)
     args = ap.parse_args(argv)
     manifest_path = Path(args.models) / "manifest.json"
@@ -176,6 +177,13 @@ def main(argv=None) -> int:
         print(f"error: {manifest_path} not found (python -m training.learning.export writes it)", file=sys.stderr)
         return 2
     manifest = json.loads(manifest_path.read_text())
+    # Where the table goes is settled before the hour of dancing, not after it.
+    out = None if args.out is None else Path(args.out)
+    if out is not None and out.is_dir():
+        out = out / "soak.json"
+    if out is not None and not out.parent.is_dir():
+        print(f"error: --out {args.out}: no folder {out.parent} to write it in", file=sys.stderr)
+        return 2
     if args.follower not in manifest["models"]:
         print(f"error: no model {args.follower!r} in {manifest_path}", file=sys.stderr)
         return 2
@@ -250,8 +258,9 @@ def main(argv=None) -> int:
               f"foot skate leader / follower {m['contact_skate_leader_cm']:.2f} / "
               f"{m['contact_skate_follower_cm']:.2f} cm per contact frame "
               f"({m['skate_leader_cm']:.2f} / {m['skate_follower_cm']:.2f} while low)")
-    if args.out:
-        Path(args.out).write_text(json.dumps({"summary": summary, "rollouts": results}, indent=1))
+    if out is not None:
+        out.write_text(json.dumps({"summary": summary, "rollouts": results}, indent=1))
+        print(f"wrote {out}")
     return 1 if bad else 0
 
 
