@@ -101,7 +101,8 @@ for k, ax in enumerate(axes.flat):
     # Flagged within the half second this frame stands for (a guard's choice is a single step).
     ax.set_title(f"t={t / FPS:.1f} s{'  ' + label if bad[t:t + FPS // 2].any() else ''}", fontsize=9)
 mode = "nobody steering" if args.nobody_steering else "steered"
-guard = f" (guard K={args.guard}, {args.guard_margin:g} m)" if args.guard else ""
+drop = f", hip drop {args.guard_hip_drop:g} m" if args.guard_hip_drop else ""
+guard = f" (guard K={args.guard}, {args.guard_margin:g} m{drop})" if args.guard else ""
 which = f"the 6 s from {args.at:g} s" if args.at is not None else f"the 6 s with most {args.dancer} frames flagged"
 fig.suptitle(f"{args.models}, {mode} seed {args.seed}{guard}: {which} ({label}: {bad.mean():.1%} of the "
              f"{args.dancer}'s frames), side view (x, height), a frame every 0.5 s")
