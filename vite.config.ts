@@ -128,5 +128,9 @@ export default defineConfig({
   plugins: [precompress(), modelsStamp()],
   test: {
     include: ['tests/web/**/*.test.ts'],
+    // No test is about speed (that is `npm run bench`): vitest's 5 s default would fail the
+    // fixture-heavy tests on a machine busy with other work, so they wait as long as they need.
+    testTimeout: 600_000,
+    hookTimeout: 600_000,
   },
 });

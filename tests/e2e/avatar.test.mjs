@@ -7,9 +7,7 @@
 
 import { after, before, test } from 'node:test';
 import assert from 'node:assert/strict';
-import { writeFileSync } from 'node:fs';
-import { join } from 'node:path';
-import { ROOT, duet, launch, startServer, waitReady, waitSteps } from './harness.mjs';
+import { WAIT_MS, duet, launch, saveScreen, startServer, waitReady, waitSteps, waitToast } from './harness.mjs';
 import { makeVrm } from './vrm.mjs';
 
 let server;
@@ -19,7 +17,7 @@ before(async () => {
   server = await startServer();
   browser = await launch();
   await browser.page.goto(`${server.url}?seed=2&camera=90,75,4`); // from the side: both dancers in view
-  await waitReady(browser.page, 60_000);
+  await waitReady(browser.page);
 });
 
 after(async () => {
@@ -48,10 +46,10 @@ const button = (page, name) => page.locator('.lil-gui button', { hasText: name }
 test('a .vrm dropped on the partner dresses the partner; its bones follow the dance', async () => {
   const { page } = browser;
   await dropAt(page, 'test-dancer.vrm', makeVrm('Test Dancer'), (await duet(page)).follower.screen);
-  await page.waitForFunction(() => window.duet.avatars?.follower, null, { timeout: 30_000 });
+  await page.waitForFunction(() => window.duet.avatars?.follower, null, { timeout: WAIT_MS });
   assert.deepEqual(Object.keys(await avatars(page)), ['follower']);
   assert.equal((await avatars(page)).follower.name, 'test-dancer.vrm');
-  await page.locator('.toast-info', { hasText: 'Your partner wears test-dancer.vrm' }).waitFor({ timeout: 5000 });
+  await waitToast(page, 'Your partner wears test-dancer.vrm', 'info');
   // While dancing: every bone of the avatar within a few degrees of the dancer's, ankles on the
   // dancer's (scaled) ankle heights.
   const samples = [];
@@ -62,39 +60,37 @@ test('a .vrm dropped on the partner dresses the partner; its bones follow the da
   const worst = (key) => Math.max(...samples.map((s) => s[key]));
   assert.ok(worst('fitDeg') < 5, `worst bone angle per sample (degrees): ${samples.map((s) => s.fitDeg.toFixed(2)).join(' ')}`);
   assert.ok(worst('feetCm') < 5, `ankles off (cm): ${samples.map((s) => s.feetCm.toFixed(2)).join(' ')}`);
-  writeFileSync(join(ROOT, 'docs', 'screenshot-avatar.png'), await page.screenshot());
+  saveScreen('screenshot-avatar.png', await page.screenshot());
 });
 
 test('a .vrm dropped on the leader dresses the leader; "plain bodies again" takes both off', async () => {
   const { page } = browser;
   await dropAt(page, 'older.vrm', makeVrm('Older', '0.0'), (await duet(page)).leader.screen);
-  await page.waitForFunction(() => window.duet.avatars?.leader, null, { timeout: 30_000 });
+  await page.waitForFunction(() => window.duet.avatars?.leader, null, { timeout: WAIT_MS });
   assert.deepEqual(Object.keys(await avatars(page)).sort(), ['follower', 'leader']);
   await waitSteps(page, 10);
   const { leader } = await avatars(page);
   assert.ok(leader.fitDeg < 5 && leader.feetCm < 5, JSON.stringify(leader));
   await button(page, 'plain bodies again').click();
-  await page.waitForFunction(() => Object.keys(window.duet.avatars ?? {}).length === 0, null, { timeout: 5000 });
+  await page.waitForFunction(() => Object.keys(window.duet.avatars ?? {}).length === 0, null, { timeout: WAIT_MS });
   assert.equal(await button(page, 'plain bodies again').isDisabled(), true);
 });
 
 test("the panel's avatar button dresses the partner (phones have no drag and drop)", async () => {
   const { page } = browser;
   await page.locator('input[aria-label="avatar file for the partner"]').setInputFiles({ name: 'chosen.vrm', mimeType: 'application/octet-stream', buffer: makeVrm('Chosen') });
-  await page.waitForFunction(() => window.duet.avatars?.follower, null, { timeout: 30_000 });
+  await page.waitForFunction(() => window.duet.avatars?.follower, null, { timeout: WAIT_MS });
   assert.deepEqual(Object.keys(await avatars(page)), ['follower']);
   assert.equal((await avatars(page)).follower.name, 'chosen.vrm');
   await button(page, 'plain bodies again').click();
-  await page.waitForFunction(() => Object.keys(window.duet.avatars ?? {}).length === 0, null, { timeout: 5000 });
+  await page.waitForFunction(() => Object.keys(window.duet.avatars ?? {}).length === 0, null, { timeout: WAIT_MS });
 });
 
 test('a file that is not an avatar gives a message, and the dance goes on', async () => {
   const { page } = browser;
   const before = (await duet(page)).frame;
   await dropAt(page, 'not-an-avatar.vrm', Buffer.from('HIERARCHY\nROOT hip'), (await duet(page)).follower.screen);
-  const toast = page.locator('.toast-error', { hasText: 'Cannot wear not-an-avatar.vrm' });
-  await toast.waitFor({ timeout: 10_000 });
-  assert.match(await toast.textContent(), /not a VRM avatar/);
+  assert.match(await waitToast(page, 'Cannot wear not-an-avatar.vrm', 'error'), /not a VRM avatar/);
   await waitSteps(page, 10);
   assert.ok((await duet(page)).frame > before, 'still dancing');
   assert.deepEqual(await avatars(page), {});

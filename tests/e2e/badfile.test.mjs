@@ -9,7 +9,7 @@
 import { after, before, describe, test } from 'node:test';
 import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
-import { duet, launch, reset, sleep, startServer, waitReady, waitSteps } from './harness.mjs';
+import { WAIT_MS, duet, launch, reset, sleep, startServer, waitReady, waitSteps, waitToast } from './harness.mjs';
 
 const VIEWPORT = { width: 1280, height: 800 };
 
@@ -31,12 +31,6 @@ async function dropFile(page, name, content) {
 const button = (page, name) => page.locator('.lil-gui button', { hasText: name });
 const playing = (page, name) => page.locator('.record-status', { hasText: `leader dances ${name}` });
 
-/** The text of the newest toast of `kind` naming `name`, once visible. */
-async function waitToast(page, name, kind) {
-  const toast = page.locator(`.toast-${kind}`).filter({ hasText: name }).last();
-  await toast.waitFor({ state: 'visible', timeout: 15_000 });
-  return toast.textContent();
-}
 
 /** The page's recording with `value` in channels `channels` of frames 21..30 (counted from 1). */
 function corrupt(text, channels, value) {
@@ -72,7 +66,7 @@ before(async () => {
   browser = await launch({ acceptDownloads: true, viewport: VIEWPORT });
   page = browser.page;
   await page.goto(`${server.url}?seed=1`);
-  await waitReady(page, 60_000);
+  await waitReady(page);
 });
 
 after(async () => {
@@ -84,10 +78,10 @@ describe('leader files no dancer could have recorded', () => {
   test("the page's own recording (3 s)", async () => {
     await waitSteps(page, 5);
     await button(page, '● record').click();
-    await page.locator('.record-status', { hasText: 'REC' }).waitFor({ state: 'visible', timeout: 5000 });
+    await page.locator('.record-status', { hasText: 'REC' }).waitFor({ state: 'visible', timeout: WAIT_MS });
     await waitSteps(page, 90);
     await button(page, '■ stop recording').click();
-    const download = page.waitForEvent('download', { predicate: (d) => /leader/.test(d.suggestedFilename()), timeout: 10_000 });
+    const download = page.waitForEvent('download', { predicate: (d) => /leader/.test(d.suggestedFilename()), timeout: WAIT_MS });
     await button(page, 'download BVH').click();
     recording = readFileSync(await (await download).path(), 'utf8');
     assert.match(recording, /^HIERARCHY\n/);
@@ -128,7 +122,7 @@ describe('leader files no dancer could have recorded', () => {
 
   test('the recording itself is danced, and R brings both dancers back while it plays', async () => {
     await dropFile(page, 'duet-leader.bvh', recording);
-    await playing(page, 'duet-leader.bvh').waitFor({ state: 'visible', timeout: 15_000 });
+    await playing(page, 'duet-leader.bvh').waitFor({ state: 'visible', timeout: WAIT_MS });
     await waitSteps(page, 60);
     assertBack(await reset(page), 'R while the file plays');
     assert.equal(await playing(page, 'duet-leader.bvh').count(), 1, 'the file plays on after R');

@@ -7,7 +7,7 @@
 import { after, before, describe, test } from 'node:test';
 import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
-import { distance, duet, launch, sleep, startServer, waitReady, waitSteps } from './harness.mjs';
+import { WAIT_MS, distance, duet, launch, sleep, startServer, waitReady, waitSteps, waitToast } from './harness.mjs';
 
 /** 1.5 s of dance (as in controls.test.mjs). Held that long, ArrowUp carries the spot the leader
  *  dances around (window.duet.anchor) about 0.9 m; his own hips, dancing since 2026-11-25, cover
@@ -26,7 +26,7 @@ before(async () => {
   browser = await launch({ viewport: { width: 1280, height: 800 }, acceptDownloads: true });
   page = browser.page;
   await page.goto(`${server.url}?seed=1&speed=2`);
-  await waitReady(page, 60_000);
+  await waitReady(page);
   await waitSteps(page, 5);
 });
 
@@ -35,12 +35,12 @@ after(async () => {
   await server?.stop();
 });
 
-describe('desktop: save a clip, and full screen', { timeout: 90_000 }, () => {
+describe('desktop: save a clip, and full screen', { timeout: WAIT_MS }, () => {
   test('"● clip" counts down, saves a video over 20 kB, and the keys still steer', async () => {
     const clip = page.locator('.title-row .clip-button');
     assert.ok(await clip.isVisible(), 'a clip button by the title');
     const idle = (await clip.textContent()).trim();
-    const download = page.waitForEvent('download', { timeout: 30_000 });
+    const download = page.waitForEvent('download', { timeout: WAIT_MS });
     await clip.click({ force: true });
     const labels = new Set();
     const badges = new Set();
@@ -113,7 +113,7 @@ describe('desktop: save a clip, and full screen', { timeout: 90_000 }, () => {
     assert.ok(seconds.duration > 4 && seconds.duration < 8, `the clip is ${seconds.duration} s long`);
     assert.ok(seconds.width > 0 && seconds.height > 0);
     assert.ok(seconds.mean > 40 && seconds.variance > 20, `a frame of the clip is not the dance: mean luminance ${seconds.mean.toFixed(0)}, variance ${seconds.variance.toFixed(0)}`);
-    await page.waitForFunction((label) => document.querySelector('.clip-button').textContent.trim() === label, idle, { timeout: 5000 });
+    await page.waitForFunction((label) => document.querySelector('.clip-button').textContent.trim() === label, idle, { timeout: WAIT_MS });
     assert.ok(!(await page.locator('.clip-badge').isVisible()), 'the badge goes when the clip is saved');
   });
 
@@ -124,9 +124,9 @@ describe('desktop: save a clip, and full screen', { timeout: 90_000 }, () => {
     assert.equal(visible, enabled, `fullscreenEnabled ${enabled}, button visible ${visible}`);
     if (enabled) {
       await page.locator('.fullscreen-button').click({ force: true });
-      await page.waitForFunction(() => document.fullscreenElement !== null, null, { timeout: 5000 });
+      await page.waitForFunction(() => document.fullscreenElement !== null, null, { timeout: WAIT_MS });
       await page.locator('.fullscreen-button').click({ force: true });
-      await page.waitForFunction(() => document.fullscreenElement === null, null, { timeout: 5000 });
+      await page.waitForFunction(() => document.fullscreenElement === null, null, { timeout: WAIT_MS });
       const start = await duet(page);
       await page.keyboard.down('ArrowUp');
       try {
@@ -150,8 +150,8 @@ describe('desktop: save a clip, and full screen', { timeout: 90_000 }, () => {
     });
     try {
       await webm.goto(`${server.url}?seed=2&speed=2`);
-      await waitReady(webm, 60_000);
-      const download = webm.waitForEvent('download', { timeout: 30_000 });
+      await waitReady(webm);
+      const download = webm.waitForEvent('download', { timeout: WAIT_MS });
       await webm.locator('.title-row .clip-button').click({ force: true });
       const file = await download;
       const bytes = readFileSync(await file.path());
@@ -162,7 +162,7 @@ describe('desktop: save a clip, and full screen', { timeout: 90_000 }, () => {
       // A browser without MediaRecorder: a toast, no error.
       await webm.evaluate(() => delete window.MediaRecorder);
       await webm.locator('.title-row .clip-button').click({ force: true });
-      await webm.locator('.toast', { hasText: 'cannot record' }).waitFor({ state: 'visible', timeout: 5000 });
+      await waitToast(webm, 'cannot record', null);
       assert.deepEqual(errors, []);
     } finally {
       await webm.close();

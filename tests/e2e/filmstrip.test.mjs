@@ -1,7 +1,8 @@
 // Film strips of the skinned dancers: for three seeds, 6 s of the running page at 1280×800 (and one
-// seed at a phone's 390×844: docs/filmstrip-phone-seed-2.png), one frame every 0.5 s (ArrowUp held for the first 2 s, ArrowLeft for the next 2 s, then nothing),
-// composed into one PNG per seed: docs/filmstrip-seed-N.png. Also docs/screenshot-desktop.png and
-// docs/screenshot-phone.png. The frames are copied from the stage canvas and composed with a 2D
+// seed at a phone's 390×844: filmstrip-phone-seed-2.png), one frame every 0.5 s (ArrowUp held for the first 2 s, ArrowLeft for the next 2 s, then nothing),
+// composed into one PNG per seed: filmstrip-seed-N.png. Also screenshot-desktop.png and
+// screenshot-phone.png. All go to runs/screens/ (harness.SCREENS, git-ignored; docs/testing.md says
+// which of them docs/ keeps a copy of). The frames are copied from the stage canvas and composed with a 2D
 // canvas inside the page (see captureStrip), so no image library is needed.
 //
 // Asserts, from window.duet only: the page is ready with skinned bodies and no error, the
@@ -11,9 +12,7 @@
 
 import { after, before, describe, test } from 'node:test';
 import assert from 'node:assert/strict';
-import { mkdirSync, writeFileSync } from 'node:fs';
-import { join } from 'node:path';
-import { ROOT, distance, duet, launch, pixelVariance, sleep, startServer, waitReady, waitSteps } from './harness.mjs';
+import { WAIT_MS, distance, duet, launch, pixelVariance, saveScreen, sleep, startServer, waitReady, waitSteps } from './harness.mjs';
 
 // DUET_FILMSTRIP_SEEDS=1 makes one strip only (while working on the bodies).
 const SEEDS = (process.env.DUET_FILMSTRIP_SEEDS ?? '1,2,3').split(',').map(Number);
@@ -33,7 +32,7 @@ const PHONE = {
 const PHONE_SEED = 2;
 const MIN_HIP = 0.5; // metres
 const MIN_VARIANCE = 20; // luminance variance; a blank canvas is ~0
-const READY_MS = 120_000; // the machine is shared: first loads can be slow
+const READY_MS = WAIT_MS; // the machine is shared: first loads can be slow
 /** Errors of a page that reloaded mid-test (window.duet gone, or the context destroyed). */
 const RELOADED = /Execution context was destroyed|navigation|reading 'frame'|window\.duet/;
 
@@ -45,9 +44,8 @@ before(async () => {
   const warm = await launch();
   warm.page.setDefaultTimeout(READY_MS);
   await warm.page.goto(`${server.url}?seed=1`).catch(() => undefined);
-  await waitReady(warm.page, READY_MS).catch(() => undefined);
+  await waitReady(warm.page).catch(() => undefined);
   await warm.close();
-  mkdirSync(join(ROOT, 'docs'), { recursive: true });
 });
 
 after(async () => {
@@ -62,7 +60,7 @@ after(async () => {
  * Copying in the page keeps the 0.5 s rhythm on a slow machine, where a full-page screenshot can
  * take seconds.
  */
-function captureStrip({ frames, interval, crop, scale, columns, title, keys }) {
+function captureStrip({ frames, interval, crop, scale, columns, title, keys, patience }) {
   return (async () => {
     const stage = document.querySelector('canvas.stage');
     const w = Math.round(crop.width * scale);
@@ -83,9 +81,9 @@ function captureStrip({ frames, interval, crop, scale, columns, title, keys }) {
       const wait = began + k * interval - performance.now();
       if (wait > 0) await new Promise((resolve) => setTimeout(resolve, wait));
       // A late copy (a slow software-GPU frame) can leave the next one only a frame later, before
-      // any step: wait up to 2 s for a step since the last copy (the test fails without one).
+      // any step: wait for a step since the last copy (the test fails without one, after `patience`).
       const previous = states.length ? states[states.length - 1].frame : -1;
-      const deadline = performance.now() + 2000;
+      const deadline = performance.now() + patience;
       while (window.duet.frame === previous && performance.now() < deadline) await new Promise((resolve) => setTimeout(resolve, 10));
       await new Promise((resolve) => requestAnimationFrame(resolve));
       const x = (k % columns) * w;
@@ -121,19 +119,19 @@ function captureStrip({ frames, interval, crop, scale, columns, title, keys }) {
 }
 
 /** One seed in one viewport: load, steer, copy 12 frames, write the strip, check what window.duet said. */
-async function filmstrip(seed, view = DESKTOP) {
+async function filmstrip(t, seed, view = DESKTOP) {
   const browser = await launch(view.launch);
   try {
     const { page, consoleErrors } = browser;
     page.setDefaultTimeout(READY_MS);
     await page.goto(`${server.url}?seed=${seed}`);
-    await waitReady(page, READY_MS);
-    await waitSteps(page, 20, READY_MS);
+    await waitReady(page);
+    await waitSteps(page, 20);
 
     // Keys from here while the page copies its frames (ArrowUp 0-2 s, ArrowLeft 2-4 s).
     const keys = Array.from({ length: FRAMES }, (_, k) => (k < 4 ? '↑ held' : k < 8 ? '← held' : ''));
     const capture = page.evaluate(captureStrip, {
-      frames: FRAMES, interval: INTERVAL_MS, crop: view.crop, scale: view.scale, columns: COLUMNS, keys,
+      frames: FRAMES, interval: INTERVAL_MS, crop: view.crop, scale: view.scale, columns: COLUMNS, keys, patience: WAIT_MS,
       title: `duet · ${view.name} · seed ${seed} · every 0.5 s · ↑ 0–2 s, ← 2–4 s`,
     });
     await page.keyboard.down('ArrowUp');
@@ -143,7 +141,7 @@ async function filmstrip(seed, view = DESKTOP) {
     await sleep(4 * INTERVAL_MS);
     await page.keyboard.up('ArrowLeft');
     const { png, states, variances } = await capture;
-    writeFileSync(join(ROOT, 'docs', view.file(seed)), Buffer.from(png.slice(png.indexOf(',') + 1), 'base64'));
+    saveScreen(view.file(seed), png);
 
     assert.equal(states.length, FRAMES);
     for (let k = 0; k < FRAMES; k++) {
@@ -156,9 +154,9 @@ async function filmstrip(seed, view = DESKTOP) {
       }
       assert.ok(variances[k] > MIN_VARIANCE, `frame ${k} looks blank (variance ${variances[k].toFixed(1)})`);
     }
-    // Each copy waits only for the next drawn frame, so the strip spans about 5.5 s; a machine
-    // busy with other work draws a frame a second or slower, hence the wide margin.
-    assert.ok(states[FRAMES - 1].t < (3 * (FRAMES - 1) * INTERVAL_MS) / 1000, `captures took ${states[FRAMES - 1].t} s`);
+    // Each copy waits only for the next drawn frame, so the strip spans about 5.5 s on a quiet
+    // machine; a busy one draws a frame a second or slower. How long it took is printed, not checked.
+    t.diagnostic(`captures took ${states[FRAMES - 1].t.toFixed(1)} s`);
     const moved = distance(states[0].leader.root, states[FRAMES - 1].leader.root);
     assert.ok(moved > 0.2, `the steered leader moved only ${moved.toFixed(2)} m`);
     assert.deepEqual(consoleErrors, []);
@@ -169,22 +167,22 @@ async function filmstrip(seed, view = DESKTOP) {
 
 /** The dev server reloads the page when a source file changes under it (someone editing while
  *  the test runs): that run says nothing about the page, so it is run once more. */
-async function filmstripOnce(seed, view) {
+async function filmstripOnce(t, seed, view) {
   try {
-    await filmstrip(seed, view);
+    await filmstrip(t, seed, view);
   } catch (error) {
     if (!RELOADED.test(String(error))) throw error;
-    await filmstrip(seed, view);
+    await filmstrip(t, seed, view);
   }
 }
 
 describe('film strips of the skinned dancers', () => {
   for (const seed of SEEDS) {
-    test(`seed ${seed}: 12 frames over 6 s (docs/${DESKTOP.file(seed)})`, () => filmstripOnce(seed, DESKTOP));
+    test(`seed ${seed}: 12 frames over 6 s (${DESKTOP.file(seed)})`, (t) => filmstripOnce(t, seed, DESKTOP));
   }
-  test(`phone, seed ${PHONE_SEED}: 12 frames over 6 s (docs/${PHONE.file(PHONE_SEED)})`, () => filmstripOnce(PHONE_SEED, PHONE));
+  test(`phone, seed ${PHONE_SEED}: 12 frames over 6 s (${PHONE.file(PHONE_SEED)})`, (t) => filmstripOnce(t, PHONE_SEED, PHONE));
 
-  test('desktop and phone screenshots (docs/screenshot-desktop.png, docs/screenshot-phone.png)', async () => {
+  test('desktop and phone screenshots (screenshot-desktop.png, screenshot-phone.png)', async () => {
     for (const [name, options] of [
       ['desktop', { viewport: { width: 1280, height: 800 } }],
       ['phone', { viewport: { width: 390, height: 844 }, deviceScaleFactor: 3, isMobile: true, hasTouch: true }],
@@ -194,13 +192,13 @@ describe('film strips of the skinned dancers', () => {
         const { page } = browser;
         page.setDefaultTimeout(READY_MS);
         await page.goto(`${server.url}?seed=1`);
-        await waitReady(page, READY_MS);
-        await waitSteps(page, 60, READY_MS);
+        await waitReady(page);
+        await waitSteps(page, 60);
         const state = await duet(page);
         assert.equal(state.bodies, 'skinned');
         assert.ok(state.follower.hip > MIN_HIP);
         const png = await page.screenshot();
-        writeFileSync(join(ROOT, 'docs', `screenshot-${name}.png`), png);
+        saveScreen(`screenshot-${name}.png`, png);
         const variance = await pixelVariance(page, png);
         assert.ok(variance > MIN_VARIANCE, `${name} screenshot variance ${variance.toFixed(1)}`);
       } finally {

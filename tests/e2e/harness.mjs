@@ -2,9 +2,14 @@
 // stop it by its own pid), launch the system Chromium through playwright-core with a fresh
 // profile, and read the page's window.duet test hook. Tests assert on window.duet only, so they
 // hold for the development simulation and for the real models alike.
+//
+// No test asserts how fast anything is: a test waits for what the page does (ready, steps taken,
+// a message shown) for up to WAIT_MS and fails only if it never happens. How fast the page loads
+// and steps is `npm run bench` (scripts/bench.mjs). Pictures the tests take go to SCREENS, a
+// git-ignored folder, so that `npm test` leaves the working tree as it found it.
 
 import { spawn } from 'node:child_process';
-import { mkdtempSync, rmSync } from 'node:fs';
+import { mkdirSync, mkdtempSync, rmSync, writeFileSync } from 'node:fs';
 import { createServer } from 'node:net';
 import { tmpdir } from 'node:os';
 import { join, resolve } from 'node:path';
@@ -12,6 +17,23 @@ import { fileURLToPath } from 'node:url';
 import { chromium } from 'playwright-core';
 
 export const ROOT = resolve(fileURLToPath(new URL('../..', import.meta.url)));
+/**
+ * How long a test waits for the page to do something before it fails (DUET_WAIT_MS, default 2
+ * minutes). Generous on purpose: a machine busy with other work only makes the page slower, and a
+ * slow page is not a failed test. A page that never does it still fails, after this long.
+ */
+export const WAIT_MS = Number(process.env.DUET_WAIT_MS ?? 120_000);
+/** Where the tests' screenshots and film strips go (DUET_SCREENS; git-ignored runs/screens). */
+export const SCREENS = resolve(process.env.DUET_SCREENS ?? join(ROOT, 'runs', 'screens'));
+
+/** Save a picture (PNG bytes, or a PNG data URL) as SCREENS/`name`; returns its path. */
+export function saveScreen(name, png) {
+  mkdirSync(SCREENS, { recursive: true });
+  const bytes = typeof png === 'string' ? Buffer.from(png.slice(png.indexOf(',') + 1), 'base64') : png;
+  const path = join(SCREENS, name);
+  writeFileSync(path, bytes);
+  return path;
+}
 const VITE = join(ROOT, 'node_modules', 'vite', 'bin', 'vite.js');
 const CHROMIUM = process.env.CHROMIUM ?? '/usr/bin/chromium';
 export const CHROMIUM_ARGS = [
@@ -67,7 +89,7 @@ export async function startServer({ mode = 'dev', base = '/', outDir = 'dist' } 
       child.once('exit', () => done());
       process.kill(child.pid, 'SIGTERM');
     });
-  const deadline = Date.now() + 30_000;
+  const deadline = Date.now() + WAIT_MS;
   for (;;) {
     if (child.exitCode !== null) throw new Error(`vite ${mode} exited early:\n${log}`);
     try {
@@ -98,6 +120,10 @@ export async function launch(options = {}) {
     viewport: { width: 1280, height: 800 },
     ...options,
   });
+  // Playwright's own waits (clicks, locators, navigation) are as patient as the tests' own.
+  context.setDefaultTimeout(WAIT_MS);
+  context.setDefaultNavigationTimeout(WAIT_MS);
+  await context.addInitScript(recordToasts);
   const page = context.pages()[0] ?? (await context.newPage());
   const consoleErrors = [];
   page.on('console', (message) => {
@@ -111,13 +137,52 @@ export async function launch(options = {}) {
   return { context, page, consoleErrors, close };
 }
 
+/**
+ * Installed before any page script: every toast the page shows is kept in window.__toasts
+ * ({ kind, text }), so a test sees a message even when it came and went (a toast stays 5-9 s, and
+ * a busy machine can take longer than that to look).
+ */
+function recordToasts() {
+  window.__toasts = [];
+  const seen = new WeakSet();
+  const look = (node) => {
+    if (!(node instanceof Element)) return;
+    for (const toast of node.matches('.toast') ? [node] : node.querySelectorAll('.toast')) {
+      if (seen.has(toast)) continue;
+      seen.add(toast);
+      const kind = [...toast.classList].find((c) => c.startsWith('toast-'))?.slice(6) ?? '';
+      window.__toasts.push({ kind, text: toast.textContent });
+    }
+  };
+  new MutationObserver((records) => {
+    for (const record of records) for (const node of record.addedNodes) look(node);
+  }).observe(document, { childList: true, subtree: true });
+}
+
+/**
+ * The text of a toast of `kind` ('error', 'info' or null for any) matching `pattern`, waited for
+ * up to WAIT_MS. Each toast answers one wait: a second wait for the same words needs a new toast.
+ */
+export async function waitToast(page, pattern, kind = 'error') {
+  const handle = await page.waitForFunction(
+    ({ source, flags, kind }) => {
+      const re = new RegExp(source, flags);
+      const i = (window.__toasts ?? []).findIndex((t) => (!kind || t.kind === kind) && re.test(t.text));
+      return i >= 0 && window.__toasts.splice(i, 1)[0].text;
+    },
+    { source: pattern instanceof RegExp ? pattern.source : pattern.replace(/[.*+?^${}()|[\]\\]/g, '\\$&'), flags: pattern instanceof RegExp ? pattern.flags : '', kind },
+    { timeout: WAIT_MS, polling: 50 },
+  );
+  return handle.jsonValue();
+}
+
 /** A snapshot of window.duet (plain data). */
 export function duet(page) {
   return page.evaluate(() => JSON.parse(JSON.stringify(window.duet ?? null)));
 }
 
-/** Wait until window.duet.ready (or an error); returns milliseconds from now. */
-export async function waitReady(page, timeoutMs = 5000) {
+/** Wait until window.duet.ready (or an error); returns milliseconds from now (for diagnostics only). */
+export async function waitReady(page, timeoutMs = WAIT_MS) {
   const started = Date.now();
   await page.waitForFunction(() => window.duet && (window.duet.ready || window.duet.error), null, {
     timeout: timeoutMs,
@@ -129,7 +194,7 @@ export async function waitReady(page, timeoutMs = 5000) {
 }
 
 /** Wait until the simulation has taken `steps` more steps. */
-export async function waitSteps(page, steps, timeoutMs = 30_000) {
+export async function waitSteps(page, steps, timeoutMs = WAIT_MS) {
   const start = (await duet(page)).frame;
   await page.waitForFunction((target) => window.duet.frame >= target, start + steps, { timeout: timeoutMs, polling: 20 });
 }
@@ -144,14 +209,18 @@ export async function reset(page) {
 export const distance = (a, b) => Math.hypot(a[0] - b[0], a[1] - b[1]);
 export const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
 
-/** How far the leader's spot moved over `ms` of wall time while `hold()` is in effect. */
-export async function displacement(page, ms, hold = async () => {}, release = async () => {}) {
-  // The leader's spot (window.duet.anchor), which the keys and the thumb carry: since 2026-11-25 he
-  // dances around it, and his own hips covered 0.87 m idle against 1.32 m steered in one CI run
-  // of built.test (2 s held), where the spot stays put unless steered.
+/**
+ * How far the leader's spot moved over `steps` simulation steps while `hold()` is in effect.
+ * Counted in steps, not wall time, so a slow machine (the page dances in slow motion there) moves
+ * him as far as a fast one.
+ */
+export async function displacement(page, steps, hold = async () => {}, release = async () => {}) {
+  // The leader's spot (window.duet.anchor), which the keys and the thumb carry: he dances around
+  // it, and his own hips covered 0.87 m idle against 1.32 m steered in one CI run of built.test
+  // (60 steps held), where the spot stays put unless steered.
   const start = await reset(page);
   await hold();
-  await sleep(ms);
+  await waitSteps(page, steps);
   await release();
   const end = await duet(page);
   return { start: [...start.anchor], end: [...end.anchor], moved: distance(start.anchor, end.anchor) };

@@ -15,13 +15,11 @@
 
 import { after, before, describe, test } from 'node:test';
 import assert from 'node:assert/strict';
-import { writeFileSync } from 'node:fs';
-import { join } from 'node:path';
-import { ROOT, duet, launch, sleep, startServer, waitReady, waitSteps } from './harness.mjs';
+import { duet, launch, saveScreen, sleep, startServer, waitReady, waitSteps } from './harness.mjs';
 
-/** Pictures a visitor would see, for docs/ (the latest test run's). */
-const shot = async (page, name) => writeFileSync(join(ROOT, 'docs', `${name}.png`), await page.screenshot());
-/** The screens whose compare mode, zoomed out, goes to docs/ (the issue's cases). */
+/** Pictures a visitor would see, in runs/screens/ (harness.SCREENS; the latest test run's). */
+const shot = async (page, name) => saveScreen(`${name}.png`, await page.screenshot());
+/** The screens whose compare mode, zoomed out, is kept as a picture (the issue's cases). */
 const SHOTS = new Set(['844x390', '1280x500']);
 
 const PHONE = { deviceScaleFactor: 1, isMobile: true, hasTouch: true };
@@ -115,7 +113,7 @@ for (const phone of [true, false]) {
     test('compare labels never overlap, at the first view and zoomed out, with the panel open or folded', async () => {
       await withScreens(phone, async (page, where, width, height) => {
         await page.goto(`${server.url}?seed=1&model=compare`);
-        await waitReady(page, 90_000);
+        await waitReady(page);
         await waitSteps(page, 10);
         checkLabels(await labelBoxes(page), `${where}, first view`);
         await openPanel(page);
@@ -132,7 +130,7 @@ for (const phone of [true, false]) {
       await withScreens(phone, async (page, where) => {
         // The longest partner name on the menu ("baseline, no intention") and the recording folder open.
         await page.goto(`${server.url}?seed=1&model=ccm`);
-        await waitReady(page, 90_000);
+        await waitReady(page);
         await openPanel(page);
         const seen = await page.evaluate(() => {
           const cut = [];
@@ -158,7 +156,7 @@ for (const phone of [true, false]) {
     test('the drop hint is drawn over the panel, and its words fit', async () => {
       await withScreens(phone, async (page, where) => {
         await page.goto(`${server.url}?seed=1`);
-        await waitReady(page, 90_000);
+        await waitReady(page);
         await openPanel(page);
         const seen = await page.evaluate(() => {
           const transfer = new DataTransfer();
@@ -178,7 +176,7 @@ test('phone: the open settings sheet shows every control, and the dancers stay i
   await withScreens(true, async (page, where, width, height) => {
     if (width > height) return; // landscape: a drawer at the side (the test above)
     await page.goto(`${server.url}?seed=1`);
-    await waitReady(page, 90_000);
+    await waitReady(page);
     await openPanel(page);
     await waitSteps(page, 5);
     const seen = await page.evaluate(() => {
@@ -202,7 +200,7 @@ for (const [width, height, phone] of [[390, 844, true], [1280, 800, false]]) {
     try {
       const { page } = browser;
       await page.goto(`${server.url}?seed=1`);
-      await waitReady(page, 90_000);
+      await waitReady(page);
       await waitSteps(page, 5);
       const help = page.locator('.help-button');
       await help.click();
@@ -221,7 +219,7 @@ for (const [width, height, phone] of [[390, 844, true], [1280, 800, false]]) {
       await sleep(1000);
       assert.equal((await duet(page)).frame, frame, 'the dance holds while the help is open');
       await page.locator('.help-close').click();
-      await waitSteps(page, 5, 10_000); // and goes on once it is closed
+      await waitSteps(page, 5); // and goes on once it is closed
       // Paused by the visitor before: still paused after the help.
       await page.keyboard.press('Space');
       assert.equal((await duet(page)).paused, true);
@@ -244,7 +242,7 @@ test('the eight possible reactions stand apart, not on top of each other', async
   try {
     const { page } = browser;
     await page.goto(`${server.url}?seed=1&ghosts=8`);
-    await waitReady(page, 90_000);
+    await waitReady(page);
     await page.keyboard.down('ArrowUp');
     await waitSteps(page, 60);
     await page.keyboard.up('ArrowUp');

@@ -7,7 +7,7 @@ import { after, before, test } from 'node:test';
 import assert from 'node:assert/strict';
 import { existsSync, readdirSync, statSync } from 'node:fs';
 import { join } from 'node:path';
-import { ROOT, build, duet, launch, waitReady } from './harness.mjs';
+import { WAIT_MS, ROOT, build, duet, launch, waitReady } from './harness.mjs';
 import { posterAndScene } from './poster.mjs';
 import { serve } from '../../scripts/serve.mjs';
 
@@ -61,7 +61,7 @@ test('before the models arrive: floor, standing pair and a loading bar; then it 
   });
   try {
     await page.goto(`${server.url}?seed=1`);
-    await page.waitForFunction(() => window.duet?.sceneMs, null, { timeout: 30_000, polling: 50 });
+    await page.waitForFunction(() => window.duet?.sceneMs, null, { timeout: WAIT_MS, polling: 50 });
     const loading = await duet(page);
     assert.equal(loading.ready, false, 'still loading');
     assert.equal(loading.error, null);
@@ -73,11 +73,11 @@ test('before the models arrive: floor, standing pair and a loading bar; then it 
     assert.equal(await page.locator('.help-keys').isVisible(), true);
     assert.equal(await page.locator('.help-touch').isVisible(), false);
     release();
-    await waitReady(page, 60_000);
+    await waitReady(page);
     assert.equal(await page.locator('#loading').isVisible(), false, 'loading bar gone once dancing');
     // The bench's times are for frames on screen: each comes after its frame was drawn, and the
     // first dancing frame is drawn right after the first step (web/ui/main.ts, web/engine/boot.ts).
-    await page.waitForFunction(() => window.duet?.firstFrameMs, null, { timeout: 30_000, polling: 50 });
+    await page.waitForFunction(() => window.duet?.firstFrameMs, null, { timeout: WAIT_MS, polling: 50 });
     const { sceneMs, firstFrameMs, bootTimings: t } = await duet(page);
     assert.ok(sceneMs >= t.scene && t['scene-painted'] === sceneMs, `loading scene on screen ${sceneMs} after its draw ${t.scene}`);
     assert.ok(t['first-drawn'] >= t['first-step'] && firstFrameMs >= t['first-drawn'], `first step ${t['first-step']}, drawn ${t['first-drawn']}, on screen ${firstFrameMs}`);
@@ -103,7 +103,7 @@ test('the loading bar counts the bytes that travel (compressed), not the decoded
       }).observe(document, { subtree: true, childList: true, characterData: true });
     });
     await page.goto(`${server.url}?seed=1`);
-    await waitReady(page, 90_000);
+    await waitReady(page);
     const { download, workerFiles } = await duet(page);
     // What the worker fetched for the first dance: the wasm and the two models, as they came.
     const files = workerFiles.filter((f) => /\.(wasm|onnx)$/.test(new URL(f.url).pathname));
@@ -162,7 +162,7 @@ test('while loading on a phone, the loading bar is clear of the title, the credi
     const { page } = phone;
     await page.route('**/models/*.onnx', () => undefined); // stays loading
     await page.goto(`${server.url}?seed=1`);
-    await page.waitForFunction(() => window.duet?.sceneMs, null, { timeout: 60_000, polling: 50 });
+    await page.waitForFunction(() => window.duet?.sceneMs, null, { timeout: WAIT_MS, polling: 50 });
     const overlap = (a, b) => a.x < b.x + b.w && b.x < a.x + a.w && a.y < b.y + b.h && b.y < a.y + a.h;
     for (const [width, height] of [[360, 740], [390, 844], [430, 932], [740, 360], [844, 390]]) {
       await page.setViewportSize({ width, height });

@@ -7,7 +7,7 @@
 import { after, before, test } from 'node:test';
 import assert from 'node:assert/strict';
 import { join } from 'node:path';
-import { ROOT, build, duet, launch, sleep, waitReady, waitSteps } from './harness.mjs';
+import { ROOT, WAIT_MS, build, duet, launch, sleep, waitReady, waitSteps } from './harness.mjs';
 import { serve } from '../../scripts/serve.mjs';
 
 let server;
@@ -25,7 +25,7 @@ after(async () => {
 });
 
 /** URLs the service worker has stored, once it holds the wasm and the two first models. */
-async function cachedUrls(page, timeoutMs = 60_000) {
+async function cachedUrls(page, timeoutMs = WAIT_MS) {
   const deadline = Date.now() + timeoutMs;
   for (;;) {
     const urls = await page.evaluate(async () => {
@@ -42,13 +42,13 @@ test('after one visit: a repeat visit downloads nothing, and the page dances off
   const { page, context } = browser;
   const url = `${server.url}?seed=2`;
   await page.goto(url);
-  await waitReady(page, 60_000);
+  await waitReady(page);
   const urls = await cachedUrls(page);
   assert.ok(urls.some((u) => u.endsWith('.wasm')), `the wasm is cached: ${urls.join(', ')}`);
   for (const model of ['leader.onnx', 'follower.onnx']) assert.ok(urls.some((u) => u.endsWith(model)), `${model} is cached`);
 
   await page.goto(url);
-  await waitReady(page, 30_000);
+  await waitReady(page);
   // The page's own downloads, and the fetcher worker's (wasm, manifest, models: window.duet.workerFiles).
   const transferred = await page.evaluate(() =>
     [...performance.getEntriesByType('resource'), ...(window.duet.workerFiles ?? [])].reduce((sum, e) => sum + e.transferSize, 0),
@@ -61,7 +61,7 @@ test('after one visit: a repeat visit downloads nothing, and the page dances off
   await context.setOffline(true);
   try {
     await page.reload();
-    await waitReady(page, 30_000);
+    await waitReady(page);
     await waitSteps(page, 30);
     const state = await duet(page);
     assert.equal(state.error, null);

@@ -1,7 +1,7 @@
 // The loading scene's picture (index.html's #poster, drawn by scripts/poster.mjs) against the live
 // loading scene, as a visitor's screen shows them: shared by tests/e2e/loading.test.mjs.
 
-import { launch, pngCanvas } from './harness.mjs';
+import { WAIT_MS, launch, pngCanvas } from './harness.mjs';
 
 /** Everything over the canvas hidden except the picture: the two screens show the scene alone. */
 const SCENE_ONLY = 'body > *:not(#app):not(#poster) { visibility: hidden !important; }';
@@ -18,7 +18,7 @@ export async function posterAndScene(url, options, css = '') {
     await page.route('**/assets/index-*.js', (route) => route.abort());
     await page.goto(url);
     await page.addStyleTag({ content: SCENE_ONLY + css });
-    await page.waitForFunction(() => document.querySelector('#poster img')?.complete, null, { timeout: 30_000, polling: 50 });
+    await page.waitForFunction(() => document.querySelector('#poster img')?.complete, null, { timeout: WAIT_MS, polling: 50 });
     const source = await page.evaluate(() => document.querySelector('#poster img').currentSrc.replace(location.origin, ''));
     await page.waitForTimeout(200);
     const poster = await page.screenshot({ type: 'png' });
@@ -26,7 +26,7 @@ export async function posterAndScene(url, options, css = '') {
 
     await page.route('**/models/*.onnx', () => undefined); // never answered: the pair stays standing
     await page.goto(url);
-    await page.waitForFunction(() => window.duet?.sceneMs || window.duet?.error, null, { timeout: 60_000, polling: 50 });
+    await page.waitForFunction(() => window.duet?.sceneMs || window.duet?.error, null, { timeout: WAIT_MS, polling: 50 });
     await page.addStyleTag({ content: SCENE_ONLY });
     const removed = await page.evaluate(() => !document.getElementById('poster'));
     await page.waitForTimeout(500); // as scripts/poster.mjs: shadows and camera damping settle

@@ -5,7 +5,7 @@
 import { after, before, describe, test } from 'node:test';
 import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
-import { distance, duet, launch, sleep, startServer, waitReady, waitSteps } from './harness.mjs';
+import { WAIT_MS, distance, duet, launch, sleep, startServer, waitReady, waitSteps, waitToast } from './harness.mjs';
 
 const JOINTS = [
   // name, parent, offset in metres (a plain dancer facing +Z, arms out, left = +X)
@@ -85,13 +85,6 @@ async function dropFile(page, name, content) {
 
 const button = (page, name) => page.locator('.lil-gui button', { hasText: name });
 
-/** The newest toast's text once one matching `pattern` is visible. */
-async function waitToast(page, pattern, kind = 'error') {
-  const toast = page.locator(`.toast-${kind}`).filter({ hasText: pattern }).last();
-  await toast.waitFor({ state: 'visible', timeout: 10_000 });
-  return toast.textContent();
-}
-
 /** Check a BVH text the way a reader would: hierarchy, frame count, one row of 54 numbers per frame. */
 function checkBvh(text) {
   assert.ok(text.startsWith('HIERARCHY\n'), 'starts with HIERARCHY');
@@ -120,7 +113,7 @@ before(async () => {
   page = browser.page;
   // The first visit compiles the modules in the dev server; allow for it.
   await page.goto(`${server.url}?seed=1`);
-  await waitReady(page, 60_000);
+  await waitReady(page);
 });
 
 after(async () => {
@@ -132,19 +125,19 @@ describe('record and export', () => {
   test('records ~2 s and downloads one BVH per dancer', async () => {
     await waitSteps(page, 5);
     await button(page, '● record').click();
-    await page.locator('.record-status', { hasText: 'REC' }).waitFor({ state: 'visible', timeout: 5000 });
+    await page.locator('.record-status', { hasText: 'REC' }).waitFor({ state: 'visible', timeout: WAIT_MS });
     await waitSteps(page, 60);
     // Download while recording: what was recorded so far is saved, and the recording goes on.
     const downloads = [];
     page.on('download', (d) => downloads.push(d));
     await button(page, 'download BVH').click();
-    const deadline = Date.now() + 10_000;
+    const deadline = Date.now() + WAIT_MS;
     while (downloads.length < 2 && Date.now() < deadline) await sleep(50);
     assert.equal(downloads.length, 2, 'two downloads');
     await waitSteps(page, 5);
     assert.ok(await page.locator('.record-status', { hasText: 'REC' }).isVisible(), 'still recording');
     await button(page, '■ stop recording').click();
-    await page.locator('.record-status', { hasText: 'not downloaded' }).waitFor({ state: 'visible', timeout: 5000 });
+    await page.locator('.record-status', { hasText: 'not downloaded' }).waitFor({ state: 'visible', timeout: WAIT_MS });
 
     const files = {};
     for (const download of downloads) {
@@ -189,14 +182,14 @@ describe('files the leader cannot dance', () => {
     const toast = page.locator('.toast-error', { hasText: 'again.txt' });
     await toast.waitFor({ state: 'visible' });
     await toast.click();
-    await toast.waitFor({ state: 'detached', timeout: 2000 });
+    await toast.waitFor({ state: 'detached', timeout: WAIT_MS });
   });
 });
 
 describe('leader from a BVH file', () => {
   test('a file chosen with the file button: the leader dances it, the follower keeps reacting', async () => {
     await page.locator('input.leader-file').setInputFiles({ name: 'walk.bvh', mimeType: 'text/plain', buffer: Buffer.from(walkingBvh()) });
-    await page.locator('.record-status', { hasText: 'leader dances walk.bvh' }).waitFor({ state: 'visible', timeout: 10_000 });
+    await page.locator('.record-status', { hasText: 'leader dances walk.bvh' }).waitFor({ state: 'visible', timeout: WAIT_MS });
     await waitToast(page, 'The leader dances a file', 'info');
     const start = await duet(page);
     await waitSteps(page, 90); // 3 s of dance
@@ -212,7 +205,7 @@ describe('leader from a BVH file', () => {
 
   test('"leader back to model" ends the file', async () => {
     await button(page, 'leader back to model').click();
-    await page.locator('.record-status', { hasText: 'leader dances' }).waitFor({ state: 'hidden', timeout: 5000 });
+    await page.locator('.record-status', { hasText: 'leader dances' }).waitFor({ state: 'hidden', timeout: WAIT_MS });
     await waitSteps(page, 10);
     const state = await duet(page);
     assert.equal(state.error, null);
@@ -222,7 +215,7 @@ describe('leader from a BVH file', () => {
   test("the page's own recording, dropped on the page, is danced by the leader", async () => {
     assert.ok(recordedLeader, 'the recording test ran');
     await dropFile(page, 'duet-leader.bvh', recordedLeader);
-    await page.locator('.record-status', { hasText: 'leader dances duet-leader.bvh' }).waitFor({ state: 'visible', timeout: 10_000 });
+    await page.locator('.record-status', { hasText: 'leader dances duet-leader.bvh' }).waitFor({ state: 'visible', timeout: WAIT_MS });
     await waitSteps(page, 30);
     const state = await duet(page);
     assert.equal(state.error, null);

@@ -13,7 +13,7 @@ import { createServer } from 'node:http';
 import { tmpdir } from 'node:os';
 import { extname, join, normalize, sep } from 'node:path';
 import {
-  CHROMIUM_ARGS, build, distance, duet, launch, pixelVariance, sleep, startServer, waitReady, waitSteps,
+  CHROMIUM_ARGS, WAIT_MS, build, distance, duet, launch, pixelVariance, sleep, startServer, waitReady, waitSteps,
 } from './harness.mjs';
 
 /**
@@ -112,7 +112,7 @@ async function openPage(browser) {
  * matches `title` and whose text matches `detail`, the same message on window.duet.error, the page
  * not ready, and a screenshot that is not blank.
  */
-async function expectMessage(t, page, title, detail, timeoutMs = 30_000) {
+async function expectMessage(t, page, title, detail, timeoutMs = WAIT_MS) {
   const started = Date.now();
   await page.waitForFunction(() => window.duet?.error, null, { timeout: timeoutMs, polling: 50 });
   const state = await duet(page);
@@ -160,7 +160,7 @@ before(async () => {
   browser = await launch();
   // Warm the dev server's module transforms (as app.test.mjs does) so timeouts measure the page.
   await browser.page.goto(`${server.url}?seed=1`);
-  await waitReady(browser.page, 120_000).catch(() => undefined);
+  await waitReady(browser.page).catch(() => undefined);
   // Headless tabs all stay "visible": a page left running would keep stepping beside every test.
   await browser.page.goto('about:blank');
 });
@@ -304,7 +304,7 @@ async function plainStaticServer(root, prefix = '/duet/') {
 async function expectOneThread(t, page, url) {
   const started = Date.now();
   await page.goto(url);
-  await waitReady(page, 60_000);
+  await waitReady(page);
   const readyMs = Date.now() - started;
   await waitSteps(page, 60);
   const state = await duet(page);
@@ -363,11 +363,11 @@ describe('without cross-origin isolation the page runs on one thread', () => {
 });
 
 describe('hidden tab', () => {
-  test(`hidden for ${HIDDEN_SECONDS} s: no catch-up, no jump, frames resume`, { timeout: (HIDDEN_SECONDS + 180) * 1000 }, async (t) => {
+  test(`hidden for ${HIDDEN_SECONDS} s: no catch-up, no jump, frames resume`, { timeout: HIDDEN_SECONDS * 1000 + 5 * WAIT_MS }, async (t) => {
     const { page, consoleErrors } = await openPage(browser);
     await page.addInitScript(installTabSwitch);
     await page.goto(`${server.url}?seed=5`);
-    await waitReady(page, 60_000);
+    await waitReady(page);
     await waitSteps(page, 30);
 
     const before = await duet(page);
@@ -382,7 +382,7 @@ describe('hidden tab', () => {
 
     const shownAt = Date.now();
     await page.evaluate(() => window.__tab.show());
-    await waitSteps(page, 1, 30_000);
+    await waitSteps(page, 1);
     const shown = await duet(page);
     const wallSeconds = (Date.now() - shownAt) / 1000;
     // Real time since showing, plus the page's 0.5 s allowance for a stall, at 30 steps/s (+ slack):
@@ -403,7 +403,7 @@ describe('hidden tab', () => {
     assert.ok(followerJump < 1, `follower moved ${followerJump.toFixed(2)} m across the hidden span`);
 
     // And it dances on.
-    await waitSteps(page, 60, 60_000);
+    await waitSteps(page, 60);
     const later = await duet(page);
     assert.equal(later.error, null);
     assert.ok(distance(later.leader.root, later.follower.root) < 3, 'partners stay together');
@@ -416,7 +416,7 @@ describe('Content-Security-Policy and crafted URLs', () => {
   test('no CSP violation while loading, stepping, with ghosts, and switching to compare', async () => {
     const { page, consoleErrors } = await openPage(browser);
     await page.goto(`${server.url}?seed=2&ghosts=3&intentions=1`);
-    await waitReady(page, 60_000);
+    await waitReady(page);
     const csp = await page.evaluate(() => document.querySelector('meta[http-equiv="Content-Security-Policy"]')?.content ?? '');
     assert.match(csp, /script-src 'self' 'wasm-unsafe-eval'/);
     assert.doesNotMatch(csp, /'unsafe-eval'/);
@@ -425,7 +425,7 @@ describe('Content-Security-Policy and crafted URLs', () => {
     await page.keyboard.up('ArrowLeft');
     // A model loaded later (the CCM follower) goes through the same policy.
     await page.locator('.lil-gui select').first().selectOption({ label: 'both, side by side' });
-    await page.waitForFunction(() => window.duet.model === 'compare', null, { timeout: 60_000 });
+    await page.waitForFunction(() => window.duet.model === 'compare', null, { timeout: WAIT_MS });
     await waitSteps(page, 60);
     assert.equal((await duet(page)).error, null);
     assert.deepEqual(await page.evaluate(() => window.__violations), []);
@@ -437,13 +437,13 @@ describe('Content-Security-Policy and crafted URLs', () => {
     // Guards the test above against passing vacuously: an inline script must be refused and seen.
     const { page } = await openPage(browser);
     await page.goto(`${server.url}?seed=2`);
-    await waitReady(page, 60_000);
+    await waitReady(page);
     await page.evaluate(() => {
       const script = document.createElement('script');
       script.textContent = 'window.__ran = true';
       document.body.appendChild(script);
     });
-    await page.waitForFunction(() => window.__violations.length > 0, null, { timeout: 5000 });
+    await page.waitForFunction(() => window.__violations.length > 0, null, { timeout: WAIT_MS });
     assert.equal(await page.evaluate(() => window.__ran ?? false), false, 'inline script did not run');
     assert.match((await page.evaluate(() => window.__violations))[0], /script-src/);
     await page.close();
@@ -455,7 +455,7 @@ describe('Content-Security-Policy and crafted URLs', () => {
     const query =
       '?temperature=<script>alert(1)</script>&model=%3Cimg%20src=x%20onerror=alert(1)%3E&seed=1e999&camera=NaN,NaN,NaN';
     await page.goto(`${server.url}${query}`);
-    await waitReady(page, 60_000);
+    await waitReady(page);
     await waitSteps(page, 60);
     const state = await duet(page);
     assert.equal(state.error, null);
@@ -488,7 +488,7 @@ describe('Content-Security-Policy and crafted URLs', () => {
     assert.deepEqual(consoleErrors, []);
     // The observer is live: an element added now is seen.
     await page.evaluate(() => document.body.append(Object.assign(document.createElement('img'), { alt: 'probe' })));
-    await page.waitForFunction(() => window.__injected.length === 1, null, { timeout: 5000 });
+    await page.waitForFunction(() => window.__injected.length === 1, null, { timeout: WAIT_MS });
     await page.close();
   });
 });

@@ -38,7 +38,7 @@ for (const threads of [1, 2]) {
   test(`the browser's outputs are Python's, on ${threads} thread${threads > 1 ? 's' : ''}`, async () => {
     const { page } = browser;
     await page.goto(`${server.url}?seed=1&threads=${threads}`);
-    await waitReady(page, 30_000);
+    await waitReady(page);
     const results = await page.evaluate(async (fixture) => {
       const { ort } = await import('/web/engine/ort.ts');
       const { SESSION_OPTIONS } = await import('/web/engine/policy.ts');

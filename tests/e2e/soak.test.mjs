@@ -17,7 +17,7 @@ import assert from 'node:assert/strict';
 import { mkdtempSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { build, distance, duet, launch, sleep, startServer, waitReady } from './harness.mjs';
+import { WAIT_MS, build, distance, duet, launch, sleep, startServer, waitReady } from './harness.mjs';
 
 const SOAK_SECONDS = Number(process.env.DUET_SOAK_SECONDS ?? 120);
 const WARMUP_SECONDS = 10;
@@ -53,7 +53,13 @@ const LATE_CHECK_SECONDS = 300;
  */
 const MAX_WASM_GROWTH = 0.25;
 /** The simulation must step at least this often (slow motion on a loaded machine is fine). */
-const MAX_STALL_MS = 10_000;
+const MAX_STALL_MS = WAIT_MS;
+/**
+ * Steps the soak dances at the least: a third of real time. On a busy machine the page dances in
+ * slow motion; the soak then goes on past SOAK_SECONDS until it has danced these (a wait on the
+ * page, not a check of its speed: `npm run bench` measures that).
+ */
+const MIN_STEPS = SOAK_SECONDS * 10;
 const ARROWS = ['ArrowUp', 'ArrowDown', 'ArrowLeft', 'ArrowRight'];
 
 /** Installed before any page script: remember the WebAssembly memories the page creates (ORT's
@@ -88,7 +94,7 @@ after(async () => {
 
 const mb = (bytes) => `${(bytes / 2 ** 20).toFixed(2)} MiB`;
 
-test(`soak: ${SOAK_SECONDS} s of random steering in Chromium`, { timeout: (SOAK_SECONDS + WARMUP_SECONDS + 300) * 1000 }, async (t) => {
+test(`soak: ${SOAK_SECONDS} s of random steering in Chromium`, { timeout: (SOAK_SECONDS + WARMUP_SECONDS) * 3000 + 5 * WAIT_MS }, async (t) => {
   const { page, consoleErrors } = browser;
   await page.addInitScript(watchWasmMemory);
   const cdp = await page.context().newCDPSession(page);
@@ -120,7 +126,7 @@ test(`soak: ${SOAK_SECONDS} s of random steering in Chromium`, { timeout: (SOAK_
   };
 
   await page.goto(`${server.url}?seed=11`);
-  await waitReady(page, 60_000);
+  await waitReady(page);
   const warmupEnd = Date.now() + WARMUP_SECONDS * 1000;
   while (Date.now() < warmupEnd) {
     await steer(Date.now());
@@ -139,7 +145,7 @@ test(`soak: ${SOAK_SECONDS} s of random steering in Chromium`, { timeout: (SOAK_
   let nextSample = began;
   let nextTrace = began + TRACE_MS;
   const trace = [{ at: 0, heap: start.heap, wasm: start.wasm }];
-  while (Date.now() < end) {
+  while (Date.now() < end || last.frame - first.frame < MIN_STEPS) {
     const now = Date.now();
     await steer(now);
     if (now >= nextSample) {
@@ -186,8 +192,8 @@ test(`soak: ${SOAK_SECONDS} s of random steering in Chromium`, { timeout: (SOAK_
   );
 
   assert.equal(final.error, null);
-  assert.ok(steps >= seconds * 5, `only ${steps} steps in ${seconds.toFixed(0)} s`);
-  assert.ok(samples >= Math.floor(SOAK_SECONDS * 0.9), `only ${samples} samples`);
+  assert.ok(steps >= MIN_STEPS, `only ${steps} steps`);
+  assert.ok(samples >= Math.min(10, SOAK_SECONDS), `only ${samples} samples`);
   assert.ok(growth < allowed, `JS heap grew ${(growth / 1024).toFixed(0)} KiB (${mb(start.heap)} -> ${mb(stop.heap)})`);
   if (SOAK_SECONDS >= LATE_CHECK_SECONDS) {
     assert.ok(lateGrowth < LATE_GROWTH_BYTES, `JS heap grew ${(lateGrowth / 1024).toFixed(0)} KiB over the second half (still climbing: a leak?)`);

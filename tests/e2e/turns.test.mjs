@@ -3,7 +3,7 @@
 // asked to lead a clockwise turn (−1, her right: what T does), and every step is
 // recorded for 3 s; the same seed without a request is the control. The same led turn on a phone
 // (390×844, touch). Film strips from the request on, a frame every 0.5 s of dance time:
-// docs/filmstrip-led-turn-desktop.png and docs/filmstrip-led-turn-phone.png.
+// filmstrip-led-turn-desktop.png and filmstrip-led-turn-phone.png in runs/screens/ (harness.SCREENS).
 //
 // Asserts, from the page's own simulation:
 // - the page takes the request and holds it for a while (turnAsked), then lets it go;
@@ -11,15 +11,15 @@
 //   doing), and the leader's pose differs by more than 1 cm within 1 s after it;
 // - the request raises his hand: his higher hand goes above LEAD_HAND m within 2.5 s (the lead a
 //   dancer sees; in the recording his hand passes 1.6 m in 84 % of her turns and is above it in
-//   17 % of his frames). Over seeds 1-100 (scripts/turns_probe.mjs, the leader at variety 0.7,
-//   his lead hand kept to the plan, 2026-11-28) it did in 98 of 100 asked runs and 52 unasked;
+//   17 % of his frames). Over seeds 1-100 (scripts/turns_probe.mjs, the shipped leader at
+//   variety 0.7, his lead hand kept to the plan) it did in 98 of 100 asked runs and 52 unasked;
 // - the page keeps dancing through the turn: a step every 1/30 s of dance, both hips above 0.5 m,
 //   no error; the phone dances the same steps as the desktop;
 // - the strips' frames are not blank.
 // Whether the follower completes a turn is printed, not asserted: she is not told, and over seeds
 // 1-100 she turned 300° the asked way within 2.5 s in 36 of 100 asked runs and 20 unasked, either
-// way 68 and 51 (in Python over 500 requests, 78 % against 61 %: docs/results.md, "His lead hand
-// kept to the plan"). Seed 50 is the strip's because she completes the led turn there (680° to her
+// way 68 and 51 (in Python over 500 requests, 78 % against 61 %: docs/results.md, "Does she turn
+// when he leads?"). Seed 50 is the strip's because she completes the led turn there (680° to her
 // right within 2.5 s asked, the first full turn 1.23 s after the request; 196° unasked): what a led
 // turn looks like when it works. Seeds 6 and 8, the strip's before, no longer turn with this leader.
 //
@@ -27,9 +27,7 @@
 
 import { after, before, describe, test } from 'node:test';
 import assert from 'node:assert/strict';
-import { mkdirSync, writeFileSync } from 'node:fs';
-import { join } from 'node:path';
-import { ROOT, launch, startServer, waitReady } from './harness.mjs';
+import { WAIT_MS, launch, saveScreen, startServer, waitReady } from './harness.mjs';
 import { FPS, J, Reloaded, armProbe, captureLedTurn, followerTurn, leaderDivergence, leaderHand, poseDistance, readProbe } from './turns.mjs';
 
 const SEED = Number(process.env.DUET_TURN_SEED ?? 50);
@@ -40,7 +38,7 @@ const FRAMES = 6; // strip frames, every 0.5 s of dance from the request on
 const MIN_HIP = 0.5; // m
 const LEAD_HAND = 1.6; // m above the floor: a raised hand
 const MIN_VARIANCE = 20; // luminance variance of a strip cell; a blank canvas is ~0
-const READY_MS = 120_000; // the machine is shared: first loads can be slow
+const READY_MS = WAIT_MS; // the machine is shared: first loads can be slow
 const DESKTOP = {
   name: 'desktop', launch: { viewport: { width: 1280, height: 800 } },
   crop: { x: 200, y: 110, width: 880, height: 600 }, scale: 0.5, file: 'filmstrip-led-turn-desktop.png',
@@ -58,9 +56,8 @@ before(async () => {
   const warm = await launch();
   warm.page.setDefaultTimeout(READY_MS);
   await warm.page.goto(`${server.url}?seed=${SEED}`).catch(() => undefined);
-  await waitReady(warm.page, READY_MS).catch(() => undefined);
+  await waitReady(warm.page).catch(() => undefined);
   await warm.close();
-  mkdirSync(join(ROOT, 'docs'), { recursive: true });
 });
 
 after(async () => {
@@ -78,7 +75,7 @@ async function runOnce(view, direction, strip, seed = SEED, until = UNTIL) {
     const { page, consoleErrors } = browser;
     page.setDefaultTimeout(READY_MS);
     await page.goto(`${server.url}?seed=${seed}`);
-    await waitReady(page, READY_MS);
+    await waitReady(page);
     await armProbe(page, { askAt: ASK_AT, direction, until });
     let capture = null;
     if (strip) {
@@ -92,7 +89,7 @@ async function runOnce(view, direction, strip, seed = SEED, until = UNTIL) {
     let shot = null;
     if (capture) {
       shot = await capture;
-      writeFileSync(join(ROOT, 'docs', view.file), Buffer.from(shot.png.slice(shot.png.indexOf(',') + 1), 'base64'));
+      saveScreen(view.file, shot.png);
     }
     return { probe, shot, consoleErrors: [...consoleErrors] };
   } catch (error) {
@@ -137,7 +134,7 @@ const handAboveHead = (probe) =>
 describe(`leading a turn (seed ${SEED})`, () => {
   let desktopAsked = null;
 
-  test('a request reaches the leader, and the page dances on (desktop, with docs/filmstrip-led-turn-desktop.png)', async () => {
+  test('a request reaches the leader, and the page dances on (desktop, with filmstrip-led-turn-desktop.png)', async () => {
     const asked = await run(DESKTOP, DIRECTION, true);
     const control = await run(DESKTOP, 0);
     desktopAsked = asked;
@@ -185,7 +182,7 @@ describe(`leading a turn (seed ${SEED})`, () => {
     );
   });
 
-  test('the same led turn on a phone (docs/filmstrip-led-turn-phone.png)', async () => {
+  test('the same led turn on a phone (filmstrip-led-turn-phone.png)', async () => {
     const phone = await run(PHONE, DIRECTION, true);
     checkDancing('phone', phone.probe, phone.consoleErrors);
     assert.equal(phone.probe.took, true);
@@ -208,8 +205,8 @@ describe(`leading a turn (seed ${SEED})`, () => {
 // and her facing recorded for 2.5 s. She is still not told: her network reads his motion. Asserted: she turns 300 degrees or
 // more (either way) within 2.5 s in most of them. The dance of a seed is the same on every run, so
 // this holds the shipped models to what they did when they were shipped: 5 of these 8 (seeds 1, 6
-// and 8 turned 109°, 22° and 294°, 2026-11-28); over seeds 1-100 the probe found 68 % when the
-// models were shipped (docs/results.md, "His lead hand kept to the plan"). Models that lead turns
+// and 8 turned 109°, 22° and 294°); over seeds 1-100 the probe found 68 % when the
+// models were shipped (docs/results.md, "Does she turn when he leads?"). Models that lead turns
 // less often fail it.
 const SEEDS = [1, 2, 3, 4, 5, 6, 7, 8];
 const WINDOW = Math.round(2.5 * FPS);
