@@ -199,9 +199,32 @@ export async function waitSteps(page, steps, timeoutMs = WAIT_MS) {
   await page.waitForFunction((target) => window.duet.frame >= target, start + steps, { timeout: timeoutMs, polling: 20 });
 }
 
-/** Press R and wait for a couple of steps so the reset state is published. */
+/**
+ * Once Space (or the pause button) has paused the dance and the steps under way have ended: the
+ * frame then. Polls every 0.5 s until two reads agree.
+ */
+export async function pausedStill(page) {
+  await page.waitForFunction(() => window.duet.paused === true, null, { timeout: WAIT_MS, polling: 20 });
+  for (let frame = (await duet(page)).frame; ; ) {
+    await sleep(500);
+    const now = (await duet(page)).frame;
+    if (now === frame) return now;
+    frame = now;
+  }
+}
+
+/**
+ * Press R (both dancers back to the start) and return the state a couple of steps later. R waits
+ * in the page's queue behind the steps under way, and on a busy machine one batch of steps can
+ * outlast any fixed wait; so the dance is paused first, R lands on an idle queue (it has run by the
+ * time the key is in), and the dance resumes.
+ */
 export async function reset(page) {
+  await page.keyboard.press('Space');
+  await pausedStill(page);
   await page.keyboard.press('r');
+  await page.keyboard.press('Space');
+  await page.waitForFunction(() => window.duet.paused === false, null, { timeout: WAIT_MS, polling: 20 });
   await waitSteps(page, 2);
   return duet(page);
 }
