@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerates docs/results.md's numbers and plots from the shipped models plus the
+# Regenerates the numbers of docs/results.md ("The paper's tables on this data") and their plots (runs/plots/) from the shipped models plus the
 # evaluation-only models (train those first: bash scripts/train_ablations.sh).
 #   bash scripts/evaluate_all.sh [DATA]      (DATA defaults to $DUET_DATA, data/cmu-salsa or ../shared/data/cmu-salsa)
 set -euo pipefail
@@ -31,4 +31,4 @@ done
 
 $PY -m training.evaluation.evaluate --data "$DATA" --takes 02,13 --models "$MODELS" --out runs/eval_all \
     --seeds 0,1,2 --temperatures 0.5,1 --quiet
-$PY -m training.evaluation.plots --out docs --eval runs/eval_all/metrics.json
+$PY -m training.evaluation.plots --out runs/plots --eval runs/eval_all/metrics.json   # the figures: runs/plots/*.png (git-ignored)
