@@ -18,8 +18,8 @@
 // - the strips' frames are not blank.
 // Whether the follower completes a turn is printed, not asserted: she is not told, and over seeds
 // 1-100 she turned 300° the asked way within 2.5 s in 36 of 100 asked runs and 20 unasked, either
-// way 68 and 51 (in Python over 500 requests, 78 % against 61 %: docs/results.md, "Does she turn
-// when he leads?"). Seed 50 is the strip's because she completes the led turn there (680° to her
+// way 68 and 51 (in Python over 500 requests, 78 % against 61 %: docs/results.md, "Leading a
+// turn"). Seed 50 is the strip's because she completes the led turn there (680° to her
 // right within 2.5 s asked, the first full turn 1.23 s after the request; 196° unasked): what a led
 // turn looks like when it works. Seeds 6 and 8, the strip's before, no longer turn with this leader.
 //
@@ -206,7 +206,7 @@ describe(`leading a turn (seed ${SEED})`, () => {
 // more (either way) within 2.5 s in most of them. The dance of a seed is the same on every run, so
 // this holds the shipped models to what they did when they were shipped: 5 of these 8 (seeds 1, 6
 // and 8 turned 109°, 22° and 294°); over seeds 1-100 the probe found 68 % when the
-// models were shipped (docs/results.md, "Does she turn when he leads?"). Models that lead turns
+// models were shipped (docs/results.md, "Leading a turn"). Models that lead turns
 // less often fail it.
 const SEEDS = [1, 2, 3, 4, 5, 6, 7, 8];
 const WINDOW = Math.round(2.5 * FPS);
