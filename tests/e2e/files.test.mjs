@@ -12,7 +12,9 @@
 
 import { after, before, test } from 'node:test';
 import assert from 'node:assert/strict';
-import { duet, launch, startServer, waitReady, waitSteps } from './harness.mjs';
+import { readFileSync } from 'node:fs';
+import { join } from 'node:path';
+import { ROOT, duet, launch, startServer, waitReady, waitSteps } from './harness.mjs';
 import { TEXTURE_RGB, makeVrm } from './vrm.mjs';
 
 /** How long to wait for the page to do something before failing (as the other tests: DUET_WAIT_MS). */
@@ -154,4 +156,44 @@ test('textured avatars, VRM 1.0 on the partner and VRM 0.x on the leader, are dr
   for (const [dancer, share] of Object.entries(shares)) {
     assert.ok(share > 0.2, `pixels around the hips in the texture's colour: ${said}; the ${dancer}'s texture is not drawn`);
   }
+});
+
+/** The dance goes on after a refused file: no error, more steps taken, the avatars as they were. */
+async function dancesOn(page, avatarsBefore) {
+  const before = (await duet(page)).frame;
+  await waitSteps(page, 10, WAIT_MS);
+  const state = await duet(page);
+  assert.equal(state.error, null);
+  assert.ok(state.frame >= before + 10, 'the dance goes on');
+  assert.deepEqual(Object.keys(state.avatars ?? {}).sort(), avatarsBefore);
+  assert.equal(await page.locator('.error-overlay').count(), 0, 'no error overlay');
+}
+
+test('a cut-short avatar is refused with "the file is cut short: N of M bytes", and the dance goes on', async () => {
+  const { page } = browser;
+  const whole = makeVrm('Textured', '1.0');
+  const worn = Object.keys(await avatars(page)).sort();
+  await dropAt(page, 'cut.vrm', whole.subarray(0, 20_000), (await duet(page)).follower.screen);
+  const text = (await errorToast(page, 'Cannot wear cut.vrm')).replace(/\u202f/g, ' ');
+  const total = whole.length.toLocaleString('en-US').replace(/,/g, ' ');
+  assert.match(text, new RegExp(`The file is cut short: 20 000 of ${total} bytes\\. Download or export it again\\.`));
+  assert.doesNotMatch(text, /typed array|RangeError|GLTFLoader/);
+  await dancesOn(page, worn);
+  assert.equal((await avatars(page)).follower?.name, 'textured-1.vrm', 'the partner keeps the avatar it wore');
+});
+
+test('a cut-short BVH is refused with where it ends, and the dance goes on', async () => {
+  const { page } = browser;
+  // The CMU-skeleton fixture (9 frames at 120 fps), cut inside its 7th frame.
+  const text = JSON.parse(readFileSync(join(ROOT, 'tests', 'fixtures', 'bvh.json'), 'utf8')).full.text;
+  const lines = text.split('\n');
+  const first = lines.findIndex((l) => l.startsWith('Frame Time:')) + 1;
+  const cut = [...lines.slice(0, first + 6), lines[first + 6].trim().split(/\s+/).slice(0, 10).join(' ')].join('\n');
+  const worn = Object.keys(await avatars(page)).sort();
+  await dropAt(page, 'cut.bvh', Buffer.from(cut));
+  const message = (await errorToast(page, 'Cannot dance cut.bvh')).replace(/\u202f/g, ' ');
+  assert.match(message, /The file is cut short: it ends in frame 7 of the 9 it announces \(it holds \d+ of the \d+ numbers they need\)/);
+  await dancesOn(page, worn);
+  assert.equal(await page.locator('.record-status', { hasText: 'leader dances cut.bvh' }).count(), 0, 'the leader does not dance the file');
+  assert.deepEqual(browser.consoleErrors, []);
 });

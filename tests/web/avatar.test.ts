@@ -6,7 +6,7 @@
 import { readFileSync } from 'node:fs';
 import * as THREE from 'three';
 import { describe, expect, it } from 'vitest';
-import { AVATAR_BONES, Avatar } from '../../web/draw/avatar';
+import { AVATAR_BONES, Avatar, AvatarError, checkGlb } from '../../web/draw/avatar';
 import { bindPositions } from '../../web/draw/figure';
 import { N_JOINTS, PARENTS } from '../../web/mirror/skeleton';
 // @ts-expect-error: a plain JavaScript helper of the browser tests, without types
@@ -96,5 +96,75 @@ describe.each(['1.0', '0.0'] as const)('a VRM %s avatar', (version) => {
 describe('files that are not avatars', () => {
   it('says what is wrong', async () => {
     await expect(Avatar.load(new TextEncoder().encode('HIERARCHY').buffer as ArrayBuffer, 'x')).rejects.toThrow(/not a VRM avatar/);
+    await expect(Avatar.load(new ArrayBuffer(0), 'x')).rejects.toThrow(/The file is empty/);
+  });
+});
+
+/** A Node Buffer's bytes as an ArrayBuffer of their own. */
+const own = (bytes: Uint8Array) => bytes.buffer.slice(bytes.byteOffset, bytes.byteOffset + bytes.byteLength) as ArrayBuffer;
+/** The message checkGlb gives, thin spaces as plain ones; '' when it passes. */
+function problem(bytes: Uint8Array): string {
+  try {
+    checkGlb(own(bytes));
+  } catch (error) {
+    expect(error).toBeInstanceOf(AvatarError);
+    return (error as Error).message.replace(/\u202f/g, ' ');
+  }
+  return '';
+}
+/** The test avatar with its JSON chunk edited (and the GLB's lengths written to match). */
+function withJson(edit: (gltf: Record<string, any>) => void): Buffer {
+  const glb: Buffer = makeVrm('Test Dancer', '1.0');
+  const jsonLength = glb.readUInt32LE(12);
+  const gltf = JSON.parse(glb.subarray(20, 20 + jsonLength).toString());
+  edit(gltf);
+  let json = Buffer.from(JSON.stringify(gltf));
+  json = Buffer.concat([json, Buffer.alloc((4 - (json.length % 4)) % 4, 0x20)]);
+  const rest = glb.subarray(20 + jsonLength);
+  const head = Buffer.alloc(20);
+  head.write('glTF', 0, 'ascii');
+  head.writeUInt32LE(2, 4);
+  head.writeUInt32LE(20 + json.length + rest.length, 8);
+  head.writeUInt32LE(json.length, 12);
+  head.write('JSON', 16, 'ascii');
+  return Buffer.concat([head, json, rest]);
+}
+
+describe('a damaged avatar file (checkGlb)', () => {
+  const glb: Buffer = makeVrm('Test Dancer', '1.0');
+  const total = glb.length;
+  const grouped = (n: number) => n.toLocaleString('en-US').replace(/,/g, ' ');
+
+  it('passes the intact test avatars, VRM 1.0 and 0.x, with and without their texture', () => {
+    for (const version of ['1.0', '0.0']) for (const texture of [true, false]) expect(problem(makeVrm('x', version, { texture }))).toBe('');
+  });
+
+  it('cut short anywhere: "the file is cut short: N of M bytes", the length its header states', async () => {
+    // Inside the JSON chunk (the glTF loader said "Invalid typed array length: 240"), at its end,
+    // inside the binary chunk, and one byte short.
+    const jsonEnd = 20 + glb.readUInt32LE(12);
+    for (const cut of [240, jsonEnd, jsonEnd + 100, 20_000, total - 1]) {
+      expect(problem(glb.subarray(0, cut))).toBe(`The file is cut short: ${grouped(cut)} of ${grouped(total)} bytes. Download or export it again.`);
+    }
+    // The same through Avatar.load, as the page reads a dropped file.
+    await expect(Avatar.load(own(glb.subarray(0, 20_000)), 'x')).rejects.toThrow(`The file is cut short: 20\u202f000 of ${grouped(total).replace(' ', '\u202f')} bytes`);
+    expect(problem(glb.subarray(0, 8))).toMatch(/^The file is cut short: 8 bytes, less than its 12-byte header/);
+  });
+
+  it('other damage is named too, never in the glTF reader\'s own words', () => {
+    const v1 = Buffer.from(glb);
+    v1.writeUInt32LE(1, 4);
+    expect(problem(v1)).toMatch(/glTF 1\.0 model.*VRM avatars are glTF 2\.0 files/);
+    const badJson = Buffer.from(glb);
+    badJson.write('}', 20, 'ascii');
+    expect(problem(badJson)).toMatch(/damaged: the description of the model \(its JSON chunk\) is not readable JSON/);
+    const longBin = Buffer.from(glb);
+    const binAt = 20 + glb.readUInt32LE(12);
+    longBin.writeUInt32LE(glb.readUInt32LE(binAt) + 1000, binAt);
+    expect(problem(longBin)).toMatch(/damaged: its data \(the BIN chunk\) is said to end at byte/);
+    expect(problem(withJson((g) => (g.accessors[0].count *= 2)))).toMatch(/damaged: accessor 0 reads .* bytes of part 0 of the data, which holds/);
+    expect(problem(withJson((g) => (g.bufferViews[2].byteOffset += 1e6)))).toMatch(/damaged: part 2 of its data \(buffer view 2\) ends at byte/);
+    expect(problem(withJson((g) => (g.buffers[0].uri = 'body.bin')))).toMatch(/separate file \("body\.bin"\).*one \.vrm file/);
+    expect(problem(withJson((g) => (g.extensionsRequired = ['KHR_draco_mesh_compression'])))).toMatch(/compressed meshes \(Draco\).*cannot read/);
   });
 });

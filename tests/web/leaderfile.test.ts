@@ -165,3 +165,42 @@ describe('leader files: what a dancer can do', () => {
     expect(refusal(lines.join('\n'))).toMatch(/lShin Yposition in frame 31 of 90 is 10 units \(15 m\).*at most 1 m/);
   });
 });
+
+describe('leader files that are broken: the problem in plain words, not the reader\'s', () => {
+  const plain = (text: string) => refusal(text).replace(/\u202f/g, ' ');
+
+  it('cut short: where it ends, against what its header announces', () => {
+    const text = recording(); // 90 frames of 54 numbers, one line each, then a newline
+    const lines = text.split('\n');
+    const first = lines.findIndex((l) => l.startsWith('Frame Time:')) + 1;
+    // In the middle of frame 41: 40 whole frames and 7 numbers of the next.
+    const in41 = [...lines.slice(0, first + 40), lines[first + 40].split(' ').slice(0, 7).join(' ')].join('\n');
+    expect(plain(in41)).toBe('Cannot dance take.bvh: The file is cut short: it ends in frame 41 of the 90 it announces ' +
+      '(it holds 2 167 of the 4 860 numbers they need). Download or record it again.');
+    // After a whole frame; the last number cut off in its middle ("-12.5" as "-").
+    expect(plain(lines.slice(0, first + 60).join('\n'))).toMatch(/cut short: it ends after frame 60 of the 90/);
+    expect(plain(text.trimEnd().slice(0, text.trimEnd().lastIndexOf(' ') + 1) + '-')).toMatch(/cut short: it ends in the middle of the last number of frame 90 \("-"\)/);
+    // Inside the skeleton, at any point; right after MOTION.
+    for (const cut of [12, 300, text.indexOf('MOTION') - 3]) {
+      expect(plain(text.slice(0, cut))).toMatch(/cut short: it ends inside the skeleton \(HIERARCHY\), before the motion \(MOTION\) begins/);
+    }
+    expect(plain(text.slice(0, text.indexOf('MOTION') + 7))).toMatch(/cut short: it ends right after MOTION/);
+  });
+
+  it('other damage: braces, words where numbers belong, the frame count', () => {
+    const text = recording();
+    expect(plain(text.replace(/\n\s*\}\n/, '\n'))).toMatch(/22 opening braces \{ and 21 closing braces \}: a closing brace is missing/);
+    expect(plain(text.replace('OFFSET', 'OFSET'))).toMatch(/skeleton \(HIERARCHY\) holds "OFSET" \(line 4\)/);
+    expect(plain(withValue(text, 7, 'abc', 4, 1))).toMatch(/holds "abc" where a number should be \(line \d+: frame 5\)/);
+    expect(plain(text.replace(/Frames: 90/, 'Frames: 91'))).toMatch(/cut short: it ends after frame 90 of the 91/);
+    expect(plain(text.replace(/Frames: 90/, 'Frames: 89'))).toMatch(/holds 4 860 numbers where its 89 frames of 54 channels make 4 806/);
+    expect(plain(text.replace(/Frames: 90/, 'Frames: 9.5'))).toMatch(/"Frames:" line says 9\.5/);
+    expect(plain(text.replace(/Frame Time: \S+/, 'Frame Time: 0'))).toMatch(/"Frame Time:" is 0 s; it must be above zero/);
+    expect(plain(text.replace('MOTION', 'MOTON'))).toMatch(/no motion: its MOTION section is missing/);
+    // No message is the reader's own: no exception names, no "list index", no file name prefix.
+    for (const cut of [5, 40, 900, 2000, text.length - 200]) {
+      const message = refusal(text.slice(0, cut));
+      expect(message).not.toMatch(/Error|list index|malformed|take\.bvh: take\.bvh/);
+    }
+  });
+});

@@ -43,6 +43,118 @@ function jointAt(positions: ArrayLike<number>, j: number, out: THREE.Vector3): T
 /** Why a file cannot be worn, in words for the page's message. */
 export class AvatarError extends Error {}
 
+/** A whole number with its thousands apart (narrow no-break spaces): 192 232. */
+const count = (n: number) => Math.round(n).toString().replace(/\B(?=(\d{3})+(?!\d))/g, '\u202f');
+
+const GLB_HEADER = 12;
+const CHUNK_HEADER = 8;
+const JSON_CHUNK = 0x4e4f534a; // "JSON", little-endian
+const BIN_CHUNK = 0x004e4942; // "BIN\0"
+/** Bytes per component of an accessor's componentType, and components per element of its type. */
+const COMPONENT_BYTES: Record<number, number> = { 5120: 1, 5121: 1, 5122: 2, 5123: 2, 5125: 4, 5126: 4 };
+const COMPONENTS: Record<string, number> = { SCALAR: 1, VEC2: 2, VEC3: 3, VEC4: 4, MAT2: 4, MAT3: 9, MAT4: 16 };
+/** Extensions the page's glTF loader has no decoder for, as a visitor would name what they do. */
+const UNREADABLE: Record<string, string> = {
+  KHR_draco_mesh_compression: 'compressed meshes (Draco)',
+  EXT_meshopt_compression: 'compressed meshes (meshopt)',
+  KHR_meshopt_compression: 'compressed meshes (meshopt)',
+  KHR_texture_basisu: 'compressed textures (KTX2)',
+};
+
+interface GltfJson {
+  extensionsRequired?: string[];
+  buffers?: { byteLength?: number; uri?: string }[];
+  bufferViews?: { buffer?: number; byteOffset?: number; byteLength?: number }[];
+  accessors?: { bufferView?: number; byteOffset?: number; componentType?: number; type?: string; count?: number }[];
+}
+
+/**
+ * Check a .vrm file's bytes as a binary glTF (GLB: a 12-byte header stating the file's length,
+ * then a JSON chunk describing the model and a BIN chunk holding its data) before the glTF loader
+ * reads them; an AvatarError says in plain words what is wrong. The loader's own errors on such
+ * files are about its internals ("Invalid typed array length: 240" for a file cut short).
+ */
+export function checkGlb(bytes: ArrayBuffer): void {
+  const size = bytes.byteLength;
+  if (size === 0) throw new AvatarError('The file is empty. Choose a .vrm avatar file.');
+  const magic = String.fromCharCode(...new Uint8Array(bytes, 0, Math.min(4, size)));
+  if (magic !== 'glTF') throw new AvatarError('This is not a VRM avatar (a .vrm file is a binary glTF, starting with "glTF").');
+  const again = 'Download or export it again.';
+  if (size < GLB_HEADER) throw new AvatarError(`The file is cut short: ${size} bytes, less than its ${GLB_HEADER}-byte header. ${again}`);
+  const view = new DataView(bytes);
+  const version = view.getUint32(4, true);
+  if (version !== 2) {
+    throw new AvatarError(version === 1
+      ? 'This is a glTF 1.0 model, older than VRM; VRM avatars are glTF 2.0 files. Export it again as VRM.'
+      : `The file says it is binary glTF version ${version}; VRM avatars are glTF 2.0 files.`);
+  }
+  const length = view.getUint32(8, true);
+  if (length > size) throw new AvatarError(`The file is cut short: ${count(size)} of ${count(length)} bytes. ${again}`);
+  const damaged = (what: string) => new AvatarError(`The file is damaged: ${what}. ${again}`);
+  // The chunks, as the loader walks them: the JSON chunk (the description of the model) first, then
+  // the BIN chunk (its data), if any; chunks of other types are skipped.
+  let jsonAt = -1, jsonLength = 0, binLength = -1;
+  for (let at = GLB_HEADER; at < length;) {
+    if (at + CHUNK_HEADER > length) throw damaged(`its last part is cut off at byte ${count(length)}`);
+    const chunkLength = view.getUint32(at, true), type = view.getUint32(at + 4, true);
+    const end = at + CHUNK_HEADER + chunkLength;
+    if (at === GLB_HEADER && type !== JSON_CHUNK) throw damaged('the description of the model (its JSON chunk) does not follow the header');
+    const what = type === JSON_CHUNK ? 'the description of the model (its JSON chunk)' : type === BIN_CHUNK ? 'its data (the BIN chunk)' : 'a part of it';
+    if (end > length) throw damaged(`${what} is said to end at byte ${count(end)}, past the file's ${count(length)}`);
+    if (type === JSON_CHUNK && jsonAt < 0) [jsonAt, jsonLength] = [at + CHUNK_HEADER, chunkLength];
+    else if (type === BIN_CHUNK && binLength < 0) binLength = chunkLength;
+    at = end;
+  }
+  if (jsonAt < 0) throw damaged('the description of the model (its JSON chunk) is missing');
+  binLength = Math.max(0, binLength);
+  let json: GltfJson;
+  try {
+    json = JSON.parse(new TextDecoder().decode(new Uint8Array(bytes, jsonAt, jsonLength)));
+  } catch {
+    throw damaged('the description of the model (its JSON chunk) is not readable JSON');
+  }
+  if (typeof json !== 'object' || json === null) throw damaged('the description of the model (its JSON chunk) is not a glTF description');
+  for (const extension of json.extensionsRequired ?? []) {
+    if (UNREADABLE[extension]) {
+      throw new AvatarError(`The avatar uses ${UNREADABLE[extension]} (${extension}), which this page cannot read. Export it without compression.`);
+    }
+  }
+  const buffers = json.buffers ?? [];
+  buffers.forEach((buffer, b) => {
+    if (buffer.uri !== undefined && !buffer.uri.startsWith('data:')) {
+      throw new AvatarError(`The avatar's data is in a separate file ("${buffer.uri.slice(0, 60)}"); a .vrm holds everything in one file. Export it as one .vrm file.`);
+    }
+    if (b === 0 && buffer.uri === undefined && (buffer.byteLength ?? 0) > binLength) {
+      throw damaged(`its data should be ${count(buffer.byteLength ?? 0)} bytes, and the file holds ${count(binLength)}`);
+    }
+  });
+  const views = json.bufferViews ?? [];
+  views.forEach((v, i) => {
+    const end = (v.byteOffset ?? 0) + (v.byteLength ?? 0);
+    const buffer = buffers[v.buffer ?? 0];
+    if (!buffer) throw damaged(`part ${i} of its data (buffer view ${i}) belongs to no buffer`);
+    if (buffer.uri === undefined && end > binLength) {
+      throw damaged(`part ${i} of its data (buffer view ${i}) ends at byte ${count(end)} of data that holds ${count(binLength)}`);
+    }
+  });
+  (json.accessors ?? []).forEach((a, i) => {
+    if (a.bufferView === undefined) return;
+    const v = views[a.bufferView];
+    if (!v) throw damaged(`accessor ${i} reads part ${a.bufferView} of the data, which the file does not have`);
+    // The least an accessor reads (tightly packed; strides and padding only add to it).
+    const need = (a.byteOffset ?? 0) + (a.count ?? 0) * (COMPONENT_BYTES[a.componentType ?? 0] ?? 1) * (COMPONENTS[a.type ?? ''] ?? 1);
+    if (need > (v.byteLength ?? 0)) {
+      throw damaged(`accessor ${i} reads ${count(need)} bytes of part ${a.bufferView} of the data, which holds ${count(v.byteLength ?? 0)}`);
+    }
+  });
+}
+
+/** A glTF loader error in words for a visitor; the loader's own words after them. */
+function loaderProblem(error: unknown): string {
+  const message = String((error as Error)?.message || error).replace(/^THREE\.GLTFLoader: /, '');
+  return `The file could not be read as a VRM avatar: it may be damaged, or use a part of glTF this page cannot read (the glTF reader says: "${message}").`;
+}
+
 const _q = new THREE.Quaternion();
 const _swing = new THREE.Quaternion();
 const _m = new THREE.Matrix4();
@@ -119,8 +231,7 @@ export class Avatar {
 
   /** Read a .vrm (VRM 0.x or 1.0) file's bytes; an AvatarError says why it cannot be worn. */
   static async load(bytes: ArrayBuffer, name: string): Promise<Avatar> {
-    const magic = new Uint8Array(bytes, 0, Math.min(4, bytes.byteLength));
-    if (String.fromCharCode(...magic) !== 'glTF') throw new AvatarError('This is not a VRM avatar (a .vrm file is a binary glTF, starting with "glTF").');
+    checkGlb(bytes);
     const loader = new GLTFLoader();
     loader.register((parser) => new VRMLoaderPlugin(parser));
     let vrm: VRM | undefined;
@@ -128,7 +239,7 @@ export class Avatar {
       const gltf = await loader.parseAsync(bytes, '');
       vrm = gltf.userData.vrm as VRM | undefined;
     } catch (error) {
-      throw new AvatarError(`The file could not be read as a VRM avatar: ${(error as Error)?.message || error}`);
+      throw new AvatarError(loaderProblem(error));
     }
     if (!vrm) throw new AvatarError('The file is a 3D model but not a VRM avatar (it has no humanoid bones).');
     for (const bone of AVATAR_BONES) {

@@ -10,6 +10,8 @@
 // checkLeaderBvh holds every number of the file against generous bounds -- what a recording of a
 // person could hold, with wide margins -- and refuses the file with a message naming the quantity,
 // the frame, the value and the bound. Frames are counted from 1, as animation tools show them.
+// A broken file (cut short by a download, a brace or a number missing) is named as such in plain
+// words too (bvhLayoutProblem, plainBvhError), never in the reader's own ("list index out of range").
 
 import { type Bvh, BvhError, parseBvh } from '../mirror/bvh';
 import { JOINT_NAMES, type Motion, SCALE, motionFromBvh } from '../mirror/skeleton';
@@ -167,6 +169,111 @@ export function checkLeaderBvh(bvh: Bvh): string | null {
   return null;
 }
 
+/** A whole number with its thousands apart (narrow no-break spaces): 19 224. */
+const count = (n: number) => Math.round(n).toString().replace(/\B(?=(\d{3})+(?!\d))/g, '\u202f');
+
+const AGAIN = 'Download or record it again.';
+
+/** The line (from 1) of the first whitespace-separated `token` in `text` at or after line `from`. */
+function lineOf(text: string, token: string, from = 1): number | null {
+  const lines = text.split('\n');
+  for (let i = from - 1; i < lines.length; i++) if (lines[i].split(/\s+/).includes(token)) return i + 1;
+  return null;
+}
+
+/**
+ * What is wrong with the layout of a BVH text, as a sentence for a visitor, or null when its
+ * sections, braces and numbers are all there (what they hold is for the reader and the check).
+ * Run before the reader, whose messages are about its own workings ("list index out of range" for
+ * a file that ends inside its skeleton): a file cut short by a failed download or copy is the
+ * usual case, and gets "The file is cut short", with how far it goes.
+ */
+export function bvhLayoutProblem(text: string): string | null {
+  const tokens = text.split(/\s+/).filter((t) => t.length > 0);
+  const motion = tokens.indexOf('MOTION');
+  const skeleton = motion < 0 ? tokens : tokens.slice(0, motion);
+  let open = 0, close = 0, depth = 0, channels = 0;
+  let badChannels: string | null = null;
+  for (let i = 0; i < skeleton.length; i++) {
+    if (skeleton[i] === '{') open++, depth++;
+    else if (skeleton[i] === '}') close++, depth--;
+    else if (skeleton[i] === 'CHANNELS' && i + 1 < skeleton.length) {
+      if (/^\+?\d+$/.test(skeleton[i + 1])) channels += Number(skeleton[i + 1]);
+      else badChannels ??= skeleton[i + 1];
+    }
+  }
+  if (motion < 0) {
+    return depth > 0 || open === 0
+      ? `The file is cut short: it ends inside the skeleton (HIERARCHY), before the motion (MOTION) begins. ${AGAIN}`
+      : 'The file has a skeleton (HIERARCHY) but no motion: its MOTION section is missing.';
+  }
+  if (badChannels !== null) {
+    const line = lineOf(text, 'CHANNELS');
+    return `A CHANNELS line of the skeleton${line ? ` (line ${lineOf(text, badChannels, line) ?? line})` : ''} gives "${badChannels.slice(0, 20)}" where the number of channels should be.`;
+  }
+  if (open !== close) {
+    return `The skeleton (HIERARCHY) has ${open} opening braces { and ${close} closing braces }: ` +
+      `${open > close ? 'a closing brace is missing' : 'there is a closing brace too many'}.`;
+  }
+  const rest = tokens.slice(motion + 1);
+  if (rest.length < 5) {
+    return `The file is cut short: it ends right after MOTION, before its "Frames:" and "Frame Time:" lines. ${AGAIN}`;
+  }
+  if (rest[0] !== 'Frames:' || rest[2] !== 'Frame' || rest[3] !== 'Time:') {
+    return 'The MOTION section does not start with its "Frames:" and "Frame Time:" lines.';
+  }
+  if (!/^\+?\d+$/.test(rest[1])) return `Its "Frames:" line says ${rest[1].slice(0, 20)}; the number of frames is a whole number.`;
+  const frames = Number(rest[1]);
+  if (frames === 0) return 'Its "Frames:" line says 0: the file holds no motion.';
+  const values = rest.length - 5;
+  const expected = frames * channels;
+  if (channels > 0 && values < expected) {
+    const whole = Math.floor(values / channels);
+    return `The file is cut short: it ends ${values % channels === 0 ? `after frame ${whole}` : `in frame ${whole + 1}`} ` +
+      `of the ${count(frames)} it announces (it holds ${count(values)} of the ${count(expected)} numbers they need). ${AGAIN}`;
+  }
+  const last = tokens[tokens.length - 1];
+  if (channels > 0 && values === expected && !/\s$/.test(text) && Number.isNaN(Number(last)) && !/^[+-]?nan$/i.test(last)) {
+    return `The file is cut short: it ends in the middle of the last number of frame ${count(frames)} ("${last.slice(0, 20)}"). ${AGAIN}`;
+  }
+  if (channels > 0 && values > expected) {
+    return `The file holds ${count(values)} numbers where its ${count(frames)} frames of ${channels} channels make ` +
+      `${count(expected)}: its "Frames:" line is wrong, or a frame has numbers too many.`;
+  }
+  return null;
+}
+
+/** A message of the BVH reader (web/mirror/bvh.ts, skeleton.ts) in words for a visitor. */
+function plainBvhError(message: string, text: string, name: string): string {
+  const said = message.startsWith(`${name}: `) ? message.slice(name.length + 2) : message;
+  const motionLine = text.split('\n').findIndex((l) => l.trim() === 'MOTION') + 1;
+  const where = (token: string, inMotion: boolean) => {
+    const line = lineOf(text, token, inMotion && motionLine > 0 ? motionLine : 1);
+    if (line === null) return '';
+    if (inMotion && motionLine > 0 && line > motionLine + 2) return ` (line ${line}: frame ${line - motionLine - 2})`;
+    return ` (line ${line})`;
+  };
+  let m: RegExpMatchArray | null;
+  if ((m = /could not convert string to float: '(.*)'\)?$/.exec(said))) return `The file holds "${m[1].slice(0, 20)}" where a number should be${where(m[1], true)}.`;
+  if ((m = /invalid literal for int\(\): '(.*)'\)?$/.exec(said))) return `The file holds "${m[1].slice(0, 20)}" where a whole number should be${where(m[1], false)}.`;
+  if ((m = /^unexpected token '(.*)' in HIERARCHY$/.exec(said))) {
+    return `The skeleton (HIERARCHY) holds "${m[1].slice(0, 20)}"${where(m[1], false)}, where a BVH has JOINT, End Site, OFFSET, CHANNELS, a brace or MOTION.`;
+  }
+  if (/list index out of range/.test(said)) return `The file is cut short: it ends inside the skeleton (HIERARCHY). ${AGAIN}`;
+  if (/unbalanced braces/.test(said)) return 'The skeleton (HIERARCHY) has a closing brace } without its opening one.';
+  if ((m = /^Frame Time must be positive, got (.*)$/.exec(said))) return `Its "Frame Time:" is ${m[1]} s; it must be above zero (0.0333333 for 30 frames a second).`;
+  if (/^BVH has no joints$/.test(said)) return 'The skeleton (HIERARCHY) has no joints.';
+  const skeleton = `The leader needs the 17-joint dancer skeleton (${JOINT_NAMES.join(', ')}).`;
+  if (/^skeleton lacks joint/.test(said)) return `The ${said}. ${skeleton}`;
+  if ((m = /^'(.*)' must be the root joint$/.exec(said))) return `This is another skeleton: "${m[1]}" is not its first (root) joint. ${skeleton}`;
+  if ((m = /^'(.*)' is not below '(.*)'$/.exec(said))) return `This is another skeleton: "${m[1]}" does not hang below "${m[2]}". ${skeleton}`;
+  if ((m = /^joint '(.*)' rotates; cannot reduce$/.exec(said))) {
+    return `This is another skeleton: its joint "${m[1]}", which the dancers do not have, moves during the dance. ${skeleton}`;
+  }
+  if ((m = /^cannot resample (.*) fps to 30 fps/.exec(said))) return `The motion is at ${m[1]} fps (frames a second); the leader dances BVH files at 30, 60 or 120 fps.`;
+  return said;
+}
+
 /**
  * A BVH text as a leader motion (30 fps, metres), or a DuetError whose title and detail say what is
  * wrong with the file in words a dancer understands.
@@ -178,6 +285,8 @@ export function leaderMotionFromText(text: string, fileName: string): Motion {
   if (!text.trimStart().startsWith('HIERARCHY')) {
     throw new DuetError(title, 'This is not a BVH file (a BVH starts with HIERARCHY). Choose a .bvh motion capture file.');
   }
+  const layout = bvhLayoutProblem(text);
+  if (layout) throw new DuetError(title, layout);
   let bvh: Bvh;
   let motion: Motion;
   try {
@@ -185,13 +294,7 @@ export function leaderMotionFromText(text: string, fileName: string): Motion {
     motion = motionFromBvh(bvh, name);
   } catch (error) {
     const message = error instanceof Error ? error.message : String(error);
-    if (error instanceof BvhError && /lacks joint/.test(message)) {
-      throw new DuetError(title, `${message}. The leader needs the 17-joint dancer skeleton (${JOINT_NAMES.join(', ')}).`);
-    }
-    if (error instanceof BvhError && /resample/.test(message)) {
-      throw new DuetError(title, `${message}. Use a BVH at 30, 60 or 120 frames per second.`);
-    }
-    throw new DuetError(title, message);
+    throw new DuetError(title, error instanceof BvhError ? plainBvhError(message, text, name) : message);
   }
   const problem = checkLeaderBvh(bvh);
   if (problem) throw new DuetError(title, `${problem} The file may be damaged, or not the motion of a dancer.`);
