@@ -7,7 +7,7 @@
 
 import { after, before, test } from 'node:test';
 import assert from 'node:assert/strict';
-import { WAIT_MS, duet, launch, saveScreen, startServer, waitReady, waitSteps, waitToast } from './harness.mjs';
+import { WAIT_MS, duet, launch, pausedStill, saveScreen, startServer, waitReady, waitSteps, waitToast } from './harness.mjs';
 import { makeVrm } from './vrm.mjs';
 
 let server;
@@ -40,12 +40,31 @@ async function dropAt(page, name, bytes, [x, y]) {
   );
 }
 
+/**
+ * Drop a file on a dancer: the page dresses the dancer drawn nearest the drop. The dance is paused
+ * for it (on a busy machine the pair moves on between reading where a dancer is drawn and the
+ * drop), and the point is a little beyond the dancer, away from the other one, so that the two
+ * standing close cannot swap it.
+ */
+async function dropOn(page, dancer, name, bytes) {
+  await page.keyboard.press('Space');
+  await pausedStill(page);
+  const state = await duet(page);
+  const [x, y] = state[dancer].screen;
+  const [ox, oy] = state[dancer === 'leader' ? 'follower' : 'leader'].screen;
+  const { width, height } = page.viewportSize();
+  const clamp = (v, top) => Math.min(top - 2, Math.max(2, v));
+  await dropAt(page, name, bytes, [clamp(x + 0.25 * (x - ox), width), clamp(y + 0.25 * (y - oy), height)]);
+  await page.keyboard.press('Space');
+  await page.waitForFunction(() => window.duet.paused === false);
+}
+
 const avatars = async (page) => (await duet(page)).avatars ?? {};
 const button = (page, name) => page.locator('.lil-gui button', { hasText: name });
 
 test('a .vrm dropped on the partner dresses the partner; its bones follow the dance', async () => {
   const { page } = browser;
-  await dropAt(page, 'test-dancer.vrm', makeVrm('Test Dancer'), (await duet(page)).follower.screen);
+  await dropOn(page, 'follower', 'test-dancer.vrm', makeVrm('Test Dancer'));
   await page.waitForFunction(() => window.duet.avatars?.follower, null, { timeout: WAIT_MS });
   assert.deepEqual(Object.keys(await avatars(page)), ['follower']);
   assert.equal((await avatars(page)).follower.name, 'test-dancer.vrm');
@@ -65,7 +84,7 @@ test('a .vrm dropped on the partner dresses the partner; its bones follow the da
 
 test('a .vrm dropped on the leader dresses the leader; "plain bodies again" takes both off', async () => {
   const { page } = browser;
-  await dropAt(page, 'older.vrm', makeVrm('Older', '0.0'), (await duet(page)).leader.screen);
+  await dropOn(page, 'leader', 'older.vrm', makeVrm('Older', '0.0'));
   await page.waitForFunction(() => window.duet.avatars?.leader, null, { timeout: WAIT_MS });
   assert.deepEqual(Object.keys(await avatars(page)).sort(), ['follower', 'leader']);
   await waitSteps(page, 10);
@@ -89,7 +108,7 @@ test("the panel's avatar button dresses the partner (phones have no drag and dro
 test('a file that is not an avatar gives a message, and the dance goes on', async () => {
   const { page } = browser;
   const before = (await duet(page)).frame;
-  await dropAt(page, 'not-an-avatar.vrm', Buffer.from('HIERARCHY\nROOT hip'), (await duet(page)).follower.screen);
+  await dropOn(page, 'follower', 'not-an-avatar.vrm', Buffer.from('HIERARCHY\nROOT hip'));
   assert.match(await waitToast(page, 'Cannot wear not-an-avatar.vrm', 'error'), /not a VRM avatar/);
   await waitSteps(page, 10);
   assert.ok((await duet(page)).frame > before, 'still dancing');
