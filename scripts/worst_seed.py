@@ -76,10 +76,10 @@ if args.ask:
         ap.error("--ask S:DIR needs --nobody-steering and DIR 1 or -1")
 if args.nobody_steering:
     rec = unasked_duet(manifest, O.leader_policy(load_onnx(leader), manifest, args), noted, args.temperature,
-                       args.seed, args.seconds, ask)
+                       args.seed, args.seconds, ask, tempo=args.tempo)
 else:
     soak_one(manifest, O.leader_policy(load_onnx(leader), manifest, args), noted, args.seed, int(args.seconds * FPS),
-             args.temperature, rec)
+             args.temperature, rec, tempo=args.tempo)
 L, F = rec["leader_shown"], rec["follower_shown"]
 flags = P.frame_flags(F if args.dancer == "follower" else L, manifest["plausibility"])
 flags["guarded"] = np.isin(np.arange(len(F)), chosen)

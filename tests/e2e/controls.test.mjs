@@ -158,7 +158,7 @@ describe('desktop: a click in the panel leaves the keys steering', () => {
     };
     report();
     const names = rows.map((r) => r.name);
-    for (const expected of ['partner', 'variety', 'speed', 'possible reactions', 'floor paths', 'show what the partner expects', 'start again (R)', 'reset view', 'copy link to this view', 'skeleton']) {
+    for (const expected of ['partner', 'variety', 'tempo', 'music', 'possible reactions', 'floor paths', 'show what the partner expects', 'start again (R)', 'reset view', 'copy link to this view', 'skeleton']) {
       assert.ok(names.includes(expected), `the panel has "${expected}" (it has ${names.join(', ')})`);
     }
 
@@ -373,10 +373,12 @@ describe('the address keeps every setting', () => {
     await ghosts.fill('3');
     await ghosts.press('Enter');
     await expectInAddress(page, 'ghosts', '3', 'typing 3 possible reactions');
-    const speed = controller(page, 'speed').locator('input');
-    await speed.fill('1.5');
-    await speed.press('Enter');
-    await expectInAddress(page, 'speed', '1.5', 'typing speed 1.5');
+    const tempo = controller(page, 'tempo').locator('input');
+    await tempo.fill('181');
+    await tempo.press('Enter');
+    await expectInAddress(page, 'tempo', '181', 'typing tempo 181');
+    await controller(page, 'music').locator('input').click(FAST);
+    await expectInAddress(page, 'music', '0', 'turning the music off');
     const variety = controller(page, 'variety').locator('input');
     await variety.fill('0.35');
     await variety.press('Enter');

@@ -30,6 +30,7 @@ if str(REPO) not in sys.path:      # run as a script from anywhere
 
 from training.mirror import features as feat  # noqa: E402
 from training.mirror import guard as G  # noqa: E402
+from training.mirror import music  # noqa: E402
 from training.mirror import rollout as ro  # noqa: E402
 from training.mirror.contact import ContactLayer  # noqa: E402
 from training.mirror.bvh import BvhError, forward_kinematics, local_transforms, parse_bvh  # noqa: E402
@@ -271,7 +272,9 @@ def rounded_track(motion: Motion) -> Track:
     rotations = np.zeros_like(motion.rotations)
     a, b = ROTATION_FRAMES
     rotations[a:b] = motion.rotations[a:b]
-    return Track(motion.positions, rotations, np.round(root, 6), np.round(heading, 6))
+    # A count at 175.8 beats a minute, its first frame between beats (both dancers hear one music).
+    beat = np.round(0.37 + np.arange(motion.frames) * 2.93 / 30, 6)
+    return Track(motion.positions, rotations, np.round(root, 6), np.round(heading, 6), beat)
 
 
 def features_fixture(rng: np.random.Generator, lead: Track, follow: Track) -> dict:
@@ -315,9 +318,19 @@ def features_fixture(rng: np.random.Generator, lead: Track, follow: Track) -> di
         "frames": FRAMES, "t": [int(f) for f in frames],
         "rotationFrames": list(ROTATION_FRAMES),
         "leader": {"positions": exact(lead.positions), "root": exact(lead.root), "heading": exact(lead.heading),
-                   "rotations": exact(lead.rotations[slice(*ROTATION_FRAMES)])},
+                   "rotations": exact(lead.rotations[slice(*ROTATION_FRAMES)]), "beat": exact(lead.beat)},
         "follower": {"positions": exact(follow.positions), "root": exact(follow.root), "heading": exact(follow.heading),
-                     "rotations": exact(follow.rotations[slice(*ROTATION_FRAMES)])},
+                     "rotations": exact(follow.rotations[slice(*ROTATION_FRAMES)]), "beat": exact(follow.beat)},
+        # What the dancers hear (training/mirror/music.py): the block for a few counts and tempos
+        # (a count below 0, one far on), and the block the tracks' own count gives at each t.
+        "music": {
+            "MUSIC_OFFSETS": music.MUSIC_OFFSETS.tolist(), "MUSIC_SIZE": music.MUSIC_SIZE,
+            "DEFAULT_TEMPO": music.DEFAULT_TEMPO, "TEMPO_RANGE": list(music.TEMPO_RANGE),
+            "blocks": [{"beat": b, "bps": q, "expected": out7(music.music_block(np.array(b), np.array(q)))}
+                       for b, q in ((0.0, 2.5), (-0.73, 3.1), (1234.56, 2.833333), (7.5, 3.3333333))],
+            "at": out7(music.music_at(lead.beat, frames)),
+            "beatsPerStep": [{"bpm": b, "expected": music.beats_per_step(b)} for b in (150.0, 170.0, 200.0)],
+        },
         "constants": {
             "KEYS": feat.KEYS, "KEY_STEP": feat.KEY_STEP, "PAST_OFFSETS": feat.PAST_OFFSETS.tolist(),
             "FUTURE_OFFSETS": feat.FUTURE_OFFSETS.tolist(), "HISTORY": feat.HISTORY,
@@ -421,7 +434,9 @@ def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_o
         o[feat.block_slices(feat.OUTPUT_LAYOUT)["contacts"]] = rng.uniform(0, 1, 2)
         return o.astype(np.float32).astype(np.float64)
 
-    duet = ro.Duet(ro.Dancer(lead_offsets, window(lead)), ro.Dancer(follow_offsets, window(follow)), start_pose)
+    # The music at another tempo than the default, its count between beats: each step reads both.
+    duet = ro.Duet(ro.Dancer(lead_offsets, window(lead)), ro.Dancer(follow_offsets, window(follow)), start_pose,
+                   tempo=176.5, beat=0.3)
     duet.steering.velocity = np.array([0.3, -0.2])
     steps = []
     scenarios = [
@@ -514,8 +529,9 @@ def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_o
         "rotationsFromVectors": {"forward": exact(vectors_f), "up": exact(vectors_u),
                                  "expected": out7(ro.rotations_from_vectors(vectors_f, vectors_u))},
         "offsets": {"leader": exact(lead_offsets), "follower": exact(follow_offsets)},
-        "startPose": start_pose,
-        "startDuet": {"leader": dancer_state(started.leader), "follower": dancer_state(started.follower)},
+        "startPose": start_pose, "tempo": 176.5, "beat": 0.3, "beatAfter": duet.beat,
+        "startDuet": {"leader": dancer_state(started.leader), "follower": dancer_state(started.follower),
+                      "tempo": started.tempo, "beat": started.beat},
         "steps": steps,
         # A request's figure keys over its life: (frames since asked, direction) -> keys; None once over.
         "figureInputs": [{"frame": f, "direction": d,

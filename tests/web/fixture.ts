@@ -63,5 +63,6 @@ export function trackOf(data: Json, role: 'leader' | 'follower', frames?: number
     rotations.slice(0, n * 153),
     Float64Array.from(d.root).slice(0, n * 2),
     Float64Array.from(d.heading).slice(0, n),
+    d.beat ? Float64Array.from(d.beat).slice(0, n) : null,
   );
 }

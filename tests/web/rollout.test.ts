@@ -48,6 +48,16 @@ describe('startDuet', () => {
     });
     expectDancer(duet.leader, data.startDuet.leader, 'leader');
     expectDancer(duet.followers[0], data.startDuet.follower, 'follower');
+    expect([duet.tempo, duet.beat]).toEqual([data.startDuet.tempo, data.startDuet.beat]);
+  });
+
+  it('takes the tempo asked for, else the manifest\'s, and refuses one that is not a tempo', () => {
+    const skeleton = { offsets: { leader: chunk(data.offsets.leader), follower: chunk(data.offsets.follower) } };
+    expect(R.startDuet({ skeleton, startPose: data.startPose }, 1, 188).tempo).toBe(188);
+    expect(R.startDuet({ skeleton, startPose: data.startPose, music: { tempo: 161 } }).tempo).toBe(161);
+    for (const bad of [0, -170, Number.NaN, Number.POSITIVE_INFINITY]) {
+      expect(() => R.startDuet({ skeleton, startPose: data.startPose }, 1, bad), String(bad)).toThrow(/tempo/);
+    }
   });
 
   it('falls back to a rest pose when the manifest has none (placeholder models)', () => {
@@ -77,6 +87,8 @@ describe('the duet loop, step by step', () => {
     steering: new R.Steering(),
     frame: 0,
     request: null,
+    tempo: data.tempo,
+    beat: data.beat,
   };
   const nan = (values: (number | null)[]) => Float32Array.from(values, (v) => (v === null ? NaN : v));
 
@@ -102,6 +114,9 @@ describe('the duet loop, step by step', () => {
       expectDancer(duet.followers[0], step.follower, 'follower');
       expect(duet.frame).toBe(i + 1);
     });
+  });
+  it('the count moved on one step of the tempo per step', () => {
+    expect(duet.beat).toBeCloseTo(data.beatAfter, 12);
   });
 });
 

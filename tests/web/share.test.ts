@@ -33,6 +33,28 @@ describe('readSettings', () => {
     expect(s.camera).toEqual({ azimuth: 30, polar: 40, distance: 6 });
   });
 
+  it('reads the music: tempo within what the control offers, music on unless ?music=0', () => {
+    expect(defaults.tempo).toBe(170);
+    expect(defaults.music).toBe(true);
+    expect(read('?tempo=188').tempo).toBe(188);
+    expect(read('?tempo=900').tempo).toBe(LIMITS.tempo[1]);
+    expect(read('?tempo=20').tempo).toBe(LIMITS.tempo[0]);
+    expect(read('?tempo=abc').tempo).toBe(defaults.tempo);
+    expect(read('?music=0').music).toBe(false);
+    expect(read('?music=1').music).toBe(true);
+    expect(defaultSettings(0.5, 181).tempo).toBe(181);
+  });
+
+  it('writes the tempo only when it is not the manifest\'s, and music=0 only when muted', () => {
+    const q = (s: Partial<Settings>, tempo = 170) => new URLSearchParams(writeSettings({ ...defaults, ...s }, null, 0.5, tempo));
+    expect(q({}).has('tempo')).toBe(false);
+    expect(q({}).has('music')).toBe(false);
+    expect(q({ tempo: 185 }).get('tempo')).toBe('185');
+    expect(q({ tempo: 170 }, 165).get('tempo')).toBe('170');
+    expect(q({ music: false }).get('music')).toBe('0');
+    expect(read(`?${q({ tempo: 155.5, music: false })}`)).toMatchObject({ tempo: 155.5, music: false });
+  });
+
   it('clamps numbers out of range to the limits', () => {
     expect(read('?temperature=5').temperature).toBe(LIMITS.temperature[1]);
     expect(read('?temperature=-1').temperature).toBe(LIMITS.temperature[0]);

@@ -19,6 +19,7 @@ from ..mirror.features import (HISTORY, Track, figure_block, follower_input, han
                                output_features, partner_turn,
                        valid_frames)
 from ..mirror.skeleton import FPS, HEAD, SCALE, Motion, mirror_motion, reduce_bvh, resample, time_warp
+from .count import Count, find_count
 
 # Split by take so no validation or test frame has a near-duplicate neighbour in training.
 # 12 is clean; 02 and 13 are full-length takes without the head glitches of 06/07.
@@ -116,16 +117,29 @@ def phases(motion: Motion) -> int:
     return max(1, int(round(motion.fps / FPS)))
 
 
+def take_count(leader: Motion, follower: Motion) -> Count:
+    """The count of a take as recorded (training/data/count.py), from both dancers at 30 fps."""
+    return find_count(resample(leader, FPS, 0).positions, resample(follower, FPS, 0).positions)
+
+
 def pair_tracks(leader: Motion, follower: Motion, phase: int = 0, mirror: bool = False, tempo: float = 1.0):
     """Both dancers at 30 fps for one phase offset, optionally mirrored left/right, and at
-    another tempo (both partners warped together, so the couple stays in step)."""
+    another tempo (both partners warped together, so the couple stays in step). Both carry the
+    take's count (Track.beat), warped with them: at tempo 1.1 the music is 1.1x as fast."""
+    count = take_count(leader, follower)
+    base = leader.fps / FPS
+    if abs(base - round(base)) < 1e-3:    # as resample and time_warp: 120.0048 fps read as 120
+        base = round(base)
     if tempo == 1.0:
         lead, follow = resample(leader, FPS, phase), resample(follower, FPS, phase)
     else:
         lead, follow = time_warp(leader, tempo, FPS, phase), time_warp(follower, tempo, FPS, phase)
     if mirror:
         lead, follow = mirror_motion(lead), mirror_motion(follow)
-    return Track.from_motion(lead), Track.from_motion(follow)
+    # Frame i is source frame phase + base * tempo * i, at (that) / the source rate seconds.
+    seconds = (phase + base * tempo * np.arange(lead.frames)) / (FPS * base)
+    beat = count.beats(seconds)
+    return Track.from_motion(lead, beat), Track.from_motion(follow, beat)
 
 
 def samples(lead: Track, follow: Track) -> dict[str, np.ndarray]:

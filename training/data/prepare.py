@@ -6,8 +6,8 @@ offsets, mirrored copies in train), PREPARED/train_tracks.npz (the training coup
 poses and speeds: training.evaluation.plausibility) and PREPARED/stats.npz (normalization, from
 the recorded tempo: recipes with and without tempo copies normalize alike), then prints frames
 per split and feature sizes. With --tempos it also writes PREPARED/train_tempo.npz, the training couples time-warped to
-those tempos (0.9,1.1 when the flag comes alone); only recipes with tempo copies read it, and no
-shipped model does, so it is not written unless asked for.
+those tempos (0.85,0.92,1.08,1.16 when the flag comes alone): the shipped recipes read it, so the
+default is those tempos (--tempos '' writes none).
 """
 from __future__ import annotations
 
@@ -21,12 +21,15 @@ from tqdm import tqdm
 
 from ..evaluation import plausibility as P
 from ..mirror import features as F
+from ..mirror.music import TEMPO_MEAN, TEMPO_STD
 from .dataset import (TEST_TAKES, VALIDATION_TAKES, DataError, discover_takes, load_pair, pair_tracks,
                       phases, samples)
 from .folders import add_folder
 
-# Tempo copies: the couple danced 0.9x and 1.1x as fast (cross-validated in docs/results.md).
-TEMPOS = [0.9, 1.1]
+# Tempo copies: the couple danced slower and faster, the music with them (training/mirror/music.py):
+# the recorded 163-187 beats a minute become 139-218, so the page's 150-200 is inside what the
+# networks heard. Shipped recipes train on them (TrainConfig.tempo_copies).
+TEMPOS = [0.85, 0.92, 1.08, 1.16]
 
 
 def split_of(take: str, validation: list[str], test: list[str]) -> str:
@@ -36,9 +39,9 @@ def split_of(take: str, validation: list[str], test: list[str]) -> str:
 def add_tracks(store: dict[str, np.ndarray], tracks, mirror: bool) -> None:
     """Keep one training couple (leader, follower Tracks at 30 fps) as couple i of
     train_tracks.npz: what training's own rollouts (training/learning/own_rollouts.py) dance beside."""
-    i = len(store) // 9
+    i = len(store) // 11
     for role, t in zip(("leader", "follower"), tracks):
-        for k in ("positions", "rotations", "root", "heading"):
+        for k in ("positions", "rotations", "root", "heading", "beat"):
             store[f"{i}_{role}_{k}"] = getattr(t, k)
     store[f"{i}_mirror"] = np.array(mirror)
 
@@ -107,6 +110,12 @@ def prepare(data: str, out: str, validation: list[str], test: list[str], leader:
                 # plan (zeros) then reads as no move, and the moves keep their own spread.
                 plan = F.block_slices(F.LEADER_INPUT_LAYOUT)["hands_plan"]
                 mean[plan], std[plan.start] = 0.0, 1.0
+            if kind == "input":
+                # The music block is read as it is (points on circles), its tempo on a fixed scale:
+                # the tempo copies and the recorded takes must read alike (training/mirror/music.py).
+                music = F.block_slices(F.LEADER_INPUT_LAYOUT if role == "leader" else F.FOLLOWER_INPUT_LAYOUT)["music"]
+                mean[music], std[music] = 0.0, 1.0
+                mean[music.stop - 1], std[music.stop - 1] = TEMPO_MEAN, TEMPO_STD
             stats[f"{role}_{kind}_mean"], stats[f"{role}_{kind}_std"] = mean, std
     # Bone offsets of each role (the first take's, as export ships them): the training terms on
     # the decoded body (partner_losses) run forward kinematics with them. In the CMU takes each
@@ -150,8 +159,8 @@ def main(argv=None) -> int:
     ap.add_argument("--test", default=",".join(TEST_TAKES), help="comma-separated takes")
     ap.add_argument("--leader", default=None, help="subject that leads (default: first by name)")
     ap.add_argument("--one-phase", action="store_true", help="use only phase 0 of 120 fps takes")
-    ap.add_argument("--tempos", nargs="?", default="", const=",".join(map(str, TEMPOS)), metavar="LIST",
-                    help="also write train_tempo.npz, the training couples at these tempos, for recipes "
+    ap.add_argument("--tempos", nargs="?", default=",".join(map(str, TEMPOS)), const=",".join(map(str, TEMPOS)), metavar="LIST",
+                    help="write train_tempo.npz, the training couples at these tempos, for recipes "
                          f"with tempo copies (alone: {','.join(map(str, TEMPOS))}; default: none)")
     args = ap.parse_args(argv)
     try:

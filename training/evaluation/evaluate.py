@@ -82,7 +82,8 @@ def evaluate(args) -> dict:
         notes.append(f"no leader.onnx in {args.models}: skipped {', '.join(dropped)}")
         parsed = {c: p for c, p in parsed.items() if p[0] != "model"}
 
-    takes = load_eval_takes(args.data, [t for t in args.takes.split(",") if t], args.max_frames, args.leader)
+    takes = load_eval_takes(args.data, [t for t in args.takes.split(",") if t], args.max_frames, args.leader,
+                            args.tempo)
     names = [t.name for t in takes]
     same_folder = Path(args.train_data).resolve() == Path(args.data).resolve()
     seen = [n for n in names if same_folder and n not in VALIDATION_TAKES + TEST_TAKES]
@@ -223,6 +224,8 @@ def main(argv=None) -> int:
     ap.add_argument("--train-takes", default=None,
                     help="default: all of --train-data except validation, test and evaluated takes")
     ap.add_argument("--leader", default=None, help="subject that leads (default: first by name)")
+    ap.add_argument("--tempo", type=float, default=None, metavar="BPM",
+                    help="time-warp each test take so that its found count runs at this tempo (default: as recorded)")
     ap.add_argument("--seeds", default="0,1,2")
     ap.add_argument("--temperatures", default="0.5,1", help="the first one is the headline")
     ap.add_argument("--conditions", default=",".join(DEFAULT_CONDITIONS),
@@ -233,6 +236,8 @@ def main(argv=None) -> int:
     ap.add_argument("--encoder-epochs", type=int, default=M.EncoderConfig.epochs)
     ap.add_argument("--quiet", action="store_true", help="no progress bar")
     args = ap.parse_args(argv)
+    if args.tempo is not None and not 60 <= args.tempo <= 300:
+        ap.error(f"--tempo {args.tempo:g}: beats a minute, 60-300")
     if args.train_data is None:
         args.train_data = args.data
     try:

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..data.dataset import DataError, discover_takes, load_pair, pair_tracks, select_takes
+from ..data.dataset import DataError, discover_takes, load_pair, pair_tracks, select_takes, take_count
 from ..mirror import features as feat
 from ..mirror.features import HISTORY, Track, output_features
 from ..mirror.rollout import OnnxPolicy
@@ -34,11 +34,16 @@ class EvalTake:
     frames: np.ndarray       # the current frames t evaluated (each predicts t+1)
 
 
-def load_eval_takes(data: str, names: list[str], max_frames: int | None, leader: str | None) -> list[EvalTake]:
+def load_eval_takes(data: str, names: list[str], max_frames: int | None, leader: str | None,
+                    tempo: float | None = None) -> list[EvalTake]:
+    """The test takes at 30 fps, each carrying its found count; with `tempo` (beats a minute)
+    each take is time-warped so that its count runs at that tempo (the couple danced faster or
+    slower, as the training's tempo copies), the recording and the methods alike."""
     out = []
     for take in select_takes(discover_takes(data, leader), names):
         lead_m, follow_m = load_pair(take)
-        lead, follow = pair_tracks(lead_m, follow_m)
+        speed = 1.0 if tempo is None else tempo / take_count(lead_m, follow_m).bpm
+        lead, follow = pair_tracks(lead_m, follow_m, tempo=speed)
         frames = feat.valid_frames(lead.frames)[:max_frames]
         if len(frames) < M.WINDOW + 1:
             raise DataError(f"take {take.name}: too short to evaluate ({lead.frames} frames at 30 fps; "

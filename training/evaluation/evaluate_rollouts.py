@@ -10,6 +10,7 @@ import numpy as np
 
 from ..mirror import features as feat
 from ..mirror.features import FUTURE_OFFSETS, HISTORY, Track, follower_input, leader_input
+from ..mirror.music import music_at
 from ..mirror.rollout import NOW, Dancer, apply_output, output_is_absurd, reset_beside
 from . import figures as Fg
 from . import metrics as M
@@ -102,12 +103,13 @@ def rollout(take: EvalTake, follower_policy, temperature: float, seed: int, star
             steer_along_recording(leader, take.lead, t)
             bend_plan(leader.track, bend)
         now = np.array([NOW])
-        xf = follower_input(leader.track, follower.track, now)[0]
+        heard = music_at(take.lead.beat, np.array([t]))   # the take's count, found in its footwork
+        xf = follower_input(leader.track, follower.track, now, heard)[0]
         if isinstance(follower_policy, RecordingPolicy):
             follower_policy.seek(take.follow, t)
         of = np.asarray(follower_policy(xf, temperature, rng)["output"][0], np.float64)
         if leader_mode != "playback":
-            xl = leader_input(follower.track, leader.track, now)[0]
+            xl = leader_input(follower.track, leader.track, now, music=heard)[0]
             ol = np.asarray(leader_policy(xl, temperature, rng)["output"][0], np.float64)
             # Leader first, as rollout.finish_step does.
             if output_is_absurd(ol):

@@ -95,9 +95,9 @@ def request_frames(frames: int) -> set[int]:
 
 
 def one_duet(manifest, leader, follower, temperature: float, seed: int, seconds: float,
-             detector: C.Detector | None = None) -> dict:
+             detector: C.Detector | None = None, tempo: float | None = None) -> dict:
     rng = np.random.default_rng(seed)
-    duet = start_duet(manifest)
+    duet = start_duet(manifest, tempo=tempo)
     frames = int(seconds * FPS)
     window = int(REQUEST_SECONDS * FPS)
     ask_at = request_frames(frames)
@@ -137,7 +137,7 @@ def dancing(lead: np.ndarray, follow: np.ndarray, start: np.ndarray | None = Non
 
 
 def unasked_duet(manifest, leader, follower, temperature: float, seed: int, seconds: float,
-                 ask: tuple[float, int] | None = None) -> dict:
+                 ask: tuple[float, int] | None = None, tempo: float | None = None) -> dict:
     """The duet one_duet dances for `seed`, without its request copies (the random stream is the
     same: each request's direction is still drawn): world positions [frames, 17, 3] of `leader`
     and `follower` as the networks left them (what one_duet measures) and `leader_shown`,
@@ -146,7 +146,7 @@ def unasked_duet(manifest, leader, follower, temperature: float, seed: int, seco
     the duet itself is asked for a turn then (one_duet asks that request's copy at frame
     seconds * FPS, with its own random stream: the film shows the request, not the same draws)."""
     rng = np.random.default_rng(seed)
-    duet = start_duet(manifest)
+    duet = start_duet(manifest, tempo=tempo)
     frames = int(seconds * FPS)
     ask_at = request_frames(frames)
     out = {k: np.zeros((frames, 17, 3)) for k in ("leader", "follower", "leader_shown", "follower_shown")}
@@ -278,7 +278,7 @@ def run(args) -> dict:
     per_seed = []
     for seed in tqdm(range(args.first_seed, args.first_seed + args.seeds), desc="duets", unit="duet",
                      file=sys.stderr, disable=args.quiet):
-        per_seed.append(one_duet(manifest, leader, follower, args.temperature, seed, args.seconds, detector))
+        per_seed.append(one_duet(manifest, leader, follower, args.temperature, seed, args.seconds, detector, args.tempo))
     return {"takes": takes, "recording": ref, "per_seed": per_seed, "summary": summary(per_seed, ref),
             "config": {"models": str(args.models), "method": args.method, "seeds": args.seeds,
                        "seconds": args.seconds, "temperature": args.temperature,

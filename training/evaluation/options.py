@@ -15,9 +15,12 @@ from __future__ import annotations
 import argparse
 
 from ..mirror.guard import UprightGuard, Variety
+from ..mirror.music import DEFAULT_TEMPO
 
 
 def add_options(ap: argparse.ArgumentParser) -> None:
+    ap.add_argument("--tempo", type=float, default=None, metavar="BPM",
+                    help="the music's tempo the duet dances to, beats a minute (default: the manifest's music.tempo)")
     ap.add_argument("--temperature", type=float, default=None,
                     help="the leader's variety (default: the manifest's leaderTemperature, else defaultTemperature)")
     ap.add_argument("--follower-temperature", type=float, default=None,
@@ -49,6 +52,10 @@ def add_options(ap: argparse.ArgumentParser) -> None:
 def resolve(args, manifest: dict) -> str | None:
     """Fill the options not given from the manifest; what is wrong with them, in one line (None: nothing)."""
     guard = manifest.get("guard") or {}
+    if getattr(args, "tempo", None) is None:
+        args.tempo = float((manifest.get("music") or {}).get("tempo", DEFAULT_TEMPO))
+    if not 60 <= args.tempo <= 300:
+        return f"--tempo {args.tempo:g}: beats a minute, 60-300 (salsa is danced at 150-210)"
     if args.temperature is None:
         args.temperature = manifest.get("leaderTemperature", manifest["defaultTemperature"])
     if args.follower_temperature is None:

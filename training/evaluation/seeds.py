@@ -32,6 +32,7 @@ from . import plausibility as P
 from .evaluate_inputs import EvalError, find_models, load_eval_takes, load_onnx
 from .interaction import contact_labels, measure, weighted as interaction_weighted
 from .motion_matching import build, load_tracks, training_takes
+from . import rhythm as R
 from .soak import soak_one
 
 INTERACTION = ["interpenetration", "hand_hold", "skate_leader_cm", "skate_follower_cm",
@@ -91,16 +92,18 @@ def _init(models: str, method: str, data: str, test: list[str], r: dict, options
     _WORKER.update(manifest=manifest, leader=leader, follower=follower, ranges=r)
 
 
-def _one(job: tuple[int, int, float]) -> dict:
-    seed, frames, temperature = job
+def _one(job: tuple[int, int, float, float]) -> dict:
+    seed, frames, temperature, tempo = job
     w = _WORKER
     rec: dict = {}
     O.restart_count(w["follower"])
     O.restart_count(w["leader"])
-    soak = soak_one(w["manifest"], w["leader"], w["follower"], seed, frames, temperature, rec)
+    soak = soak_one(w["manifest"], w["leader"], w["follower"], seed, frames, temperature, rec, tempo=tempo)
     out = {"seed": seed, "resets": soak["resets"], "guarded": getattr(w["follower"], "guarded", 0),
            "leader_guarded": getattr(w["leader"], "guarded", 0),
-           "figures": {"leader": dancer_figures(rec["leader"]), "follower": dancer_figures(rec["follower"])}}
+           "figures": {"leader": dancer_figures(rec["leader"]), "follower": dancer_figures(rec["follower"])},
+           # on the count: after the first second's standing start (evaluation.rhythm)
+           "rhythm": {"seed": seed, **R.rhythm(rec["leader"][FPS:], rec["follower"][FPS:], rec["beat"][FPS:], tempo)}}
     for kind, suffix in (("alone", ""), ("layer", "_shown")):
         lead, follow = rec["leader" + suffix], rec["follower" + suffix]
         out[kind] = {**P.duet(lead, follow, w["ranges"]),
@@ -108,9 +111,9 @@ def _one(job: tuple[int, int, float]) -> dict:
     return out
 
 
-def run_method(args, method: str, r: dict, test: list[str], bar) -> dict:
+def run_method(args, method: str, r: dict, test: list[str], bar, r_rhythm: dict) -> dict:
     frames = int(args.seconds * FPS)
-    jobs = [(seed, frames, args.temperature) for seed in range(args.first_seed, args.first_seed + args.seeds)]
+    jobs = [(seed, frames, args.temperature, args.tempo) for seed in range(args.first_seed, args.first_seed + args.seeds)]
     options = {k: getattr(args, k) for k in ("temperature", "follower_temperature", "guard", "guard_margin",
                                              "guard_hip_margin", "guard_partner_low", "guard_partner_low_hip_margin",
                                              "leader_guard")}
@@ -129,7 +132,8 @@ def run_method(args, method: str, r: dict, test: list[str], bar) -> dict:
         per_seed = list(counted(map(_one, jobs)))
     row = {"per_seed": per_seed, "resets": int(sum(s["resets"] for s in per_seed)),
            "guarded": int(sum(s["guarded"] for s in per_seed)),
-           "seeds_guarded": int(sum(s["guarded"] > 0 for s in per_seed)), "figures": figures_row(per_seed)}
+           "seeds_guarded": int(sum(s["guarded"] > 0 for s in per_seed)), "figures": figures_row(per_seed),
+           "rhythm": R.summarize([s["rhythm"] for s in per_seed], r_rhythm)}
     for kind in ("alone", "layer"):
         duets = [s[kind] for s in per_seed]
         row[kind] = {**P.summarize(duets, [frames] * len(duets)), **weighted(duets, [frames] * len(duets))}
@@ -167,11 +171,13 @@ def run(args) -> dict:
         raise EvalError(f"--methods {','.join(unknown)}: not in {args.models} (known: {', '.join(known)})")
     methods = [m for m in known if not wanted or m in wanted]
     ref = recording_row(args.data, test, r)
-    res = {"takes": test, "ranges": r, "recording": ref, "methods": {}}
+    r_rhythm = R.recorded(args.data)   # every take at its found count: the rhythm's reference
+    res = {"takes": test, "ranges": r, "recording": ref, "methods": {}, "rhythm_recording": r_rhythm,
+           "tempo": args.tempo}
     bar = tqdm(total=len(methods) * args.seeds, desc="steered duets", unit="duet", file=sys.stderr,
                disable=args.quiet)
     for m in methods:
-        row = run_method(args, m, r, test, bar)
+        row = run_method(args, m, r, test, bar, r_rhythm)
         row["ratio"] = {k: ratios(row[k], ref) for k in ("alone", "layer")}
         res["methods"][m] = row
     bar.close()
@@ -277,6 +283,9 @@ def main(argv=None) -> int:
     out.mkdir(parents=True, exist_ok=True)
     (out / "seeds.json").write_text(json.dumps(res, indent=1))
     write_markdown(out / "seeds.md", res)
+    for m, row in res["methods"].items():
+        print(R.format_summary(f"rhythm of {m}, steered, at {res['tempo']:g} beats a minute", row["rhythm"],
+                               res["rhythm_recording"]))
     print(f"wrote {out}/seeds.json and seeds.md")
     return 0
 

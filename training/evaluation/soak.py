@@ -32,6 +32,7 @@ from ..data.folders import add_folder
 from ..mirror.rollout import NOW, OnnxPolicy, start_duet, step
 from . import options as O
 from . import metrics as M
+from . import rhythm as R
 from . import plausibility as P
 from ..mirror.skeleton import FEET, FPS, PARENTS
 
@@ -70,13 +71,18 @@ def bone_error(positions: np.ndarray, offsets: np.ndarray) -> float:
 
 
 def soak_one(manifest, leader, follower, seed: int, frames: int, temperature: float,
-             record: dict | None = None) -> dict:
-    """One steered duet. With `record` (a dict), every frame's world positions and foot contacts
-    of both dancers are stored there: `leader`, `follower` [frames, 17, 3] as the networks left
-    them, `leader_shown`, `follower_shown` after the contact layer, `leader_contacts`, `follower_contacts` [frames, 2]."""
+             record: dict | None = None, tempo: float | None = None, steer: bool = True) -> dict:
+    """One steered duet, the music at `tempo` beats a minute (None: the manifest's); with
+    steer=False nobody steers (the same seed's noise). With `record` (a dict), every frame's world
+    positions and foot contacts of both dancers are stored there: `leader`, `follower` [frames, 17, 3]
+    as the networks left them, `leader_shown`, `follower_shown` after the contact layer,
+    `leader_contacts`, `follower_contacts` [frames, 2], and `beat` [frames], the count each frame's
+    step danced on (beats since the music started)."""
     rng = np.random.default_rng(seed)
     sticks = steering_script(rng, frames)
-    duet = start_duet(manifest)
+    if not steer:
+        sticks[:] = 0.0
+    duet = start_duet(manifest, tempo=tempo)
     worst = {"nonfinite": 0, "max_distance": 0.0, "bone_error": 0.0, "min_foot": np.inf}
     speeds = np.zeros((frames, 2))
     if record is not None:
@@ -84,7 +90,10 @@ def soak_one(manifest, leader, follower, seed: int, frames: int, temperature: fl
             record[k] = np.zeros((frames, 17, 3))
             record[f"{k}_shown"] = np.zeros((frames, 17, 3))
             record[f"{k}_contacts"] = np.zeros((frames, 2))
+        record["beat"] = np.zeros(frames)
     for f in range(frames):
+        if record is not None:
+            record["beat"][f] = duet.beat   # the count this step dances on
         step(duet, leader, follower, sticks[f], temperature, rng)
         if record is not None:
             for i, (k, d) in enumerate((("leader", duet.leader), ("follower", duet.follower))):
@@ -164,6 +173,7 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m training.evaluation.soak", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     add_folder(ap, "models", "the leader and follower that dance")
+    add_folder(ap, "data", "read for the recorded couples' rhythm, which the duets' is compared with (skipped when absent)")
     ap.add_argument("--follower", default="follower", help="follower model name in the manifest")
     ap.add_argument("--rollouts", type=int, default=100)
     ap.add_argument("--minutes", type=float, default=10.0)
@@ -213,7 +223,7 @@ def main(argv=None) -> int:
     for i in tqdm(range(args.rollouts), desc="soak", unit="rollout", leave=False):
         rec = {}
         O.restart_count(follower)
-        r = soak_one(manifest, leader, follower, args.seed + i, frames, temperature, rec)
+        r = soak_one(manifest, leader, follower, args.seed + i, frames, temperature, rec, tempo=args.tempo)
         r["guarded"] = getattr(follower, "guarded", 0)
         r["interaction"] = M.interaction(rec["leader"], rec["follower"], rec["leader_contacts"], rec["follower_contacts"])
         r["interaction_layer"] = M.interaction(rec["leader_shown"], rec["follower_shown"], rec["leader_contacts"],
@@ -223,6 +233,8 @@ def main(argv=None) -> int:
             r["collapsed"] = [who for who in ("leader", "follower") if r["plausibility"][who]["collapse"]]
             r["fell"] = r["plausibility"]["follower"]["worst_second"] > P.BAD_SECOND
         r["failures"] = failures(r)
+        # on the count, after the first second's standing start (evaluation.rhythm)
+        r["rhythm"] = {"seed": r["seed"], **R.rhythm(rec["leader"][FPS:], rec["follower"][FPS:], rec["beat"][FPS:], args.tempo)}
         results.append(r)
         tqdm.write(f"{r['seed']:>5} {r['nonfinite']:>10} {r['max_distance']:>11.2f} "
                    f"{r['bone_error'] * 1000:>12.4f} {r['min_foot'] * 100:>12.1f} {r['frozen_leader']:>9.3f} "
@@ -258,6 +270,14 @@ def main(argv=None) -> int:
               f"foot skate leader / follower {m['contact_skate_leader_cm']:.2f} / "
               f"{m['contact_skate_follower_cm']:.2f} cm per contact frame "
               f"({m['skate_leader_cm']:.2f} / {m['skate_follower_cm']:.2f} while low)")
+    if Path(args.data).is_dir():
+        try:
+            reference = R.recorded(args.data)
+        except Exception as e:   # a data folder that is not the couples: the rhythm stays unrated
+            print(f"rhythm: not compared with the recording ({e})")
+        else:
+            summary["rhythm"] = R.summarize([r["rhythm"] for r in results], reference)
+            print(R.format_summary(f"rhythm at {args.tempo:g} beats a minute, steered", summary["rhythm"], reference))
     if out is not None:
         out.write_text(json.dumps({"summary": summary, "rollouts": results}, indent=1))
         print(f"wrote {out}")

@@ -27,6 +27,7 @@ import numpy as np
 import torch
 
 from ..mirror import features as feat
+from ..mirror import music
 from ..data.dataset import DataError, discover_takes, load_pair
 from ..data.folders import add_folder
 from .models import OutputEncoderStep, StepModel
@@ -170,6 +171,9 @@ def write_manifest(out: Path, models: dict[str, StepModel], data: str, prepared:
         # The training dancers' range (evaluation.plausibility): soak counts a collapse against it
         # and training.evaluation.seeds judges every steered frame against it.
         "plausibility": plausibility_ranges(prepared),
+        # What the dancers hear (training/mirror/music.py): the page's tempo when the address names
+        # none, and what its tempo control offers; the evaluation commands dance at this tempo too.
+        "music": {"tempo": music.DEFAULT_TEMPO, "range": list(music.TEMPO_RANGE)},
         "credit": CREDIT,
     }
     for name, m in models.items():

@@ -26,11 +26,12 @@ import torch
 from ..data.prepared import TrainError
 from ..mirror import features as feat
 from ..mirror.features import HISTORY, Track
+from ..mirror.music import music_at
 from ..evaluation.evaluate_inputs import window
 from ..evaluation.evaluate_rollouts import steer_along_recording
 from ..mirror.rollout import NOW, Dancer, apply_output, output_is_absurd
 
-FIELDS = ("positions", "rotations", "root", "heading")
+FIELDS = ("positions", "rotations", "root", "heading", "beat")
 
 
 @dataclass
@@ -81,15 +82,16 @@ def inputs_at(run: Run, role: str, led_turn: bool = False) -> tuple[np.ndarray, 
     track beside the recorded partner; the targets the recording's (with `led_turn`, the
     intention target is followed by the recorded turn he leads, prepared.load_split)."""
     c, t, now = run.couple, run.t, np.array([NOW])
+    heard = music_at(c.leader.beat, np.array([t]))    # the recorded take's count, where the recording is
     if role == "follower":
         partner, recorded = window(c.leader, t), c.follower
-        x = feat.follower_input(partner, run.me.track, now)[0]
+        x = feat.follower_input(partner, run.me.track, now, heard)[0]
     else:
         partner, recorded = window(c.follower, t), c.leader
         steer_along_recording(run.me, recorded, t)   # his plan: the recorded path, laid from where he stands
         # His hands plan: where the recorded hands went over the next second, from where his are.
         plan = feat.hands_plan_block(recorded_hands(recorded, t, run.me.track), 1)
-        x = feat.leader_input(partner, run.me.track, now, feat.figure_block(c.partner_turn[t][None], 1), plan)[0]
+        x = feat.leader_input(partner, run.me.track, now, feat.figure_block(c.partner_turn[t][None], 1), plan, heard)[0]
     y = feat.output_features(recorded, np.array([t]))[0]
     j = feat.intention_target(partner, run.me.track, now)[0]
     if led_turn:

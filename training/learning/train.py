@@ -223,8 +223,10 @@ MODELS = {
     # 25.9 times a minute (the recording: 25.9; before 11.5) with FID 82 (before 118); and where the
     # followers before sank at low variety beside our steered leader (5 of 20 seeds at 0.5), none of
     # 20 does down to 0.35, so the page runs her at 0.5 (docs/results.md, "Salsa turns").
-    "follower": replace(steady(OURS), state_dropout=0.5, turn_weight=4.0, own_rollouts_from=10),
-    "follower_ccm": replace(steady(CCM), state_dropout=0.5, turn_weight=4.0, own_rollouts_from=10),
+    # Both hear the music (features "music" block) and train on the tempo copies too, so that they
+    # dance on the count from 150 to 200 beats a minute (docs/music.md).
+    "follower": replace(steady(OURS), state_dropout=0.5, turn_weight=4.0, own_rollouts_from=10, tempo_copies=True),
+    "follower_ccm": replace(steady(CCM), state_dropout=0.5, turn_weight=4.0, own_rollouts_from=10, tempo_copies=True),
     # Measured, not shipped (docs/results.md, "She reads his hand" and "He turns on his own"): only
     # the turn starts his raised hand leads weigh more (unled_turn_weight). At 8x she reads his hand
     # as the recorded follower does (unasked she turns in 81-84 % of the windows with his hand up and
@@ -297,7 +299,7 @@ MODELS = {
     # (0.7 a minute nobody steering; at 300, none); at 30 on the recorded contacts he turned 13.8
     # times a minute but had a bad second in 15 of 100 steered seeds (docs/results.md, "His feet").
     "leader": replace(LEADER_BEFORE_CONTACT, lambda_foot_contact=100.0, recorded_contacts=True,
-                      contact_spare_turning=120.0),
+                      contact_spare_turning=120.0, tempo_copies=True),
     # Measured, not shipped (docs/results.md, "He turns on his own"): the samples where his own turn
     # starts weigh 4x (own_turn_weight). His turns had come from the few seeds where the couple spins
     # together (nobody steering, the median seed 0.17x the recorded leader's rate; 10 of 12 recorded

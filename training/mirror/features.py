@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .music import MUSIC_SIZE, music_at
 from .skeleton import FEET, FPS, HANDS, JOINT_NAMES, KEY_JOINTS, Motion, root_from_motion
 
 KEYS = 6                                     # trajectory keys per second (the paper's k)
@@ -35,22 +36,22 @@ FOLLOWER_INPUT_LAYOUT = [
     ("partner_trajectory_past", TRAJECTORY_SIZE), ("partner_trajectory_future", TRAJECTORY_SIZE),
     ("partner_key_joints_past", KEY_JOINTS_SIZE), ("partner_pose", POSE_SIZE),
     ("self_trajectory_past", TRAJECTORY_SIZE), ("self_key_joints_past", KEY_JOINTS_SIZE),
-    ("self_pose", POSE_SIZE),
+    ("self_pose", POSE_SIZE), ("music", MUSIC_SIZE),
 ]
 LEADER_INPUT_LAYOUT = [
     ("partner_trajectory_past", TRAJECTORY_SIZE), ("partner_key_joints_past", KEY_JOINTS_SIZE),
     ("partner_pose", POSE_SIZE),
     ("self_trajectory_past", TRAJECTORY_SIZE), ("self_key_joints_past", KEY_JOINTS_SIZE),
     ("self_pose", POSE_SIZE), ("control", TRAJECTORY_SIZE), ("figure", FIGURE_SIZE),
-    ("hands_plan", HANDS_PLAN_SIZE),
+    ("hands_plan", HANDS_PLAN_SIZE), ("music", MUSIC_SIZE),
 ]
 OUTPUT_LAYOUT = [
     ("root_update", ROOT_UPDATE_SIZE), ("trajectory_future", TRAJECTORY_SIZE),
     ("key_joints_future", KEY_JOINTS_SIZE), ("pose", POSE_SIZE), ("contacts", CONTACTS_SIZE),
 ]
 INTENTION_LAYOUT = [("partner_key_joints_future", KEY_JOINTS_SIZE)]
-INPUT_SIZE = sum(s for _, s in FOLLOWER_INPUT_LAYOUT)     # 660: the follower's input
-LEADER_INPUT_SIZE = sum(s for _, s in LEADER_INPUT_LAYOUT)  # 704: the same blocks, control, figure, hands plan
+INPUT_SIZE = sum(s for _, s in FOLLOWER_INPUT_LAYOUT)     # 713: the follower's input
+LEADER_INPUT_SIZE = sum(s for _, s in LEADER_INPUT_LAYOUT)  # 757: the same blocks, control, figure, hands plan, music
 OUTPUT_SIZE = sum(s for _, s in OUTPUT_LAYOUT)            # 323
 INTENTION_SIZE = KEY_JOINTS_SIZE                          # 90
 INPUT_SIZES = {"follower": INPUT_SIZE, "leader": LEADER_INPUT_SIZE}
@@ -144,16 +145,18 @@ def foot_contacts(positions, previous_positions, fps=FPS):
 
 @dataclass
 class Track:
-    """A dancer as the features see it: motion plus the root per frame (30 fps)."""
+    """A dancer as the features see it: motion plus the root per frame (30 fps), and the count of
+    the music it dances to when it is known (a recorded take's, training/data/count.py)."""
     positions: np.ndarray   # [F, 17, 3]
     rotations: np.ndarray   # [F, 17, 3, 3]
     root: np.ndarray        # [F, 2]
     heading: np.ndarray     # [F]
+    beat: np.ndarray | None = None   # [F] the count, beats since the music started
 
     @classmethod
-    def from_motion(cls, motion: Motion) -> "Track":
+    def from_motion(cls, motion: Motion, beat: np.ndarray | None = None) -> "Track":
         root, heading = root_from_motion(motion)
-        return cls(motion.positions, motion.rotations, root, heading)
+        return cls(motion.positions, motion.rotations, root, heading, beat)
 
     @property
     def frames(self) -> int:
@@ -180,8 +183,20 @@ def _pose_at(track, frames, root, heading):
                       track.rotations[frames], root, heading)
 
 
-def follower_input(partner: Track, me: Track, frames: np.ndarray) -> np.ndarray:
-    """Input I [N, 660] for the follower at `frames` (partner = leader, whose future is steered)."""
+def music_of(partner: Track, me: Track, frames: np.ndarray, music: np.ndarray | None) -> np.ndarray:
+    """The music block [N, 53]: as given (the rollout's clock), else from the count the tracks carry."""
+    if music is not None:
+        return np.broadcast_to(np.asarray(music, float), (len(frames), MUSIC_SIZE))
+    for track in (me, partner):
+        if track.beat is not None:
+            return music_at(track.beat, frames)
+    raise ValueError("no count: the tracks carry no beat and no music block was given "
+                     "(a recorded take's count: training/data/count.py; a rollout's: its clock)")
+
+
+def follower_input(partner: Track, me: Track, frames: np.ndarray, music: np.ndarray | None = None) -> np.ndarray:
+    """Input I [N, 713] for the follower at `frames` (partner = leader, whose future is steered),
+    the music last (music_block's [N, 53]; None: the count the tracks carry)."""
     root, heading = me.root[frames], me.heading[frames]
     return np.concatenate([
         _trajectory_at(partner, frames, PAST_OFFSETS, root, heading),
@@ -191,6 +206,7 @@ def follower_input(partner: Track, me: Track, frames: np.ndarray) -> np.ndarray:
         _trajectory_at(me, frames, PAST_OFFSETS, root, heading),
         _key_joints_at(me, frames, PAST_OFFSETS, root, heading),
         _pose_at(me, frames, root, heading),
+        music_of(partner, me, frames, music),
     ], -1)
 
 
@@ -238,10 +254,10 @@ def hands_moves(me: Track, frames: np.ndarray) -> np.ndarray:
 
 
 def leader_input(partner: Track, me: Track, frames: np.ndarray, figure: np.ndarray | None = None,
-                 hands_plan: np.ndarray | None = None) -> np.ndarray:
-    """Input I [N, 704] for the leader (partner = follower, control = own future trajectory, then
+                 hands_plan: np.ndarray | None = None, music: np.ndarray | None = None) -> np.ndarray:
+    """Input I [N, 757] for the leader (partner = follower, control = own future trajectory, then
     the figure block: figure_block's [N, 7], and the hands plan: hands_plan_block's [N, 37], zeros
-    when not given)."""
+    when not given; the music last, as the follower's)."""
     root, heading = me.root[frames], me.heading[frames]
     return np.concatenate([
         _trajectory_at(partner, frames, PAST_OFFSETS, root, heading),
@@ -253,6 +269,7 @@ def leader_input(partner: Track, me: Track, frames: np.ndarray, figure: np.ndarr
         _trajectory_at(me, frames, FUTURE_OFFSETS, root, heading),
         figure_block(None, len(frames)) if figure is None else figure,
         hands_plan_block(None, len(frames)) if hands_plan is None else hands_plan,
+        music_of(partner, me, frames, music),
     ], -1)
 
 

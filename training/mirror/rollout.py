@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import features as feat
+from . import music
 from .contact import ContactLayer
 from .features import (FUTURE_OFFSETS, HISTORY, KEYS, Track, follower_input, from_root_space_directions,
                        from_root_space_points, leader_input)
@@ -305,6 +306,11 @@ class Duet:
     shown: np.ndarray = field(default_factory=lambda: np.zeros((2, feat.N_JOINTS, 3)))
     resets_seen: int = 0
     request: TurnRequest | None = None
+    # The music both dancers hear (training/mirror/music.py): its tempo (beats a minute) and the
+    # count now (beats since it started). Each step moves the count on by one step of the tempo;
+    # the page reads it from the audio clock instead (what the listener hears now).
+    tempo: float = music.DEFAULT_TEMPO
+    beat: float = 0.0
 
 
 def show(duet: Duet) -> None:
@@ -319,11 +325,27 @@ def show(duet: Duet) -> None:
                      duet.leader.heading, duet.follower.heading)
 
 
-def start_duet(manifest: dict) -> Duet:
+def manifest_tempo(manifest: dict) -> float:
+    """The music's tempo a duet dances to when none is asked for: the manifest's (export writes
+    `music.tempo`), else music.DEFAULT_TEMPO."""
+    return float(manifest.get("music", {}).get("tempo", music.DEFAULT_TEMPO))
+
+
+def start_duet(manifest: dict, tempo: float | None = None) -> Duet:
+    """Both dancers in their start poses, the music at `tempo` beats a minute (None: the
+    manifest's) and its count at 0."""
     sk, sp = manifest["skeleton"], manifest["startPose"]
     leader = start_dancer(sk["offsets"]["leader"], sp["leader"], [0.0, 0.0], 0.0)
     follower = start_dancer(sk["offsets"]["follower"], sp["follower"], [0.0, START_DISTANCE], np.pi)
-    return Duet(leader, follower, sp, Steering(anchor=leader.root.copy()))
+    bpm = manifest_tempo(manifest) if tempo is None else float(tempo)
+    if not np.isfinite(bpm) or bpm <= 0:
+        raise ValueError(f"tempo must be a positive number of beats a minute, got {tempo}")
+    return Duet(leader, follower, sp, Steering(anchor=leader.root.copy()), tempo=bpm)
+
+
+def music_input(duet: Duet) -> np.ndarray:
+    """The music block [53] both dancers hear this step: the count now and the tempo."""
+    return music.music_block(np.array(duet.beat), np.array(duet.tempo / 60.0))
 
 
 def step_inputs(duet: Duet) -> tuple[np.ndarray, np.ndarray]:
@@ -333,8 +355,9 @@ def step_inputs(duet: Duet) -> tuple[np.ndarray, np.ndarray]:
     figure = None if keys is None else feat.figure_block(keys[None], 1)
     moves = hands_input(duet.request, duet.leader)
     plan = None if moves is None else feat.hands_plan_block(moves[None], 1)
-    return (leader_input(duet.follower.track, duet.leader.track, now, figure, plan)[0],
-            follower_input(duet.leader.track, duet.follower.track, now)[0])
+    heard = music_input(duet)
+    return (leader_input(duet.follower.track, duet.leader.track, now, figure, plan, heard)[0],
+            follower_input(duet.leader.track, duet.follower.track, now, heard)[0])
 
 
 def finish_step(duet: Duet, leader_output: np.ndarray, follower_output: np.ndarray,
@@ -361,6 +384,7 @@ def finish_step(duet: Duet, leader_output: np.ndarray, follower_output: np.ndarr
         f.intention = from_root_space_points(keys, f.root, f.heading)
     show(duet)
     duet.frame += 1
+    duet.beat += music.beats_per_step(duet.tempo)
 
 
 class OnnxPolicy:

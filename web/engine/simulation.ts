@@ -13,7 +13,7 @@ import { type GuardSettings, type Ranges, hipSlackFor, mostUpright, nearestPlan,
 import { LeaderPlayback } from './playback';
 import { StepTimer } from './timing';
 import {
-  Dancer, type Duet, NOW, applyOutput, askTurn, finishStep, outputIsAbsurd, startDuet, steerPlan, stepInputs,
+  Dancer, type Duet, NOW, applyOutput, askTurn, finishStep, musicInput, outputIsAbsurd, startDuet, steerPlan, stepInputs,
 } from '../mirror/rollout';
 import type { DancerView, Simulation, SimulationOptions, StepPolicy, Steer } from './types';
 
@@ -103,6 +103,7 @@ export class DuetSimulation implements Simulation {
     const lg = manifest.leaderGuard;
     this.leaderGuard = lg && lg.samples >= 2 && manifest.plausibility ? { settings: lg, ranges: manifest.plausibility } : null;
     this.duet = startDuet(manifest, followers.length);
+    this.shownBeat = this.duet.beat;
     this.leaderView = new View(false);
     this.followerViews = followers.map((p) => new View(p.hasIntention));
     this.leader = this.leaderView;
@@ -113,7 +114,8 @@ export class DuetSimulation implements Simulation {
   }
 
   reset(): void {
-    this.duet = startDuet(this.options.manifest, this.followerPolicies.length);
+    this.duet = startDuet(this.options.manifest, this.followerPolicies.length, this.duet.tempo);
+    this.shownBeat = this.duet.beat;
     this.ghostBranched = []; // the possible reactions branch again from the new start
     this.upright = 0;
     this.playback?.start(this.duet.leader.track);
@@ -142,6 +144,22 @@ export class DuetSimulation implements Simulation {
     return this.duet.request?.direction ?? 0;
   }
 
+  /** The count of the last step taken (the one on screen); duet.beat is the next step's. */
+  private shownBeat = 0;
+
+  setCount(beat: number | null, tempo: number): void {
+    this.duet.tempo = tempo;
+    if (beat !== null) this.duet.beat = beat;
+  }
+
+  get beat(): number {
+    return this.shownBeat;
+  }
+
+  get tempo(): number {
+    return this.duet.tempo;
+  }
+
   async step(steer: Steer, temperature: number): Promise<void> {
     const started = performance.now();
     this.temperature = temperature;
@@ -152,6 +170,7 @@ export class DuetSimulation implements Simulation {
       const sz = steer.active ? steer.z : 0;
       steerPlan(duet.leader, duet.steering, sx, sz);
     }
+    this.shownBeat = duet.beat;
     stepInputs(duet, playing ? null : this.leaderPolicy.input, this.followerInputs);
     if (!playing) await this.stepLeader(this.leaderTemperature ?? temperature);
     for (let i = 0; i < this.followerPolicies.length; i++) {
@@ -242,7 +261,8 @@ export class DuetSimulation implements Simulation {
       this.ghostBranched[i] = true;
     }
     const input = policy.batchInput(k);
-    for (let i = 0; i < k; i++) followerInput(this.duet.leader.track, this.ghostDancers[i].track, NOW, input, i * INPUT_SIZE);
+    const heard = musicInput(this.duet);
+    for (let i = 0; i < k; i++) followerInput(this.duet.leader.track, this.ghostDancers[i].track, NOW, input, i * INPUT_SIZE, heard);
     const { output } = await policy.runBatch(k, this.temperature);
     while (this.ghostPoses.length < k) this.ghostPoses.push(new Float32Array(POSITIONS_SIZE));
     for (let i = 0; i < k; i++) {

@@ -9,6 +9,7 @@
 // and none of these functions re-enters another while its scratch is live).
 
 import { FEET, FPS, HANDS, KEY_JOINTS, type Motion, N_JOINTS, POSITIONS_SIZE, ROTATIONS_SIZE, rootFromMotion } from './skeleton';
+import { MUSIC_SIZE, musicAt } from './music';
 
 /** Any float array a feature can be written into (policy inputs are float32, tests use float64). */
 export type Out = Float32Array | Float64Array;
@@ -36,14 +37,14 @@ export const FOLLOWER_INPUT_LAYOUT: Layout = [
   ['partner_trajectory_past', TRAJECTORY_SIZE], ['partner_trajectory_future', TRAJECTORY_SIZE],
   ['partner_key_joints_past', KEY_JOINTS_SIZE], ['partner_pose', POSE_SIZE],
   ['self_trajectory_past', TRAJECTORY_SIZE], ['self_key_joints_past', KEY_JOINTS_SIZE],
-  ['self_pose', POSE_SIZE],
+  ['self_pose', POSE_SIZE], ['music', MUSIC_SIZE],
 ];
 export const LEADER_INPUT_LAYOUT: Layout = [
   ['partner_trajectory_past', TRAJECTORY_SIZE], ['partner_key_joints_past', KEY_JOINTS_SIZE],
   ['partner_pose', POSE_SIZE],
   ['self_trajectory_past', TRAJECTORY_SIZE], ['self_key_joints_past', KEY_JOINTS_SIZE],
   ['self_pose', POSE_SIZE], ['control', TRAJECTORY_SIZE], ['figure', FIGURE_SIZE],
-  ['hands_plan', HANDS_PLAN_SIZE],
+  ['hands_plan', HANDS_PLAN_SIZE], ['music', MUSIC_SIZE],
 ];
 export const OUTPUT_LAYOUT: Layout = [
   ['root_update', ROOT_UPDATE_SIZE], ['trajectory_future', TRAJECTORY_SIZE],
@@ -51,8 +52,8 @@ export const OUTPUT_LAYOUT: Layout = [
 ];
 export const INTENTION_LAYOUT: Layout = [['partner_key_joints_future', KEY_JOINTS_SIZE]];
 const layoutSize = (layout: Layout) => layout.reduce((sum, [, size]) => sum + size, 0);
-export const INPUT_SIZE = layoutSize(FOLLOWER_INPUT_LAYOUT); // 660: the follower's input
-export const LEADER_INPUT_SIZE = layoutSize(LEADER_INPUT_LAYOUT); // 704: the same blocks, control, figure, hands plan
+export const INPUT_SIZE = layoutSize(FOLLOWER_INPUT_LAYOUT); // 713: the follower's input
+export const LEADER_INPUT_SIZE = layoutSize(LEADER_INPUT_LAYOUT); // 757: the same blocks, control, figure, hands plan, music
 export const OUTPUT_SIZE = layoutSize(OUTPUT_LAYOUT); // 323
 export const INTENTION_SIZE = KEY_JOINTS_SIZE; // 90
 export const INPUT_SIZES: Readonly<Record<string, number>> = { follower: INPUT_SIZE, leader: LEADER_INPUT_SIZE };
@@ -238,7 +239,10 @@ export function footContacts(
 
 // ---------------------------------------------------------------- one dancer over time
 
-/** A dancer as the features see it: motion plus the root per frame (30 fps). */
+/**
+ * A dancer as the features see it: motion plus the root per frame (30 fps), and the count of the
+ * music it dances to when it is known (a recorded take's; the rollout passes its clock instead).
+ */
 export class Track {
   constructor(
     /** [F × 17 × 3] world. */
@@ -249,6 +253,8 @@ export class Track {
     readonly root: Float64Array,
     /** [F] radians, 0 = facing +Z. */
     readonly heading: Float64Array,
+    /** [F] the count, beats since the music started; null: not known. */
+    readonly beat: Float64Array | null = null,
   ) {}
 
   static fromMotion(motion: Motion): Track {
@@ -335,6 +341,11 @@ const INPUT_BLOCKS: Record<string, InputBlock> = {
   figure: (_partner, _me, _t, _x, _z, _h, out, at) => figureBlock(null, out, at),
   // Nor for a lead; leaderInput writes the request's hands plan over it when there is one.
   hands_plan: (_partner, _me, _t, _x, _z, _h, out, at) => handsPlanBlock(null, out, at),
+  // The count the tracks carry; followerInput / leaderInput write the rollout's clock instead.
+  music: (partner, me, t, _x, _z, _h, out, at) => {
+    const beat = me.beat ?? partner.beat;
+    if (beat) musicAt(beat, t, out, at);
+  },
 };
 
 /**
@@ -381,26 +392,43 @@ function writeInput(plan: { write: InputBlock; start: number }[], partner: Track
   for (const block of plan) block.write(partner, me, t, x, z, h, out, at + block.start);
 }
 
-/** Input I [660] for the follower at frame t (partner = leader, whose future is steered). */
-export function followerInput(partner: Track, me: Track, t: number, out: Out, at = 0): void {
+const FOLLOWER_MUSIC_AT = blockSlices(FOLLOWER_INPUT_LAYOUT).music.start;
+const LEADER_MUSIC_AT = blockSlices(LEADER_INPUT_LAYOUT).music.start;
+
+/** The music block: the caller's (the rollout's clock) over what the tracks carry; neither is an error. */
+function copyMusic(music: ArrayLike<number> | null, partner: Track, me: Track, out: Out, at: number): void {
+  if (music) for (let i = 0; i < MUSIC_SIZE; i++) out[at + i] = music[i];
+  else if (!me.beat && !partner.beat) {
+    throw new Error('no count: the tracks carry no beat and no music block was given');
+  }
+}
+
+/**
+ * Input I [713] for the follower at frame t (partner = leader, whose future is steered), the music
+ * last (musicBlock's [53]; null: the count the tracks carry).
+ */
+export function followerInput(partner: Track, me: Track, t: number, out: Out, at = 0, music: ArrayLike<number> | null = null): void {
   writeInput(FOLLOWER_PLAN, partner, me, t, out, at);
+  copyMusic(music, partner, me, out, at + FOLLOWER_MUSIC_AT);
 }
 
 const FIGURE_AT = blockSlices(LEADER_INPUT_LAYOUT).figure.start;
 const HANDS_PLAN_AT = blockSlices(LEADER_INPUT_LAYOUT).hands_plan.start;
 
 /**
- * Input I [704] for the leader (partner = follower, control = own future trajectory, then the
+ * Input I [757] for the leader (partner = follower, control = own future trajectory, then the
  * figure block: figureBlock of `figure`, the partner's planned turn per key, and the hands plan:
- * handsPlanBlock of `handsPlan`, each zeros when null).
+ * handsPlanBlock of `handsPlan`, each zeros when null; the music last, as the follower's).
  */
 export function leaderInput(
   partner: Track, me: Track, t: number, out: Out, at = 0,
   figure: ArrayLike<number> | null = null, handsPlan: ArrayLike<number> | null = null,
+  music: ArrayLike<number> | null = null,
 ): void {
   writeInput(LEADER_PLAN, partner, me, t, out, at);
   if (figure) figureBlock(figure, out, at + FIGURE_AT);
   if (handsPlan) handsPlanBlock(handsPlan, out, at + HANDS_PLAN_AT);
+  copyMusic(music, partner, me, out, at + LEADER_MUSIC_AT);
 }
 
 /** Output O [323]: the self at t+1, in the root space of t+1 (root update in t's). */

@@ -19,6 +19,7 @@ import {
   blockSlices, followerInput, fromRootSpaceDirections, fromRootSpacePoints, leaderInput, toRootSpacePoints, wrapAngle,
 } from './features';
 import { FEET, FPS, HANDS, KEY_JOINTS, PARENTS, POSITIONS_SIZE, ROTATIONS_SIZE, forwardKinematicsReduced } from './skeleton';
+import { DEFAULT_TEMPO, MUSIC_SIZE, beatsPerStep, musicBlock } from './music';
 
 export const NOW = HISTORY;
 export const TRACK_FRAMES = 2 * HISTORY + 1;
@@ -455,12 +456,25 @@ export interface Duet {
   frame: number;
   /** A turn the visitor asked the leader to lead, while it runs; null otherwise. */
   request: TurnRequest | null;
+  /**
+   * The music both dancers hear (web/mirror/music.ts): its tempo (beats a minute) and the count now
+   * (beats since it started). finishStep moves the count on by one step of the tempo; the page sets
+   * it from the audio clock before a step while the music plays (what the listener hears now).
+   */
+  tempo: number;
+  beat: number;
 }
 
 /** The parts of manifest.json a duet starts from. */
 export interface DuetManifest {
   skeleton: { offsets: { leader: number[][]; follower: number[][] } };
   startPose: unknown;
+  music?: { tempo?: number };
+}
+
+/** The music's tempo a duet dances to when none is asked for: the manifest's, else DEFAULT_TEMPO. */
+export function manifestTempo(manifest: DuetManifest): number {
+  return manifest.music?.tempo ?? DEFAULT_TEMPO;
 }
 
 /** Still T-ish rest pose (all rotations identity), ankles 8 cm up: for manifests without a start pose. */
@@ -484,8 +498,13 @@ function isStartPose(value: unknown): value is StartPose {
   return !!p && Array.isArray(p.hip) && p.hip.length === 3 && rows(p.forward) && rows(p.up);
 }
 
-/** Both partners standing still, 0.8 m apart and facing each other (leader at the origin facing +Z). */
-export function startDuet(manifest: DuetManifest, followerCount = 1): Duet {
+/**
+ * Both partners standing still, 0.8 m apart and facing each other (leader at the origin facing +Z),
+ * the music at `tempo` beats a minute (null: the manifest's) and its count at 0.
+ */
+export function startDuet(manifest: DuetManifest, followerCount = 1, tempo: number | null = null): Duet {
+  const bpm = tempo ?? manifestTempo(manifest);
+  if (!Number.isFinite(bpm) || bpm <= 0) throw new Error(`tempo must be a positive number of beats a minute, got ${tempo}`);
   const offsets = manifest.skeleton.offsets;
   const poses = (manifest.startPose ?? {}) as Record<string, unknown>;
   const startPose = {
@@ -495,7 +514,7 @@ export function startDuet(manifest: DuetManifest, followerCount = 1): Duet {
   const leader = startDancer(offsets.leader.flat(), startPose.leader, 0, 0, 0);
   const followers = Array.from({ length: followerCount }, () =>
     startDancer(offsets.follower.flat(), startPose.follower, 0, START_DISTANCE, Math.PI));
-  const duet: Duet = { leader, followers, startPose, steering: new Steering(), frame: 0, request: null };
+  const duet: Duet = { leader, followers, startPose, steering: new Steering(), frame: 0, request: null, tempo: bpm, beat: 0 };
   setAnchor(duet);
   return duet;
 }
@@ -505,11 +524,20 @@ export function startDuet(manifest: DuetManifest, followerCount = 1): Duet {
  * followers' never hold the request: they read the leader.
  */
 export function stepInputs(duet: Duet, leaderOut: Out | null, followerOuts: Out[]): void {
+  const heard = musicInput(duet);
   if (leaderOut) {
     leaderInput(duet.followers[0].track, duet.leader.track, NOW, leaderOut, 0, figureInput(duet.request),
-      handsInput(duet.request, duet.leader));
+      handsInput(duet.request, duet.leader), heard);
   }
-  duet.followers.forEach((f, i) => followerInput(duet.leader.track, f.track, NOW, followerOuts[i]));
+  duet.followers.forEach((f, i) => followerInput(duet.leader.track, f.track, NOW, followerOuts[i], 0, heard));
+}
+
+const heardNow = new Float64Array(MUSIC_SIZE);
+
+/** The music block [53] both dancers hear this step: the count now and the tempo (shared scratch). */
+export function musicInput(duet: Duet): Float64Array {
+  musicBlock(duet.beat, duet.tempo / 60, heardNow, 0);
+  return heardNow;
 }
 
 const intentionLocal = new Float64Array(INTENTION_SIZE);
@@ -556,4 +584,5 @@ export function finishStep(
     if (duet.request.frame >= REQUEST_SECONDS * FPS) duet.request = null;
   }
   duet.frame += 1;
+  duet.beat += beatsPerStep(duet.tempo);
 }

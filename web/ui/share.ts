@@ -5,6 +5,7 @@
 
 import type { FollowerChoice } from '../engine/types';
 import type { CameraOrbit } from '../draw/scene';
+import { DEFAULT_TEMPO, TEMPO_RANGE } from '../mirror/music';
 
 export interface Settings {
   model: FollowerChoice;
@@ -12,7 +13,13 @@ export interface Settings {
   seed: number;
   camera: CameraOrbit | null;
   ghosts: number;
+  /** Plays the dance faster or slower (address only: tests and fast-forward); the music plays
+   *  only at 1, where the dance can keep to it. */
   speed: number;
+  /** The music's tempo, beats a minute (the networks dance to it). */
+  tempo: number;
+  /** Whether the page plays the music (muted: the dance keeps its silent count). */
+  music: boolean;
   trajectories: boolean;
   intentions: boolean;
   /** The thin bones over the shaded bodies. */
@@ -25,6 +32,8 @@ export const LIMITS = {
   temperature: [0, 2],
   ghosts: [0, 8],
   speed: [0.25, 4],
+  /** The tempo control: within what the networks trained on (139-218, web/mirror/music.ts). */
+  tempo: TEMPO_RANGE,
   /** The camera (web/draw/scene.ts): degrees down from straight above; metres from the pair, at
    *  most 12, short of the fog (from 14 m). */
   polar: [5, 88],
@@ -33,11 +42,11 @@ export const LIMITS = {
 } as const;
 
 /** The query keys the settings own; addressQuery replaces these and keeps any other. */
-const KEYS = ['model', 'temperature', 'seed', 'camera', 'ghosts', 'speed', 'trajectories', 'intentions', 'skeleton'];
+const KEYS = ['model', 'temperature', 'seed', 'camera', 'ghosts', 'speed', 'tempo', 'music', 'trajectories', 'intentions', 'skeleton'];
 
 const MODELS: readonly FollowerChoice[] = ['ours', 'ccm', 'compare'];
 
-export function defaultSettings(defaultTemperature: number): Settings {
+export function defaultSettings(defaultTemperature: number, defaultTempo: number = DEFAULT_TEMPO): Settings {
   return {
     model: 'ours',
     temperature: clamp(defaultTemperature, LIMITS.temperature),
@@ -45,6 +54,8 @@ export function defaultSettings(defaultTemperature: number): Settings {
     camera: null,
     ghosts: 0,
     speed: 1,
+    tempo: clamp(defaultTempo, LIMITS.tempo),
+    music: true,
     trajectories: true,
     intentions: false,
     skeleton: false,
@@ -61,6 +72,8 @@ export function readSettings(search: string, defaults: Settings): Settings {
   settings.temperature = readNumber(query.get('temperature'), LIMITS.temperature, settings.temperature);
   settings.ghosts = Math.round(readNumber(query.get('ghosts'), LIMITS.ghosts, settings.ghosts));
   settings.speed = readNumber(query.get('speed'), LIMITS.speed, settings.speed);
+  settings.tempo = readNumber(query.get('tempo'), LIMITS.tempo, settings.tempo);
+  settings.music = readBoolean(query.get('music'), settings.music);
   settings.trajectories = readBoolean(query.get('trajectories'), settings.trajectories);
   settings.intentions = readBoolean(query.get('intentions'), settings.intentions);
   settings.skeleton = readBoolean(query.get('skeleton'), settings.skeleton);
@@ -73,7 +86,7 @@ export function readSettings(search: string, defaults: Settings): Settings {
 }
 
 /** The query string for a share link (only what differs from a fresh visit, plus the seed). */
-export function writeSettings(settings: Settings, camera: CameraOrbit | null, defaultTemperature: number): string {
+export function writeSettings(settings: Settings, camera: CameraOrbit | null, defaultTemperature: number, defaultTempo: number = DEFAULT_TEMPO): string {
   const query = new URLSearchParams();
   if (settings.model !== 'ours') query.set('model', settings.model);
   if (settings.temperature !== defaultTemperature) query.set('temperature', round(settings.temperature, 3));
@@ -81,6 +94,8 @@ export function writeSettings(settings: Settings, camera: CameraOrbit | null, de
   if (camera) query.set('camera', formatCamera(camera));
   if (settings.ghosts) query.set('ghosts', String(settings.ghosts));
   if (settings.speed !== 1) query.set('speed', round(settings.speed, 2));
+  if (settings.tempo !== defaultTempo) query.set('tempo', round(settings.tempo, 1));
+  if (!settings.music) query.set('music', '0');
   if (!settings.trajectories) query.set('trajectories', '0');
   if (settings.intentions) query.set('intentions', '1');
   if (settings.skeleton) query.set('skeleton', '1');
@@ -91,10 +106,10 @@ export function writeSettings(settings: Settings, camera: CameraOrbit | null, de
  * The page's query `search` with the settings written in (writeSettings), every other parameter
  * (?threads=1, ?bodies=sticks, anything a link carried) kept as it was.
  */
-export function addressQuery(search: string, settings: Settings, camera: CameraOrbit | null, defaultTemperature: number): string {
+export function addressQuery(search: string, settings: Settings, camera: CameraOrbit | null, defaultTemperature: number, defaultTempo: number = DEFAULT_TEMPO): string {
   const query = new URLSearchParams(search);
   for (const key of KEYS) query.delete(key);
-  for (const [key, value] of new URLSearchParams(writeSettings(settings, camera, defaultTemperature))) query.append(key, value);
+  for (const [key, value] of new URLSearchParams(writeSettings(settings, camera, defaultTemperature, defaultTempo))) query.append(key, value);
   return query.toString();
 }
 

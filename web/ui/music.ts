@@ -1,0 +1,109 @@
+// The page's music: started by the visitor's first key press or tap (browsers start audio only
+// after a gesture), muted and re-tempoed from the panel, paused with the dance. The band itself
+// (web/music/groove.ts, with its voices) is fetched when the music starts, never before the
+// first dancing frame.
+//
+// While it plays, the dance reads its count from it (heardBeat: what the listener hears now);
+// muted, paused for good, at a playback speed other than 1, or where the browser has no Web
+// Audio, the dance keeps its own silent count at the same tempo (web/mirror/rollout.ts).
+
+import type { Groove } from '../music/groove';
+
+export type MusicState = 'waiting' | 'starting' | 'playing' | 'muted' | 'unavailable';
+
+export class Music {
+  private ctx: AudioContext | null = null;
+  private groove: Groove | null = null;
+  private starting: Promise<void> | null = null;
+  private held = false;
+  state: MusicState;
+  /** Why the music could not start, when it could not. */
+  problem = '';
+
+  constructor(
+    private tempo: number,
+    private enabled: boolean,
+    /** The dance's count now: the music joins it where it is, no jump. */
+    private readonly danceBeat: () => number,
+  ) {
+    this.state = typeof AudioContext === 'undefined' ? 'unavailable' : enabled ? 'waiting' : 'muted';
+  }
+
+  /**
+   * Called from a key or tap handler (a user gesture): makes the audio context there and then,
+   * as Safari asks, and starts the band once its code is in. Later calls do nothing.
+   */
+  gesture(): void {
+    if (this.state !== 'waiting' || this.starting) return;
+    try {
+      this.ctx ??= new AudioContext({ latencyHint: 'interactive' });
+      void this.ctx.resume();
+    } catch (error) {
+      this.state = 'unavailable';
+      this.problem = error instanceof Error ? error.message : String(error);
+      return;
+    }
+    this.state = 'starting';
+    this.starting = import('../music/groove')
+      .then(({ Groove }) => {
+        if (this.state !== 'starting' || !this.ctx) return; // muted while the code came
+        this.groove = new Groove(this.ctx, this.tempo, this.danceBeat());
+        this.state = 'playing';
+        if (this.held) void this.ctx.suspend();
+      })
+      .catch((error: unknown) => {
+        this.state = 'unavailable';
+        this.problem = error instanceof Error ? error.message : String(error);
+      })
+      .finally(() => (this.starting = null));
+  }
+
+  /** The count the listener hears now, or null while no music plays (the dance counts alone). */
+  heardBeat(): number | null {
+    if (!this.groove || this.state !== 'playing' || this.held || this.ctx?.state !== 'running') return null;
+    return this.groove.heardBeat();
+  }
+
+  /** Notes the band has scheduled (0 before it starts), and eighths it dropped (their time had
+   *  passed before the scheduler ran: a main thread held longer than the lookahead). */
+  get scheduled(): number {
+    return this.groove?.scheduled ?? 0;
+  }
+
+  get dropped(): number {
+    return this.groove?.dropped ?? 0;
+  }
+
+  get contextState(): string {
+    return this.ctx?.state ?? 'none';
+  }
+
+  setTempo(bpm: number): void {
+    this.tempo = bpm;
+    this.groove?.setTempo(bpm);
+  }
+
+  /** Mute (false) or play again (true, from the next gesture if none came yet). */
+  setEnabled(on: boolean): void {
+    if (on === this.enabled || this.state === 'unavailable') return;
+    this.enabled = on;
+    if (!on) {
+      this.groove?.stop();
+      this.groove = null;
+      this.state = 'muted';
+      return;
+    }
+    this.state = 'waiting';
+    // A click in the panel is itself a gesture: start at once where the context exists or may.
+    this.gesture();
+  }
+
+  /** Hold the music with the dance (pause, help open), or let it go on. */
+  hold(held: boolean): void {
+    if (held === this.held) return;
+    this.held = held;
+    if (!this.ctx || !this.groove) return;
+    if (held) void this.ctx.suspend();
+    else void this.ctx.resume();
+  }
+}
