@@ -281,6 +281,18 @@ describe('phone', () => {
         leader: hip(window.duet.leader.screen), follower: hip(window.duet.follower.screen), hudLines: Math.round(box('.hud').h / 16),
       };
     });
+  /** The boxes once the title, legend and panel stand still (a resize or the panel's open animation
+   *  takes longer than any fixed wait on a busy machine): two reads 0.2 s apart agree. */
+  const settled = async () => {
+    let previous = '';
+    for (const deadline = Date.now() + WAIT_MS; ; ) {
+      const b = await boxes();
+      const now = JSON.stringify([b.title, b.hud, b.panel, b.centre]);
+      if (now === previous || Date.now() > deadline) return b;
+      previous = now;
+      await sleep(200);
+    }
+  };
   const overlap = (a, b) => a.x < b.x + b.w && b.x < a.x + a.w && a.y < b.y + b.h && b.y < a.y + a.h;
   const check = (b, state) => {
     const open = b.panel.h > 60;
@@ -293,11 +305,11 @@ describe('phone', () => {
   };
 
   test('phone layout: title, legend and panel clear of each other and of the dancers (screenshot-phone-panel.png)', async () => {
-    check(await boxes(), 'panel folded');
+    check(await settled(), 'panel folded');
     await page.locator('.duet-panel > .lil-title').click();
     await sleep(500); // lil-gui's open animation
     assert.ok(await page.evaluate(() => !document.querySelector('.duet-panel').classList.contains('lil-closed')), 'panel opened');
-    check(await boxes(), 'panel open');
+    check(await settled(), 'panel open');
     saveScreen('screenshot-phone-panel.png', await page.screenshot());
     await page.locator('.duet-panel > .lil-title').click();
     await sleep(500);
@@ -310,10 +322,10 @@ describe('phone', () => {
         await page.setViewportSize({ width, height });
         await sleep(400); // resize observers, the camera's aspect
         const folded = await page.evaluate(() => document.querySelector('.duet-panel').classList.contains('lil-closed'));
-        check(await boxes(), `${width}x${height}, panel ${folded ? 'folded' : 'open'}`);
+        check(await settled(), `${width}x${height}, panel ${folded ? 'folded' : 'open'}`);
         await page.locator('.duet-panel > .lil-title').click();
         await sleep(500); // lil-gui's open and close animation
-        check(await boxes(), `${width}x${height}, panel ${folded ? 'open' : 'folded'}`);
+        check(await settled(), `${width}x${height}, panel ${folded ? 'open' : 'folded'}`);
         await page.locator('.duet-panel > .lil-title').click();
         await sleep(500);
       }

@@ -214,19 +214,22 @@ export async function pausedStill(page) {
 }
 
 /**
- * Press R (both dancers back to the start) and return the state a couple of steps later. R waits
- * in the page's queue behind the steps under way, and on a busy machine one batch of steps can
- * outlast any fixed wait; so the dance is paused first, R lands on an idle queue (it has run by the
- * time the key is in), and the dance resumes.
+ * Press R (both dancers back to the start) and return the state R left, then dance on. R waits in
+ * the page's queue behind the steps under way, and on a busy machine one batch of steps can outlast
+ * any fixed wait (and the first batch after it can be a second of dance): so the dance is paused
+ * first, R lands on an idle queue (it has run by the time the key is in), the state is read while
+ * the dance stands at the start (two frames drawn, so the places on the screen are the start's
+ * too), and then the dance resumes.
  */
 export async function reset(page) {
   await page.keyboard.press('Space');
   await pausedStill(page);
   await page.keyboard.press('r');
+  await page.evaluate(() => new Promise((done) => requestAnimationFrame(() => requestAnimationFrame(done))));
+  const state = await duet(page);
   await page.keyboard.press('Space');
   await page.waitForFunction(() => window.duet.paused === false, null, { timeout: WAIT_MS, polling: 20 });
-  await waitSteps(page, 2);
-  return duet(page);
+  return state;
 }
 
 export const distance = (a, b) => Math.hypot(a[0] - b[0], a[1] - b[1]);

@@ -15,7 +15,7 @@
 
 import { after, before, describe, test } from 'node:test';
 import assert from 'node:assert/strict';
-import { duet, launch, saveScreen, sleep, startServer, waitReady, waitSteps } from './harness.mjs';
+import { WAIT_MS, duet, launch, saveScreen, sleep, startServer, waitReady, waitSteps } from './harness.mjs';
 
 /** Pictures a visitor would see, in runs/screens/ (harness.SCREENS; the latest test run's). */
 const shot = async (page, name) => saveScreen(`${name}.png`, await page.screenshot());
@@ -52,6 +52,7 @@ async function withScreens(phone, run) {
     for (const [w, h] of sizes) {
       await browser.page.setViewportSize({ width: w, height: h });
       await sleep(400); // the resize observers, and a frame or two drawn at the new size
+      await standStill(() => panelBox(browser.page));
       await run(browser.page, `${w}x${h}`, w, h);
     }
     assert.deepEqual(browser.consoleErrors, []);
@@ -60,12 +61,32 @@ async function withScreens(phone, run) {
   }
 }
 
-const openPanel = (page) =>
-  page.evaluate(async () => {
+/** Read `read()` every 0.2 s until two reads agree (an animation, a glide or a resize has ended:
+ *  on a busy machine they take longer than any fixed wait), for up to WAIT_MS; the last read. */
+async function standStill(read) {
+  let previous = '';
+  for (const deadline = Date.now() + WAIT_MS; ; ) {
+    const now = await read();
+    const key = JSON.stringify(now);
+    if (key === previous || Date.now() > deadline) return now;
+    previous = key;
+    await sleep(200);
+  }
+}
+
+const panelBox = (page) => page.evaluate(() => {
+  const r = document.querySelector('.duet-panel').getBoundingClientRect();
+  return [r.left, r.top, r.width, r.height];
+});
+
+const openPanel = async (page) => {
+  await page.evaluate(async () => {
     const panel = document.querySelector('.duet-panel');
     if (panel.classList.contains('lil-closed')) panel.querySelector(':scope > .lil-title').click();
     await new Promise((resolve) => setTimeout(resolve, 500)); // lil-gui's open animation
   });
+  await standStill(() => panelBox(page));
+};
 
 /** The two labels' boxes, the overlap's area (px²), and the open panel card's box. */
 const labelBoxes = (page) =>
@@ -105,7 +126,8 @@ async function zoomOut(page, width, height) {
     await page.mouse.wheel(0, 500);
     await sleep(40);
   }
-  await sleep(800); // the camera's glide
+  await sleep(800); // the camera's glide...
+  await standStill(async () => Number((await duet(page)).camera.distance.toFixed(2))); // ...to its end
 }
 
 for (const phone of [true, false]) {
