@@ -35,7 +35,7 @@ after(async () => {
   await server?.stop();
 });
 
-describe('desktop: save a clip, and full screen', { timeout: WAIT_MS }, () => {
+describe('desktop: save a clip, and full screen', { timeout: 5 * WAIT_MS }, () => {
   test('"● clip" counts down, saves a video over 20 kB, and the keys still steer', async () => {
     const clip = page.locator('.title-row .clip-button');
     assert.ok(await clip.isVisible(), 'a clip button by the title');
