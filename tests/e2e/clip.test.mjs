@@ -14,7 +14,10 @@ import { WAIT_MS, distance, duet, launch, sleep, startServer, waitReady, waitSte
  *  0.4-2.5 m of it (0.78 m once in a full run), so the spot is measured, as controls.test.mjs does. */
 const STEER_STEPS = 45;
 const MIN_STEER_M = 0.6;
-const MIN_CLIP_BYTES = 20_000;
+/** More than a header: an empty recording is a few hundred bytes. How much more depends on how many
+ *  frames the machine drew in the clip's 6 s (a busy one drew enough for 19.9 kB), so the first
+ *  test decodes its clip and looks at a frame instead. */
+const MIN_CLIP_BYTES = 5_000;
 const EBML = [0x1a, 0x45, 0xdf, 0xa3];
 
 let server;
@@ -36,7 +39,7 @@ after(async () => {
 });
 
 describe('desktop: save a clip, and full screen', { timeout: 5 * WAIT_MS }, () => {
-  test('"● clip" counts down, saves a video over 20 kB, and the keys still steer', async () => {
+  test('"● clip" counts down, saves a video of the dance, and the keys still steer', async () => {
     const clip = page.locator('.title-row .clip-button');
     assert.ok(await clip.isVisible(), 'a clip button by the title');
     const idle = (await clip.textContent()).trim();
