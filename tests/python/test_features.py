@@ -4,6 +4,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from training.mirror.music import music_block
 from training.mirror import features as F
 from training.data.dataset import samples
 from training.mirror.rollout import rotations_from_vectors
@@ -34,7 +35,7 @@ def moved(track: F.Track, angle: float, shift) -> F.Track:
     recompute its root from the moved joints (as training would for such a recording)."""
     R = rot_y(angle)
     m = Motion(track.positions @ R.T + np.asarray(shift, float), R @ track.rotations, np.zeros((17, 3)), FPS)
-    return F.Track.from_motion(m)
+    return F.Track.from_motion(m, track.beat)   # the music does not move with the dancer
 
 
 # ---------------------------------------------------------------- sizes and layout
@@ -120,7 +121,8 @@ def straight_walker(frames, start, heading, speed):
     positions[..., 0] = root[:, None, 0]
     positions[..., 2] = root[:, None, 1]
     positions[..., 1] = np.linspace(0.1, 1.7, 17)
-    return F.Track(positions, np.tile(np.eye(3), (frames, 17, 1, 1)), root, np.full(frames, heading))
+    beat = 0.25 + t * 170 / 60    # music at 170 beats a minute, a quarter beat in at the first frame
+    return F.Track(positions, np.tile(np.eye(3), (frames, 17, 1, 1)), root, np.full(frames, heading), beat)
 
 
 def test_blocks_describe_a_known_scene():
@@ -146,6 +148,8 @@ def test_blocks_describe_a_known_scene():
     np.testing.assert_allclose(pose[:, 1], np.linspace(0.1, 1.7, 17), atol=1e-12)        # heights
     # The partner's facing (R ez with identity rotations is +Z in world) seen from self: +Z.
     np.testing.assert_allclose(pose[:, 6:9], np.tile([0, 0, 1.0], (17, 1)), atol=1e-12)
+    # The music: the count at frame 50 and 170 beats a minute, as music_block writes them.
+    np.testing.assert_allclose(b["music"], music_block(np.array(me.beat[50]), np.array(170 / 60)), atol=1e-9)
     intention = F.intention_target(partner, me, t)[0].reshape(6, 5, 3)
     np.testing.assert_allclose(intention[:, :, 0], np.repeat((50 / 30 + np.arange(1, 7) * 5 / 30)[:, None], 5, 1), atol=1e-12)
     np.testing.assert_allclose(intention[:, :, 2], 0.8, atol=1e-12)
@@ -163,8 +167,8 @@ def test_blocks_describe_a_known_scene():
 @pytest.mark.parametrize("angle,shift", [(2.2, (4.0, 0.0, -7.5)), (-0.9, (0.0, 0.0, 0.0)), (0.0, (-30.0, 0.0, 12.0))])
 def test_features_ignore_where_the_couple_stands(take_tracks, angle, shift):
     lead, follow = take_tracks
-    a = all_features(F.Track.from_motion(Motion(lead.positions, lead.rotations, np.zeros((17, 3)), FPS)),
-                     F.Track.from_motion(Motion(follow.positions, follow.rotations, np.zeros((17, 3)), FPS)))
+    a = all_features(F.Track.from_motion(Motion(lead.positions, lead.rotations, np.zeros((17, 3)), FPS), lead.beat),
+                     F.Track.from_motion(Motion(follow.positions, follow.rotations, np.zeros((17, 3)), FPS), follow.beat))
     b = all_features(moved(lead, angle, shift), moved(follow, angle, shift))
     for k in a:
         err = np.abs(a[k] - b[k]).max()

@@ -209,40 +209,49 @@ def test_files_in_other_units(tmp_path, capsys):
     assert_nothing_written(tmp_path / "out")
 
 
-def test_tempo_copies_are_written_only_when_asked_for(data3, prepared3, tmp_path):
-    """prepare alone writes no tempo copies; --tempos alone writes them at 0.9x and 1.1x, in a file
-    of their own, and changes nothing else."""
+def test_tempo_copies_are_written_by_default_and_change_nothing_else(data3, prepared3, tmp_path):
+    """prepare writes the tempo copies the shipped recipes read (prepare.TEMPOS), in a file of their
+    own, carrying the count warped with them; --tempos '' writes none and changes nothing else."""
     from training.data.prepare import TEMPOS
     from training.data.prepared import load_mirror_flags, load_split
-    copies = tmp_path / "copies"
-    assert main(["--data", str(data3), "--prepared", str(copies), "--validation", "12", "--test", "06",
-                 "--tempos"]) == 0
-    assert not (prepared3 / "train_tempo.npz").exists() and (copies / "train_tempo.npz").exists()
+    plain_dir = tmp_path / "plain"
+    assert main(["--data", str(data3), "--prepared", str(plain_dir), "--validation", "12", "--test", "06",
+                 "--tempos", ""]) == 0
+    assert (prepared3 / "train_tempo.npz").exists() and not (plain_dir / "train_tempo.npz").exists()
     # The recorded tempo's arrays and statistics are the same with or without the copies.
     for f in ("train.npz", "validation.npz", "test.npz", "stats.npz"):
-        with np.load(prepared3 / f) as a, np.load(copies / f) as b:
+        with np.load(prepared3 / f) as a, np.load(plain_dir / f) as b:
             for k in a.files:
                 np.testing.assert_array_equal(a[k], b[k])
-    with np.load(copies / "train_tempo.npz") as z:
+    with np.load(prepared3 / "train_tempo.npz") as z:
         tempos = z["tempo"]
     assert sorted(set(tempos.tolist())) == pytest.approx(TEMPOS)
-    plain = load_split(str(copies), "train", "follower")["input"]
-    more = load_split(str(copies), "train", "follower", tempo_copies=True)["input"]
-    # 0.9x plays longer (more samples), 1.1x shorter; the copies follow the recorded samples.
-    assert (tempos == np.float32(0.9)).sum() > len(plain) > (tempos == np.float32(1.1)).sum() > 0
-    assert len(more) == len(plain) + len(tempos) and np.array_equal(more[:len(plain)], plain)
-    assert len(load_mirror_flags(str(copies), tempo_copies=True)) == len(more)
+    plain = load_split(str(prepared3), "train", "follower")["input"]
+    more = load_split(str(prepared3), "train", "follower", tempo_copies=True)
+    # slower copies play longer (more samples), faster shorter; the copies follow the recorded samples.
+    slow, fast = min(TEMPOS), max(TEMPOS)
+    assert (tempos == np.float32(slow)).sum() > len(plain) > (tempos == np.float32(fast)).sum() > 0
+    assert len(more["input"]) == len(plain) + len(tempos) and np.array_equal(more["input"][:len(plain)], plain)
+    assert len(load_mirror_flags(str(prepared3), tempo_copies=True)) == len(more["input"])
+    # The music they hear is warped with them: a copy at 1.16x hears a tempo 1.16x the recorded one.
+    bps = more["input"][:, -1]
+    recorded = float(np.median(bps[:len(plain)]))
+    assert float(np.median(bps[len(plain):][tempos == np.float32(fast)])) == pytest.approx(fast * recorded, rel=0.01)
 
 
-def test_a_tempo_recipe_without_copies_says_to_prepare_with_tempos(prepared3, tmp_path, capsys):
+def test_a_tempo_recipe_without_copies_says_to_prepare_with_tempos(data3, tmp_path, capsys):
     from training.data.prepared import TrainError, load_mirror_flags, load_split
     from training.learning.train import main as train_main
-    for read in (lambda: load_split(str(prepared3), "train", "follower", tempo_copies=True),
-                 lambda: load_mirror_flags(str(prepared3), tempo_copies=True)):
+    bare = tmp_path / "bare"
+    assert main(["--data", str(data3), "--prepared", str(bare), "--validation", "12", "--test", "06",
+                 "--tempos", ""]) == 0
+    capsys.readouterr()
+    for read in (lambda: load_split(str(bare), "train", "follower", tempo_copies=True),
+                 lambda: load_mirror_flags(str(bare), tempo_copies=True)):
         with pytest.raises(TrainError, match=r"train_tempo\.npz not found.*training\.data\.prepare .*--tempos"):
             read()
-    # Training such a recipe stops with that one line, before any epoch.
-    assert train_main(["--model", "follower_tempo", "--smoke", "--prepared", str(prepared3),
+    # Training a shipped recipe (they read the copies) stops with that one line, before any epoch.
+    assert train_main(["--model", "follower", "--smoke", "--prepared", str(bare),
                        "--runs", str(tmp_path / "runs")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert "--tempos" in err[-1] and "train_tempo.npz" in err[-1]

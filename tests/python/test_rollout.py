@@ -61,6 +61,18 @@ def test_smoke_duet_stays_finite(exported, rng):
                 assert np.isfinite(a).all(), f"non-finite state at frame {duet.frame}"
         assert duet.follower.intention is not None and np.isfinite(duet.follower.intention).all()
     assert duet.frame == 300
+    # the music moved on one step of the tempo per step
+    assert duet.beat == pytest.approx(300 * duet.tempo / 60 / 30)
+    assert duet.tempo == manifest["music"]["tempo"]
+
+
+def test_start_duet_takes_a_tempo_and_refuses_what_is_not_one(exported):
+    manifest = json.loads((exported["models"] / "manifest.json").read_text())
+    assert R.start_duet(manifest, tempo=188).tempo == 188
+    assert R.start_duet({**manifest, "music": {"tempo": 161}}).tempo == 161
+    for bad in (0, -170, float("nan"), float("inf")):
+        with pytest.raises(ValueError, match="tempo"):
+            R.start_duet(manifest, tempo=bad)
 
 
 # ---------------------------------------------------------------- features <-> run time
@@ -83,10 +95,13 @@ def test_apply_output_replays_the_recording(take_tracks, take_pair):
 
 
 def test_step_inputs_equal_training_features(take_tracks):
-    """A duet holding recorded windows builds the very inputs prepare computed for that frame."""
+    """A duet holding recorded windows, its music at the take's count and tempo, builds the very
+    inputs prepare computed for that frame."""
     lead, follow = take_tracks
     t = 100
-    duet = R.Duet(R.Dancer(np.zeros((17, 3)), window(lead, t)), R.Dancer(np.zeros((17, 3)), window(follow, t)), {})
+    tempo = float((lead.beat[t + 1] - lead.beat[t - 1]) * 30 / 2 * 60)
+    duet = R.Duet(R.Dancer(np.zeros((17, 3)), window(lead, t)), R.Dancer(np.zeros((17, 3)), window(follow, t)), {},
+                  tempo=tempo, beat=float(lead.beat[t]))
     xl, xf = R.step_inputs(duet)
     np.testing.assert_allclose(xl, feat.leader_input(follow, lead, np.array([t]))[0], atol=1e-12)
     np.testing.assert_allclose(xf, feat.follower_input(lead, follow, np.array([t]))[0], atol=1e-12)

@@ -45,7 +45,7 @@ describe('validateManifest', () => {
     expect(refusal((m) => m.layout.outputBlocks.pop())).toBe(
       'layout.outputBlocks block 5 is missing, this page expects "contacts" (2)');
     expect(refusal((m) => m.layout.leaderInput.push(['extra', 1]))).toBe(
-      'layout.leaderInput block 10 is "extra" (1), this page expects no more blocks');
+      'layout.leaderInput block 11 is "extra" (1), this page expects no more blocks');
   });
 
   it('refuses a manifest without block lists', () => {
@@ -54,7 +54,7 @@ describe('validateManifest', () => {
   });
 
   it('checks the sizes first, as before', () => {
-    expect(refusal((m) => (m.layout.input = 600))).toBe('layout.input is 600, this page expects 660');
+    expect(refusal((m) => (m.layout.input = 600))).toBe('layout.input is 600, this page expects 713');
   });
 });
 

@@ -24,12 +24,12 @@ def _unreadable(path: Path, e: Exception) -> TrainError:
 
 
 def require_tempo_copies(prepared: str) -> None:
-    """Tempo copies are written only on request (prepare --tempos): a recipe that trains on them
-    says how to get them instead of failing on a missing file."""
+    """Tempo copies are written by prepare unless `--tempos ''` turned them off: a recipe that trains
+    on them (the shipped ones do) says how to get them instead of failing on a missing file."""
     path = Path(prepared) / "train_tempo.npz"
     if not path.exists():
-        raise TrainError(f"{path} not found: this recipe trains on tempo copies, which prepare writes only "
-                         f"when asked: run `python -m training.data.prepare --prepared {prepared} --tempos` first")
+        raise TrainError(f"{path} not found: this recipe trains on tempo copies: run "
+                         f"`python -m training.data.prepare --prepared {prepared} --tempos` (its default) first")
 
 
 # The turn a leader leads (the follower's turn over the next second, in full turns at each future

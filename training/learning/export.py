@@ -119,6 +119,31 @@ def coarsen(path: Path, step: int) -> None:
     onnx.save(model, str(path))
 
 
+def short_names(path: Path) -> None:
+    """Rename the graph's nodes and the values passed between them to short numbers: the exporter's
+    and the quantizer's names ("/matching/encoder/layers.0/MatMul_output_0_quantized", ...) are
+    about 9 KB of every file the page downloads and mean nothing to it. The inputs, outputs and
+    initializers keep their names; what the graph computes is unchanged (the tests compare outputs)."""
+    import onnx
+    model = onnx.load(str(path))
+    g = model.graph
+    keep = {v.name for v in (*g.input, *g.output)} | {i.name for i in g.initializer} | {""}
+    renamed: dict[str, str] = {}
+
+    def short(name: str) -> str:
+        if name in keep:
+            return name
+        return renamed.setdefault(name, f"v{len(renamed)}")
+
+    for i, node in enumerate(g.node):
+        node.name = f"n{i}"
+        node.input[:] = [short(n) for n in node.input]
+        node.output[:] = [short(n) for n in node.output]
+    for info in g.value_info:
+        info.name = short(info.name)
+    onnx.save(model, str(path))
+
+
 def skeleton_offsets(data: str) -> dict:
     """Bone offsets (metres) of each role, from the first take: the page draws and exports BVH
     with them. Offsets are constant per dancer, so this is not frame-by-frame data."""
@@ -219,6 +244,7 @@ def export_all(names: list[str], runs: str, out: str, data: str, prepared: str, 
         export_onnx(model, fp32)
         quantize(fp32, out_dir / f"{name}.onnx")
         coarsen(out_dir / f"{name}.onnx", weight_step)
+        short_names(out_dir / f"{name}.onnx")
         stamp = stamp_of(name, model)
         write_stamp(out_dir / f"{name}.onnx", stamp)
         if model.cfg.role == "follower":
