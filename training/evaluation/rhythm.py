@@ -222,6 +222,44 @@ def format_summary(title: str, s: dict, reference: dict) -> str:
     return "\n".join(lines)
 
 
+def plot(path: str, data: str, manifest, leader, follower, temperature: float, tempo: float,
+         take: str = "07", seed: int = 0, start: float = 6.0, seconds: float = 5.0) -> None:
+    """Footwork against the beat: a recorded take at its found count above a duet of the shipped
+    networks (nobody steering, `seed`) at `tempo`; vertical lines are the beats."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from ..data.dataset import discover_takes, load_pair, pair_tracks, select_takes
+    (t,) = select_takes(discover_takes(data), [take])
+    lead, follow = pair_tracks(*load_pair(t))
+    from .soak import soak_one
+    rec: dict = {}
+    frames = int((start + seconds) * FPS) + FPS
+    soak_one(manifest, leader, follower, seed, frames, temperature, record=rec, tempo=tempo, steer=False)
+    rows = [(f"recorded take {take}, its found count", lead.positions, follow.positions, lead.beat),
+            (f"the shipped networks, nobody steering (seed {seed}), music at {tempo:g} beats a minute",
+             rec["leader"], rec["follower"], rec["beat"])]
+    fig, axes = plt.subplots(2, 1, figsize=(10, 4.2), sharex=True)
+    for ax, (title, lp, fp, beat) in zip(axes, rows):
+        sl = slice(int(start * FPS), int((start + seconds) * FPS))
+        x = np.arange(sl.start, sl.stop) / FPS
+        lw, fw = footwork(lp)[sl], footwork(fp)[sl]
+        ax.plot(x, lw, color="#2a6fdb", lw=1.2, label="leader")
+        ax.plot(x, fw, color="#d62f3a", lw=1.2, label="follower")
+        ax.set_ylim(0, 1.1 * np.percentile(np.concatenate([lw, fw]), 98))
+        b = beat[sl]
+        for k in range(int(np.ceil(b[0])), int(np.floor(b[-1])) + 1):
+            i = np.searchsorted(b, k)
+            ax.axvline(x[min(i, len(x) - 1)], color="k", lw=0.8, alpha=0.45)
+        ax.set_title(title, fontsize=9, loc="left")
+        ax.set_ylabel("m/s")
+    axes[0].legend(loc="upper right", fontsize=8)
+    axes[1].set_xlabel("seconds (footwork: summed ankle speed; lines: the beats; on the count, a foot lands at each line)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    print(f"wrote {path}")
+
+
 def load_dancers(args):
     """The manifest and both dancers' policies as the page runs them (evaluation.options)."""
     from . import options as O
@@ -252,6 +290,8 @@ def main(argv=None) -> int:
                     help="tempos to dance at (default: --tempo, else the manifest's, and 0.9x and 1.1x of it)")
     ap.add_argument("--steer", choices=["both", "steered", "nobody"], default="both")
     ap.add_argument("--out", default=None, help="write every seed's figures and the summaries as JSON")
+    ap.add_argument("--plot", metavar="FILE", help="only draw footwork against the beat: a recorded take above "
+                                                  "one duet of the networks (PNG)")
     ap.add_argument("--recorded", action="store_true",
                     help="only the recorded couples: each take's rhythm and where on the count her turns start and end")
     O.add_options(ap)
@@ -274,6 +314,9 @@ def main(argv=None) -> int:
         return 0
     asked_tempo = args.tempo
     manifest, leader, follower, temperature = load_dancers(args)
+    if args.plot:
+        plot(args.plot, args.data, manifest, leader, follower, temperature, args.tempo)
+        return 0
     base = args.tempo   # resolved: --tempo, else the manifest's
     try:
         tempos = ([base] if asked_tempo is not None else [base, 0.9 * base, 1.1 * base]) if args.tempos is None \

@@ -8,6 +8,8 @@
 // Audio, the dance keeps its own silent count at the same tempo (web/mirror/rollout.ts).
 
 import type { Groove } from '../music/groove';
+import { heardTime } from '../music/clock';
+
 
 export type MusicState = 'waiting' | 'starting' | 'playing' | 'muted' | 'unavailable';
 
@@ -45,9 +47,12 @@ export class Music {
     }
     this.state = 'starting';
     this.starting = import('../music/groove')
-      .then(({ Groove }) => {
+      .then(async ({ Groove }) => {
         if (this.state !== 'starting' || !this.ctx) return; // muted while the code came
-        this.groove = new Groove(this.ctx, this.tempo, this.danceBeat());
+        const groove = await Groove.start(this.ctx, this.tempo, this.danceBeat);
+        if (this.state !== 'starting') return groove.stop(); // muted while the band was rendered
+        this.groove = groove;
+        if (groove.tempo !== this.tempo) void groove.setTempo(this.tempo); // changed meanwhile
         this.state = 'playing';
         if (this.held) void this.ctx.suspend();
       })
@@ -64,8 +69,14 @@ export class Music {
     return this.groove.heardBeat();
   }
 
-  /** Notes the band has scheduled (0 before it starts), and eighths it dropped (their time had
-   *  passed before the scheduler ran: a main thread held longer than the lookahead). */
+  /** The audio clock's time the listener hears now, seconds (null while no music plays). */
+  heardTime(): number | null {
+    if (!this.groove || !this.ctx || this.state !== 'playing') return null;
+    return heardTime(this.ctx);
+  }
+
+  /** Notes in the band's rendered loops (0 before it starts), and notes it could not play (the
+   *  loop plays on the audio thread: none). */
   get scheduled(): number {
     return this.groove?.scheduled ?? 0;
   }
@@ -80,7 +91,7 @@ export class Music {
 
   setTempo(bpm: number): void {
     this.tempo = bpm;
-    this.groove?.setTempo(bpm);
+    if (this.groove) void this.groove.setTempo(bpm);
   }
 
   /** Mute (false) or play again (true, from the next gesture if none came yet). */
