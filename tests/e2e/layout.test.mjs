@@ -74,9 +74,10 @@ async function standStill(read) {
   }
 }
 
+/** The panel's box (null before the page is loaded: a screen is sized before its page opens). */
 const panelBox = (page) => page.evaluate(() => {
-  const r = document.querySelector('.duet-panel').getBoundingClientRect();
-  return [r.left, r.top, r.width, r.height];
+  const r = document.querySelector('.duet-panel')?.getBoundingClientRect();
+  return r ? [r.left, r.top, r.width, r.height] : null;
 });
 
 const openPanel = async (page) => {
