@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 import torch
 
+from training.data.prepare import TEMPOS
 from training.evaluation import crossval
 from training.data.synthetic import write_couples
 
@@ -66,7 +67,7 @@ def test_crossval_runs_every_fold_and_resumes(tmp_path):
     assert all(k in res["means"]["ours"] for k in figures)
     # One data folder per fold; only the tempo method read its copies (it saw more samples).
     with np.load(out / "fold0" / "data" / "train_tempo.npz") as z:
-        assert sorted(set(z["tempo"].tolist())) == pytest.approx([0.9, 1.1])
+        assert sorted(set(z["tempo"].tolist())) == pytest.approx(TEMPOS)
     runs = out / "fold0" / "seed1" / "runs"
     configs = {r: torch.load(runs / r / "checkpoint.pt", weights_only=False)["config"]["tempo_copies"]
                for r in ("follower", "follower_ccm", "follower_tempo")}

@@ -48,10 +48,11 @@ METHODS = {
     "ccm": ("follower_ccm", "follower_ccm_no_proximity", False),
     "ours_tempo": ("follower_tempo", "follower_no_proximity", True),
     "ccm_tempo": ("follower_ccm_tempo", "follower_ccm_no_proximity", True),
-    # The shipped recipes (decoders that read the pose, proximity, state noise, state dropout), and
+    # The shipped recipes (decoders that read the pose, proximity, state noise, state dropout, the
+    # tempo copies the music needs), and
     # the same with the turn onsets weighed 4x (measured, not shipped).
-    "ours_steady": ("follower_steady", "follower", False),
-    "ccm_steady": ("follower_ccm_steady", "follower_ccm", False),
+    "ours_steady": ("follower_steady", "follower", True),
+    "ccm_steady": ("follower_ccm_steady", "follower_ccm", True),
     "ours_turns": ("follower_turns", "follower_turns", False),
     "ccm_turns": ("follower_ccm_turns", "follower_ccm_turns", False),
     # The shipped recipe whose intention also forecasts the turn the leader leads (turn_keys).

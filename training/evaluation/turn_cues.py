@@ -75,8 +75,10 @@ LEADER_BODY_SIZE = LEADER_BODY.stop - LEADER_BODY.start   # 342
 
 def leader_body(follow, lead, frames: np.ndarray) -> np.ndarray:
     """[N, 342] the leader's own past path, key joints, pose and planned path, in his root space
-    (the leader's input from his own past block to his control)."""
-    return feat.leader_input(follow, lead, frames)[:, LEADER_BODY]
+    (the leader's input from his own past block to his control). The music is not among them: any
+    block stands in for it where the tracks carry no count (a rollout's)."""
+    music = None if (lead.beat is not None or follow.beat is not None) else np.zeros(feat.MUSIC_SIZE)
+    return feat.leader_input(follow, lead, frames, music=music)[:, LEADER_BODY]
 
 
 def labels(s: dict, lead: int) -> np.ndarray:
