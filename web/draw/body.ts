@@ -38,6 +38,21 @@ const L_ANKLE = joint('lFoot');
 const R_HIP = joint('rThigh');
 const R_ANKLE = joint('rFoot');
 
+/**
+ * Where a skinned dancer's body ends (figure.ts), each as a joint and an offset from it in the bind
+ * pose, metres (y up, z where the body faces): the top of the head (the head's ellipsoid and the
+ * follower's bun reach 0.133 m above the head joint), and the toe and the heel of each shoe (its
+ * sole 0.052 m below the ankle, its tip 0.167 m ahead and its heel 0.077 m behind). The framing
+ * keeps these in the picture (web/draw/framing.ts) and the tests check it (tests/e2e/framing.test.mjs).
+ */
+export const OUTLINE: readonly (readonly [number, number, number, number])[] = [
+  [HEAD, 0, 0.135, 0],
+  [L_ANKLE, 0, -0.052, 0.167],
+  [L_ANKLE, 0, -0.052, -0.077],
+  [R_ANKLE, 0, -0.052, 0.167],
+  [R_ANKLE, 0, -0.052, -0.077],
+];
+
 /** The extra instances after the 17 joints of each dancer, in this order. */
 const EXTRA_L_HAND = 0;
 const EXTRA_R_HAND = 1;
@@ -83,6 +98,8 @@ export interface DancerBody extends ContactState {
   readonly color: THREE.Color;
   setCount(count: number): void;
   setPose(index: number, positions: ArrayLike<number>, rotations?: ArrayLike<number> | null, contacts?: ArrayLike<number> | null): void;
+  /** The top of the head and each shoe's toe and heel as last posed (OUTLINE), world xyz into `out`. */
+  outline(out: Float32Array): Float32Array;
 }
 
 /** How the dancers are drawn: skinned characters (the default) or the capsule figures. */
@@ -176,6 +193,24 @@ export class DancerMeshes implements DancerBody {
     if (this.joints.instanceColor) this.joints.instanceColor.needsUpdate = true;
   }
 
+  /** Dancer 0's joint positions as last posed (for outline()). */
+  private readonly first = new Float32Array(3 * N_JOINTS);
+
+  /** Dancer 0's OUTLINE points, from its joints: the head sphere's top, and each shoe's ends along
+   *  the hips' facing (the shoes' own turn is not kept: the same reach either way). */
+  outline(out: Float32Array): Float32Array {
+    const p = this.first;
+    horizontalForward(p, L_HIP, R_HIP, _r);
+    for (let i = 0; i < OUTLINE.length; i++) {
+      const [j, , y, z] = OUTLINE[i];
+      const up = j === HEAD ? HEAD_RADIUS * this.thickness : y;
+      out[3 * i] = p[3 * j] + z * _r.x;
+      out[3 * i + 1] = p[3 * j + 1] + up;
+      out[3 * i + 2] = p[3 * j + 2] + z * _r.z;
+    }
+    return out;
+  }
+
   /** How many of the `capacity` dancers to draw. */
   setCount(count: number): void {
     const n = Math.max(0, Math.min(this.capacity, count));
@@ -215,6 +250,7 @@ export class DancerMeshes implements DancerBody {
     }
     this.poseExtras(base + this.jointCount, positions, rotations ?? null, index === 0);
     if (index === 0) {
+      for (let i = 0; i < this.first.length; i++) this.first[i] = positions[i];
       this.footContact[0] = contacts ? contacts[0] : 0;
       this.footContact[1] = contacts ? contacts[1] : 0;
     }
@@ -407,6 +443,18 @@ export class SkinnedDancer implements DancerBody {
   /** Bone j's world matrix as last posed (for tests). */
   boneMatrix(j: number): THREE.Matrix4 {
     return this.bones[j].matrixWorld;
+  }
+
+  /** The OUTLINE points (head top, toes and heels) as last posed, world metres, into `out` (xyz each). */
+  outline(out: Float32Array): Float32Array {
+    for (let i = 0; i < OUTLINE.length; i++) {
+      const [j, x, y, z] = OUTLINE[i];
+      _p.set(this.bind[3 * j] + x, this.bind[3 * j + 1] + y, this.bind[3 * j + 2] + z).applyMatrix4(this.bones[j].matrixWorld);
+      out[3 * i] = _p.x;
+      out[3 * i + 1] = _p.y;
+      out[3 * i + 2] = _p.z;
+    }
+    return out;
   }
 }
 

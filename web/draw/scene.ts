@@ -6,8 +6,9 @@
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import type { Avatar } from './avatar';
-import { type Bodies, ContactMarks, type DancerBody, DancerMeshes, SkinnedDancer } from './body';
+import { type Bodies, ContactMarks, type DancerBody, DancerMeshes, OUTLINE, SkinnedDancer } from './body';
 import { LIMITS } from '../ui/share';
+import { type Basis, type FrameWindow, type Rect, cylinderPoints, distanceToFit, frameWindow, viewShift } from './framing';
 
 export { DancerMeshes } from './body';
 
@@ -38,9 +39,12 @@ export const COLORS = {
 
 const FLOOR_SIZE = 200; // metres; one grid cell per metre
 const TARGET_HEIGHT = 0.9;
-/** Metres either side of the pair's midpoint that the picture always spans: partners stand about
- *  a metre apart, so both dancers' hips stay on screen however close a pinch brings the camera. */
+/** Metres around the pair's midpoint that the picture always holds, from the floor to above the
+ *  heads, from any angle: however close a wheel or a pinch brings the camera (framing.ts). Partners
+ *  stand about a metre apart; a dancer who steps out of it backs the camera off (Stage.frameCamera). */
 export const PAIR_HALF_WIDTH = 0.8;
+/** Seconds in which a camera that backed off for a dancer comes most of the way back (1 - 1/e). */
+const HOLD_SECONDS = 2;
 
 /** A polyline with a dot at every point, rewritten in place from a Float32Array of world points. */
 export class PathOverlay {
@@ -154,8 +158,23 @@ export class Stage {
   private readonly rendered = { view: new THREE.Matrix4(), projection: new THREE.Matrix4(), size: new THREE.Vector2(), stale: true };
   /** The controls were updated by needsRender() since the last render(). */
   private controlsUpdated = false;
-  /** Metres either side of the orbit target kept in the picture (keepInView). */
+  /** Metres around the orbit target kept in the picture from any angle (keepInView). */
   private halfWidth = PAIR_HALF_WIDTH;
+  /** The part of the canvas the pair is drawn in (CSS px; setFrame), null: all of it. */
+  private free: Rect | null = null;
+  /** The free part's size as framing.ts reads it (applyFrame). */
+  private window: FrameWindow = frameWindow({ left: 0, top: 0, right: 1, bottom: 1 }, 1, 45);
+  /** The nearest a wheel or a pinch may bring the camera at its angle now (updateClosest). */
+  private closest: number = LIMITS.distance[0];
+  /** Points around the cylinder the closest distance keeps in the picture (framing.ts). */
+  private cylinder = cylinderPoints(PAIR_HALF_WIDTH, TARGET_HEIGHT);
+  /** The distance the visitor chose (a wheel, a pinch, a link, reset view), within LIMITS. */
+  private chosen = DEFAULT_ORBIT.distance;
+  /** The distance the camera was put at after the last update: a change since is the visitor's. */
+  private placed = DEFAULT_ORBIT.distance;
+  /** How far the dancers' own heads and feet need the camera, held, and let go slowly. */
+  private held = 0;
+  private heldAt = 0;
 
   constructor(container: HTMLElement, parents: number[], maxGhosts: number, options: StageOptions = {}) {
     this.renderer = new THREE.WebGLRenderer({ antialias: true });
@@ -174,11 +193,12 @@ export class Stage {
     this.controls = new OrbitControls(this.camera, this.canvas);
     this.controls.enableDamping = true;
     this.controls.enablePan = false; // the camera follows the dancers; panning would fight that
-    // Limits a wheel, a pinch or a drag cannot pass (the same a shared link's camera is clamped
-    // to): never straight overhead nor under the floor, never farther than where the fog begins
-    // (14 m), and never closer than the screen's shape allows (keepInView, set in resize()).
-    this.controls.minDistance = LIMITS.distance[0];
-    this.controls.maxDistance = LIMITS.distance[1];
+    // Limits a drag cannot pass (the same a shared link's camera is clamped to): never straight
+    // overhead nor under the floor. How near and how far a wheel or a pinch may bring it is
+    // frameCamera()'s: never farther than where the fog begins (14 m), never closer than the pair
+    // fits in the free part of the screen, and farther while a dancer needs it.
+    this.controls.minDistance = 0;
+    this.controls.maxDistance = Infinity;
     this.controls.minPolarAngle = THREE.MathUtils.degToRad(LIMITS.polar[0]);
     this.controls.maxPolarAngle = THREE.MathUtils.degToRad(LIMITS.polar[1]);
     // One finger steers (the joystick in controls.ts); two fingers orbit and zoom.
@@ -259,8 +279,8 @@ export class Stage {
    */
   needsRender(): boolean {
     this.controls.update();
+    this.frameCamera();
     this.controlsUpdated = true;
-    this.camera.updateMatrixWorld();
     const { rendered } = this;
     return rendered.stale || !rendered.view.equals(this.camera.matrixWorld) || !rendered.projection.equals(this.camera.projectionMatrix) ||
       !rendered.size.equals(this.renderer.getDrawingBufferSize(_size));
@@ -276,20 +296,103 @@ export class Stage {
     if (now.x === width && now.y === height) return;
     this.renderer.setSize(width, height, false);
     this.camera.aspect = width / height;
-    this.camera.updateProjectionMatrix();
-    this.keepInView(this.halfWidth);
+    this.applyFrame();
   }
 
   /**
-   * Keep `halfWidth` metres either side of the orbit target (the pair's midpoint) in the picture:
-   * the camera may come no closer than that allows on this screen's width. On a portrait phone a
-   * pinch used to bring it 1.5 m from the pair, where the picture is 0.6 m wide and neither
-   * dancer was on screen. The controls apply it at their next update.
+   * Draw the pair in `free`, the part of the canvas (CSS px from its top-left) that the title card
+   * and the panel leave (web/ui/layout.ts): the picture's centre moves to its middle (a view
+   * offset: the orbit, the steering and the follow target are unchanged), and the camera comes no
+   * closer than the pair fits in it. On a phone with the settings sheet open the pair stood in the
+   * middle of the whole screen, heads under the title card and legs under the sheet.
    */
-  keepInView(halfWidth: number): void {
+  setFrame(free: Rect): void {
+    if (free === this.free) return;
+    this.free = free;
+    this.applyFrame();
+  }
+
+  /** The free part's view offset and closest distance, for this canvas size and halfWidth. */
+  private applyFrame(): void {
+    const width = this.renderer.getSize(_size).x, height = _size.y;
+    const free = this.free ?? { left: 0, top: 0, right: width, bottom: height };
+    const [x, y] = viewShift(free, width, height);
+    if (x !== 0 || y !== 0) this.camera.setViewOffset(width, height, x, y, width, height);
+    else this.camera.clearViewOffset();
+    this.camera.updateProjectionMatrix();
+    this.window = frameWindow(free, height, this.camera.fov);
+    this.held = 0; // what the dancers needed in the old frame says nothing about the new one
+    this.cylinder = cylinderPoints(this.halfWidth, TARGET_HEIGHT);
+    this.updateClosest();
+  }
+
+  /** The closest distance for the camera's angle now: the cylinder fits (framing.ts). */
+  private updateClosest(): void {
+    this.camera.updateMatrixWorld();
+    cameraBasis(this.camera, _basis);
+    this.closest = Math.max(LIMITS.distance[0], distanceToFit(this.cylinder, this.cylinder.length / 3, _basis, this.window));
+  }
+
+  /**
+   * Keep `halfWidth` metres around the orbit target (the pair's midpoint; in compare mode both
+   * pairs), from the floor to above the heads, in the picture: the camera may come no closer than
+   * that allows in the free part of this screen, at the angle it looks from (a drag to a low
+   * angle backs it off in the same frame). Returns that distance, for the angle now.
+   */
+  keepInView(halfWidth: number): number {
     this.halfWidth = halfWidth;
-    const tanHalfWidth = Math.tan(THREE.MathUtils.degToRad(this.camera.fov / 2)) * this.camera.aspect;
-    this.controls.minDistance = Math.max(LIMITS.distance[0], halfWidth / tanHalfWidth);
+    this.applyFrame();
+    return this.closest;
+  }
+
+  /**
+   * After each update of the controls: the camera at the distance the visitor chose, within the
+   * limits (LIMITS.distance, and no closer than the pair fits: keepInView), or farther while a
+   * dancer's head or feet need it (a step out of the cylinder, a turn at arm's length). The
+   * camera backs off at once (the frame on screen holds them whole) and comes back slowly.
+   */
+  private frameCamera(): void {
+    const target = this.controls.target;
+    _offset.copy(this.camera.position).sub(target);
+    const radius = _offset.length() || 1;
+    this.updateClosest();
+    // Within the limits of this layout (kept apart from the choice itself: when the sheet folds
+    // again the camera comes back to where the visitor had it).
+    const within = (d: number) => Math.min(Math.max(LIMITS.distance[1], this.closest), Math.max(this.closest, d));
+    // A change since the last frame is the visitor's zoom (a wheel turn, a pinch), by a factor of
+    // the distance they chose; within this layout's limits, so that no turn of the wheel is lost
+    // beyond them.
+    if (Math.abs(radius - this.placed) > 1e-6) this.chosen = clampDistance(within((this.chosen * radius) / this.placed));
+    const chosen = within(this.chosen);
+    const need = this.outlineNeed();
+    const now = performance.now();
+    const dt = this.heldAt > 0 ? Math.min(1, (now - this.heldAt) / 1000) : 0;
+    this.heldAt = now;
+    this.held = need >= this.held ? need : need + (this.held - need) * Math.exp(-dt / HOLD_SECONDS);
+    const distance = Math.max(chosen, this.held);
+    if (Math.abs(distance - radius) > 1e-9) {
+      this.camera.position.copy(target).addScaledVector(_offset, distance / radius);
+      this.camera.updateMatrixWorld();
+    }
+    this.placed = distance;
+  }
+
+  /** The distance the drawn dancers' heads and feet need (framing.ts), looking as the camera looks
+   *  (_basis, as updateClosest() just set it). */
+  private outlineNeed(): number {
+    const target = this.controls.target;
+    let need = 0;
+    for (const dancer of this.dancers) {
+      if (!dancer.group.visible) continue;
+      const points = dancer.outline(_outline);
+      for (let i = 0; i < points.length; i += 3) {
+        points[i] -= target.x;
+        points[i + 1] -= target.y;
+        points[i + 2] -= target.z;
+      }
+      need = Math.max(need, distanceToFit(points, OUTLINE.length, _basis, this.window));
+    }
+    return need;
   }
 
   /** Keep the pair in view: move the orbit target (and the camera with it) toward their midpoint. */
@@ -307,13 +410,16 @@ export class Stage {
     this.sun.position.set(this.followTarget.x + 3, 8, this.followTarget.z + 2);
   }
 
+  /** Where the camera is; `distance` is the one the visitor chose (it may stand farther while a
+   *  dancer needs it, or the sheet is open: frameCamera), which a link keeps. */
   getOrbit(): CameraOrbit {
     _offset.copy(this.camera.position).sub(this.controls.target);
     _spherical.setFromVector3(_offset);
+    const moved = Math.abs(_spherical.radius - this.placed) > 1e-6;
     return {
       azimuth: THREE.MathUtils.radToDeg(_spherical.theta) + 180,
       polar: THREE.MathUtils.radToDeg(_spherical.phi),
-      distance: _spherical.radius,
+      distance: moved ? clampDistance((this.chosen * _spherical.radius) / this.placed) : this.chosen,
     };
   }
 
@@ -333,6 +439,9 @@ export class Stage {
     this.camera.position.copy(this.controls.target).add(_offset);
     this.camera.lookAt(this.controls.target);
     this.controls.update();
+    // The visitor's distance now (frameCamera puts the camera farther if the pair needs it).
+    this.chosen = clampDistance(orbit.distance);
+    this.placed = this.camera.position.distanceTo(this.controls.target);
   }
 
   /** The camera's viewing direction projected on the floor, normalized: "forward" for steering. */
@@ -362,6 +471,23 @@ export class Stage {
     const rect = this.canvas.getBoundingClientRect();
     _offset.setFromMatrixPosition(body.boneMatrix(0)).project(this.camera);
     return [rect.left + ((_offset.x + 1) / 2) * rect.width, rect.top + ((1 - _offset.y) / 2) * rect.height];
+  }
+
+  /**
+   * Where a dancer's head top, toes and heels (body.ts OUTLINE) were last drawn, client pixels, or
+   * null for capsule figures: what the framing keeps clear of the title card and the panel.
+   */
+  outline(dancer: 'leader' | 'follower'): [number, number][] | null {
+    const body = dancer === 'leader' ? this.leader : this.followers[0];
+    if (!(body instanceof SkinnedDancer)) return null;
+    const rect = this.canvas.getBoundingClientRect();
+    const world = body.outline(_outline);
+    const points: [number, number][] = [];
+    for (let i = 0; i < OUTLINE.length; i++) {
+      _offset.fromArray(world, 3 * i).project(this.camera);
+      points.push([rect.left + ((_offset.x + 1) / 2) * rect.width, rect.top + ((1 - _offset.y) / 2) * rect.height]);
+    }
+    return points;
   }
 
   /** Dress a dancer in `avatar` (null: its own body again); false when the bodies are sticks. */
@@ -412,6 +538,7 @@ export class Stage {
     this.contacts.update(this.dancers);
     if (!this.controlsUpdated) this.controls.update();
     this.controlsUpdated = false;
+    this.frameCamera();
     this.renderer.render(this.scene, this.camera);
     const { rendered } = this;
     rendered.view.copy(this.camera.matrixWorld);
@@ -419,6 +546,19 @@ export class Stage {
     this.renderer.getDrawingBufferSize(rendered.size);
     rendered.stale = false;
   }
+}
+
+/** A distance within the limits a link and the visitor's zoom keep to (LIMITS.distance). */
+function clampDistance(distance: number): number {
+  return Math.min(LIMITS.distance[1], Math.max(LIMITS.distance[0], distance));
+}
+
+/** The camera's right, up and forward axes (world) from its matrix (after updateMatrixWorld). */
+function cameraBasis(camera: THREE.Camera, out: { right: number[]; up: number[]; forward: number[] }): void {
+  const e = camera.matrixWorld.elements;
+  out.right[0] = e[0]; out.right[1] = e[1]; out.right[2] = e[2];
+  out.up[0] = e[4]; out.up[1] = e[5]; out.up[2] = e[6];
+  out.forward[0] = -e[8]; out.forward[1] = -e[9]; out.forward[2] = -e[10];
 }
 
 /** A Lambert floor with 1 m grid lines (and darker lines every 5 m) drawn by its shader. */
@@ -443,3 +583,5 @@ const _delta = new THREE.Vector3();
 const _offset = new THREE.Vector3();
 const _spherical = new THREE.Spherical();
 const _size = new THREE.Vector2();
+const _outline = new Float32Array(3 * OUTLINE.length);
+const _basis: Basis & { right: number[]; up: number[]; forward: number[] } = { right: [1, 0, 0], up: [0, 1, 0], forward: [0, 0, -1] };

@@ -49,6 +49,14 @@ export interface Simulation {
   readonly anchor: ArrayLike<number>;
   /** Advance one 1/30 s step. */
   step(steer: Steer, temperature: number): Promise<void>;
+  /**
+   * The music the dancers hear from the next step on: its tempo (beats a minute), and the count
+   * that step is on (beats), read from the audio clock; null: the dance counts on by itself.
+   */
+  setCount(beat: number | null, tempo: number): void;
+  /** The count of the step on screen (beats since the music started) and the tempo it is at. */
+  readonly beat: number;
+  readonly tempo: number;
   leader: DancerView;
   /** One follower, or two in compare mode (ours first). */
   followers: DancerView[];
@@ -149,11 +157,26 @@ export interface Manifest {
   leaderGuard?: GuardSettings;
   /** The recording's range (training/evaluation/plausibility.py); the guard judges against it. */
   plausibility?: Ranges;
+  /** What the dancers hear: the tempo (beats a minute) when the address names none, and what the
+   *  tempo control offers; absent in older exports (web/mirror/music.ts DEFAULT_TEMPO). */
+  music?: { tempo: number; range?: [number, number] };
   credit: string;
 }
 
 /** Follower model choices in the panel and the URL. */
 export type FollowerChoice = 'ours' | 'ccm' | 'compare';
+
+/** One dancer in the test hook. `hip`: the drawn hip joint's height above the floor, metres;
+ *  `screen`: where the hips are drawn, client pixels (read when asked, for tests that drop files
+ *  on a dancer); `outline`: where the top of the head and each shoe's toe and heel are drawn,
+ *  client pixels (read when asked; null for capsule figures: web/draw/body.ts OUTLINE). */
+export interface DancerHook {
+  root: [number, number];
+  heading: number;
+  hip?: number;
+  screen?: [number, number] | null;
+  outline?: [number, number][] | null;
+}
 
 /** The test hook on window.duet: the end-to-end tests (tests/e2e) read only this. */
 export interface DuetHook {
@@ -161,10 +184,11 @@ export interface DuetHook {
   error: string | null;
   /** Simulation steps taken since the page loaded (not reset by R). */
   frame: number;
-  /** `hip`: the drawn hip joint's height above the floor, metres; `screen`: where the hips are
-   *  drawn, client pixels (read when asked, for tests that drop files on a dancer). */
-  leader: { root: [number, number]; heading: number; hip?: number; screen?: [number, number] | null };
-  follower: { root: [number, number]; heading: number; hip?: number; screen?: [number, number] | null };
+  /** The two dancers (DancerHook). */
+  leader: DancerHook;
+  follower: DancerHook;
+  /** Called after each frame is drawn, if set (tests read `outline` and the camera there). */
+  afterDraw?: () => void;
   /** step() wall time over the last 300 steps: features + both models + pose. */
   stepMs: { median: number; p95: number };
   /** Follower model in use: 'ours', 'ccm' or 'compare'. */
@@ -176,6 +200,17 @@ export interface DuetHook {
   turnAsked?: number;
   /** The spot the leader dances around (world x, z): it moves only while the visitor steers. */
   anchor?: [number, number];
+  /** The music's tempo, beats a minute, and the count of the step on screen (beats since the
+   *  music started, float): the music's while it plays, the dance's own silent count otherwise. */
+  tempo?: number;
+  beat?: number;
+  /** performance.now() when the step on screen read its count (from the music while it plays). */
+  countAt?: number;
+  /** The music (read when asked): its state, the audio context's, notes the band scheduled,
+   *  eighths it dropped (a main thread held past the lookahead), the count the listener hears now
+   *  and the audio clock's time of it, seconds, and the tempo the band plays (all null while none
+   *  plays). */
+  music?: { state: string; context: string; scheduled: number; dropped: number; heard: number | null; time: number | null; tempo: number | null; problem: string };
   /** The contact layer's hand hold between the leader and the (first) follower, 0..1
    *  (web/mirror/contact.ts): 1 when the closest hands meet. */
   hold: number;

@@ -17,7 +17,13 @@ const SVG = 'http://www.w3.org/2000/svg';
 const CLIP_FPS = 30;
 /** In order of preference: MP4 plays most widely (H.264 first), then WebM. */
 const CLIP_TYPES = ['video/mp4;codecs=avc1', 'video/mp4', 'video/webm;codecs=vp9', 'video/webm;codecs=vp8', 'video/webm'];
-const IDLE_LABEL = '● clip';
+/** "● clip"; the word is a span of its own, which a phone's one row of buttons folds away (style.css). */
+function idleLabel(): (string | Node)[] {
+  const word = document.createElement('span');
+  word.className = 'clip-word';
+  word.textContent = 'clip';
+  return ['● ', word];
+}
 const IDLE_TITLE = `save a ${CLIP_SECONDS} s video clip of the dance`;
 
 /** The first type this browser's MediaRecorder makes, or '' (let it choose). */
@@ -45,7 +51,7 @@ export class ClipButton {
     this.element = document.createElement('button');
     this.element.type = 'button';
     this.element.className = 'pause-button clip-button';
-    this.element.textContent = IDLE_LABEL;
+    this.element.replaceChildren(...idleLabel());
     this.element.title = IDLE_TITLE;
     this.element.setAttribute('aria-label', IDLE_TITLE);
     this.element.addEventListener('click', () => this.record());
@@ -96,7 +102,7 @@ export class ClipButton {
       stream.getTracks().forEach((track) => track.stop());
       this.recording = false;
       this.element.classList.remove('recording');
-      this.element.textContent = IDLE_LABEL;
+      this.element.replaceChildren(...idleLabel());
       this.badge.hidden = true;
     };
     recorder.addEventListener('stop', () => {

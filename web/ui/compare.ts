@@ -58,8 +58,7 @@ export class CompareLayout {
       const overlay = document.getElementById('overlay');
       this.overlayBottom = overlay ? overlay.getBoundingClientRect().bottom : 0;
       // No pinch can bring the camera closer than this either, while compare mode lasts.
-      stage.keepInView(HALF_WIDTH);
-      const needed = stage.controls.minDistance;
+      const needed = stage.keepInView(HALF_WIDTH);
       if (orbit.distance < needed) {
         this.distanceBefore = orbit.distance;
         stage.setOrbit({ ...orbit, distance: needed });

@@ -1,5 +1,6 @@
 // Steering input: arrow keys / WASD and a touch joystick, both relative to where the camera looks,
-// turned into one 2D vector on the floor (world x, z) of length 0..1. Space pauses, R resets.
+// turned into one 2D vector on the floor (world x, z) of length 0..1. Space pauses, R resets; a
+// double-click or a double tap on the floor frames both dancers again.
 // The keys steer wherever the focus is (a button, a checkbox, the partner menu): only a text field
 // keeps its keys.
 
@@ -8,6 +9,12 @@ import type { Steer } from '../engine/types';
 /** Joystick travel in CSS pixels for full speed, and the dead zone around the thumb. */
 const JOYSTICK_RADIUS = 60;
 const DEAD_ZONE = 6;
+/** A tap: a finger down and up within this long, moved less than this far. Two taps within
+ *  DOUBLE_TAP_MS of each other and DOUBLE_TAP_PX apart are a double tap. */
+const TAP_MS = 300;
+const TAP_PX = 12;
+const DOUBLE_TAP_MS = 400;
+const DOUBLE_TAP_PX = 40;
 
 const KEY_DIRECTIONS: Record<string, [number, number]> = {
   // [forward, right]
@@ -28,8 +35,10 @@ export interface ControlsOptions {
   viewForward(out: { x: number; z: number }): void;
   onPause(): void;
   onReset(): void;
-  /** T: lead the partner's turn to her right (clockwise seen from above, -1); Shift+T to her left (+1). */
+  /** T: the leader raises his right hand to lead her turn (-1); Shift+T his left (+1). */
   onTurn(direction: number): void;
+  /** A double-click or a double tap on the surface: frame both dancers again. */
+  onFrame?(): void;
 }
 
 export class Controls {
@@ -40,6 +49,9 @@ export class Controls {
   private readonly base: HTMLElement;
   private readonly knob: HTMLElement;
   private readonly touches = new Set<number>();
+  /** The finger down now (for taps), and the last tap's end: time (ms) and place. */
+  private readonly press = { id: -1, t: 0, x: 0, y: 0 };
+  private readonly lastTap = { t: -Infinity, x: 0, y: 0 };
 
   constructor(private readonly options: ControlsOptions) {
     // Keys are read by physical position (event.code), so WASD works on AZERTY keyboards too.
@@ -66,6 +78,7 @@ export class Controls {
     window.addEventListener('pointercancel', (event) => this.onPointerUp(event));
     // iOS Safari pinch-zooms the page through its own gesture events.
     document.addEventListener('gesturestart', (event) => event.preventDefault());
+    surface.addEventListener('dblclick', () => options.onFrame?.());
   }
 
   /** The current steering vector in world x/z (the same object every call). */
@@ -124,8 +137,10 @@ export class Controls {
     this.touches.add(event.pointerId);
     if (this.touches.size > 1) {
       this.release();
+      this.press.id = -1; // two fingers: not a tap
       return;
     }
+    Object.assign(this.press, { id: event.pointerId, t: event.timeStamp, x: event.clientX, y: event.clientY });
     const j = this.joystick;
     j.pointerId = event.pointerId;
     j.originX = event.clientX;
@@ -160,6 +175,21 @@ export class Controls {
   private onPointerUp(event: PointerEvent): void {
     this.touches.delete(event.pointerId);
     if (event.pointerId === this.joystick.pointerId) this.release();
+    if (event.pointerId === this.press.id && event.type === 'pointerup') this.tapped(event);
+  }
+
+  /** A finger lifted: a second tap close to the first, soon after it, frames the pair again. */
+  private tapped(event: PointerEvent): void {
+    const { press, lastTap } = this;
+    press.id = -1;
+    const still = Math.hypot(event.clientX - press.x, event.clientY - press.y) < TAP_PX;
+    if (!still || event.timeStamp - press.t > TAP_MS) return;
+    if (event.timeStamp - lastTap.t < DOUBLE_TAP_MS && Math.hypot(event.clientX - lastTap.x, event.clientY - lastTap.y) < DOUBLE_TAP_PX) {
+      lastTap.t = -Infinity;
+      this.options.onFrame?.();
+      return;
+    }
+    Object.assign(lastTap, { t: event.timeStamp, x: event.clientX, y: event.clientY });
   }
 
   private release(): void {
@@ -188,8 +218,13 @@ const NOT_TEXT = new Set(['button', 'checkbox', 'color', 'file', 'image', 'radio
  */
 export function releaseFocusAfterUse(root: HTMLElement): void {
   let pointer = false;
-  root.addEventListener('pointerdown', () => (pointer = true), { capture: true });
+  let mouse = false;
+  root.addEventListener('pointerdown', (event) => {
+    pointer = true;
+    mouse = event.pointerType === 'mouse';
+  }, { capture: true });
   window.addEventListener('keydown', () => (pointer = false), { capture: true });
+  guideNumberBoxes(root, () => pointer && mouse);
   root.addEventListener('click', () => {
     const active = document.activeElement;
     // A click on a menu opens it: the menu keeps the focus until a choice is made ('change').
@@ -199,4 +234,56 @@ export function releaseFocusAfterUse(root: HTMLElement): void {
   root.addEventListener('change', (event) => {
     if (event.target instanceof HTMLSelectElement) event.target.blur();
   });
+}
+
+/** How long a number box clicked with the mouse keeps the keys with nothing typed into it, ms. */
+export const NUMBER_BOX_IDLE_MS = 2500;
+
+/**
+ * A number box (the text field beside a slider) keeps the arrow keys while it has the focus: they
+ * change its number, and a visitor who clicked it and then pressed ↑ to lead saw the dancer stand
+ * still and the number creep up. So while one has the focus, a line over it says what the arrows
+ * do now and how to give them back; Enter gives them back (lil-gui blurs), and so does a moment
+ * with nothing typed after a mouse click (NUMBER_BOX_IDLE_MS: typing a number takes keys, which
+ * restart the wait). A box reached with Tab keeps the keys until Tab or Enter moves on.
+ */
+function guideNumberBoxes(root: HTMLElement, clicked: () => boolean): void {
+  const hint = document.createElement('div');
+  hint.className = 'keys-hint';
+  hint.setAttribute('role', 'status');
+  hint.hidden = true;
+  hint.textContent = '↑ ↓ change this number · Enter gives the arrows back to the dance';
+  document.body.append(hint);
+  let box: HTMLInputElement | null = null;
+  /** The box had the focus from a mouse click (not Tab). */
+  let byMouse = false;
+  let timer = 0;
+  const wait = () => {
+    clearTimeout(timer);
+    const held = box;
+    if (held && byMouse) timer = window.setTimeout(() => document.activeElement === held && held.blur(), NUMBER_BOX_IDLE_MS);
+  };
+  root.addEventListener('focusin', (event) => {
+    const target = event.target;
+    if (!(target instanceof HTMLInputElement) || !typesText(target) || !target.closest('.lil-number')) return;
+    box = target;
+    byMouse = clicked();
+    hint.hidden = false;
+    // Over the box, inside the window (a panel at the right edge).
+    const r = target.getBoundingClientRect();
+    const width = hint.offsetWidth;
+    hint.style.left = `${Math.max(4, Math.min(window.innerWidth - width - 4, r.left + r.width / 2 - width / 2))}px`;
+    hint.style.top = `${Math.max(4, r.top - hint.offsetHeight - 6)}px`;
+    wait();
+  });
+  root.addEventListener('focusout', (event) => {
+    if (event.target !== box) return;
+    box = null;
+    hint.hidden = true;
+    clearTimeout(timer);
+  });
+  // In the capture phase: lil-gui keeps its keys from bubbling out of the panel.
+  root.addEventListener('keydown', (event) => {
+    if (box && event.target === box) wait();
+  }, { capture: true });
 }

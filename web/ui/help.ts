@@ -4,7 +4,13 @@
 // longer explanation of every control, the keys, the research names and the engine's live
 // figures) waits behind "more", a fold a visitor never needs and a researcher finds in one click.
 // The dance holds still while the help is open (main.ts): it is read, not watched.
-// Text only (textContent), built once.
+// Text only (textContent), built once. Every number it states about the page comes from where the
+// page takes it (the manifest, the controls' limits, the clip's length: HelpFacts), and
+// tests/web/help.test.ts checks each against those. Where the card needs scrolling (a phone held
+// sideways), a "more below" line at its bottom edge says so until the end is in view.
+
+import type { Manifest } from '../engine/types';
+import { CLIP_SECONDS } from './clip';
 
 export interface HelpOptions {
   /** [label, one short sentence] per control or mark on the picture: shown at once. */
@@ -17,27 +23,70 @@ export interface HelpOptions {
   details?: HTMLElement;
   /** The help opened (true) or closed (false). */
   onToggle?(open: boolean): void;
+  /** The numbers the help states, as the page has them. */
+  facts: HelpFacts;
 }
 
-const METHOD = [
-  'You lead the blue dancer; the red partner is a small neural network that picks her next pose thirty times a second from the last second of both dancers.',
-  'Before each move she guesses where your head, hands and feet are going (your intention) and reacts to that guess, as a follower reads her leader.',
-  'She learned from recorded salsa couples, and everything runs in this page.',
-];
+/** What the help says in numbers, from where the page takes them (main.ts: the manifest). */
+export interface HelpFacts {
+  /** Steps a second (manifest.fps). */
+  fps: number;
+  /** The partner's variety (sampling temperature) a page starts with (manifest.defaultTemperature). */
+  variety: number;
+  /** The leader model's own variety (manifest.leaderTemperature); null: he takes the partner's. */
+  leaderVariety: number | null;
+  /** The upright guard's fresh samples (manifest.guard.samples); null: no guard. */
+  uprightSamples: number | null;
+}
 
-const KEYS =
-  'Keys: arrows or WASD lead · T raise your right hand over her to lead a turn, Shift+T your left · Space pause · R start again (the camera too) · ' +
-  '“● clip” saves a 6 s video, the corners button goes full screen · drag to turn the camera, wheel to zoom. Phone: drag one finger ' +
-  'to lead, two fingers to turn and zoom; “pause” and the two “turn” buttons by the title.';
+/** The facts of a manifest, for a page whose partner starts at `variety` (the address may say
+ *  another: the manifest's defaultTemperature, within the control's limits). */
+export function helpFacts(manifest: Manifest, variety: number): HelpFacts {
+  const guard = manifest.guard;
+  return {
+    fps: manifest.fps,
+    variety,
+    leaderVariety: manifest.leaderTemperature ?? null,
+    // The upright guard acts where simulation.ts starts it: samples to choose from, and the range.
+    uprightSamples: guard && guard.samples >= 2 && manifest.plausibility ? guard.samples : null,
+  };
+}
 
-const RESEARCH =
-  'Research names: "reads your intention" is this project\'s follower (ours), which predicts the leader\'s ' +
-  'future key joints and conditions its pose on them; "baseline, no intention" is CCM, the same network ' +
-  'without that step; "variety" is the partner\'s sampling temperature (the leader model keeps 0.5); ' +
-  '"possible reactions" are ghost rollouts (copies of the follower branched off at staggered steps ' +
-  'within the last second, each run on by her model with fresh noise); an "upright choice" ' +
-  'is a step in which the partner\'s sampled pose would have left the recorded dancers\' range (hips low, ' +
-  'torso tipping) and the page took the most upright of 32 fresh samples instead.';
+/** The method in three sentences (shown at once). */
+export function methodText(facts: HelpFacts): string[] {
+  return [
+    `You lead the blue dancer; the red partner is a small neural network that picks her next pose ${facts.fps} times a second from the last second of both dancers.`,
+    'Before each move she guesses where your head, hands and feet are going (your intention) and reacts to that guess, as a follower reads her leader.',
+    'She learned from recorded salsa couples, and everything runs in this page.',
+  ];
+}
+
+/** Every key and gesture (in the "more" fold). */
+export function keysText(): string {
+  return (
+    'Keys: arrows or WASD lead · T: your dancer raises his right hand over her to lead a turn, Shift+T his left (she may turn either way) · ' +
+    'Space pause · R start again (the camera too) · ' +
+    `“● clip” saves a ${CLIP_SECONDS} s video, the corners button goes full screen · drag to turn the camera, wheel to zoom, ` +
+    'double-click to frame both dancers again. Phone: drag one finger to lead, two fingers to turn and zoom, double-tap to frame ' +
+    'them again; “pause” and the two “turn” buttons by the title. After a click in a number box the arrows change its number ' +
+    'until Enter, or a moment without typing, gives them back to the dance.'
+  );
+}
+
+/** The research names behind the plain ones (in the "more" fold). */
+export function researchText(facts: HelpFacts): string {
+  const leader = facts.leaderVariety === null ? 'the leader model dances with the same' : `the leader model keeps ${facts.leaderVariety}`;
+  const upright = facts.uprightSamples === null ? '' :
+    '; an "upright choice" is a step in which the partner\'s sampled pose would have left the recorded dancers\' range (hips low, ' +
+    `torso tipping) and the page took the most upright of ${facts.uprightSamples} fresh samples instead`;
+  return (
+    'Research names: "reads your intention" is this project\'s follower (ours), which predicts the leader\'s ' +
+    'future key joints and conditions its pose on them; "baseline, no intention" is CCM, the same network ' +
+    `without that step; "variety" is the partner's sampling temperature (it starts at ${facts.variety}; ${leader}); ` +
+    '"possible reactions" are ghost rollouts (copies of the follower branched off at staggered steps ' +
+    `within the last second, each run on by her model with fresh noise)${upright}.`
+  );
+}
 
 function element<K extends keyof HTMLElementTagNameMap>(tag: K, className = '', text = ''): HTMLElementTagNameMap[K] {
   const e = document.createElement(tag);
@@ -62,6 +111,8 @@ export class Help {
   readonly overlay: HTMLElement;
   readonly card: HTMLElement;
   readonly details: HTMLDetailsElement;
+  /** The "more below" cue at the card's bottom edge. */
+  readonly moreBelow: HTMLElement;
 
   constructor(private readonly options: HelpOptions) {
     this.button = element('button', 'help-button', '?');
@@ -87,7 +138,7 @@ export class Help {
     const heading = element('h2', '', 'How duet works');
     heading.id = 'help-heading';
     card.append(close, heading);
-    for (const sentence of METHOD) card.append(element('p', 'help-method', sentence));
+    for (const sentence of methodText(options.facts)) card.append(element('p', 'help-method', sentence));
     card.append(list('help-brief', options.brief));
 
     // Class about-details: tests treat what is inside as the fold where research terms may stand.
@@ -95,12 +146,21 @@ export class Help {
     this.details.append(
       element('summary', '', 'more: every control in full, the keys, research names, live figures'),
       list('help-controls', options.controls),
-      element('p', 'help-keys-line', KEYS),
-      element('p', '', RESEARCH),
+      element('p', 'help-keys-line', keysText()),
+      element('p', '', researchText(options.facts)),
       element('p', '', options.note),
     );
     if (options.details) this.details.append(options.details);
-    card.append(this.details);
+    // "more below": held at the card's bottom edge while there is more to scroll to. No height of
+    // its own (its words hang above it), so it never makes the card scroll.
+    this.moreBelow = element('div', 'help-more-below');
+    this.moreBelow.append(element('span', '', 'more below ↓'));
+    this.moreBelow.setAttribute('aria-hidden', 'true');
+    card.append(this.details, this.moreBelow);
+    const cue = () => this.showMoreBelow();
+    card.addEventListener('scroll', cue, { passive: true });
+    this.details.addEventListener('toggle', cue);
+    new ResizeObserver(cue).observe(card);
     this.overlay.append(card);
     // A click on the dimmed backdrop (not the card) closes, as does Escape.
     this.overlay.addEventListener('click', (event) => {
@@ -123,7 +183,14 @@ export class Help {
     if (show) {
       this.details.open = false; // each opening starts short: the part that fits the screen
       this.card.scrollTop = 0;
+      this.showMoreBelow();
     }
     this.options.onToggle?.(show);
+  }
+
+  /** Whether the card has more below what it shows (a phone held sideways): the cue says so. */
+  private showMoreBelow(): void {
+    const card = this.card;
+    this.moreBelow.classList.toggle('shown', card.scrollTop + card.clientHeight < card.scrollHeight - 2);
   }
 }

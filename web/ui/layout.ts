@@ -1,21 +1,51 @@
-// Keep the dancers in the part of the screen the panel leaves free. On a wide screen the open
-// panel is a card over the right edge (a drawer on a short screen); the camera's picture is
-// shifted left by half its width. On a phone the open panel is a sheet over the bottom, as tall
-// as its controls (half the screen): the picture moves up, so that the pair stands in the middle
-// of the band between the title card and the sheet. A view offset: the orbit, the steering and
-// the follow target are unchanged. The folded panel covers nothing that matters and leaves the
-// picture centred.
+// Keep the dancers in the part of the screen the page leaves them: below the title card, above a
+// phone's settings sheet (open, or its folded bar), left of the open panel card or drawer (wide
+// and landscape screens), below the folded panel's title bar at the top right. The stage centres
+// the picture in that part and keeps the camera far enough for both dancers' heads and feet to
+// fit in it (web/draw/scene.ts setFrame, web/draw/framing.ts). Measured only when the panel, the
+// title card or the window change size, never per frame.
 
+import type { Rect } from '../draw/framing';
 import type { Stage } from '../draw/scene';
 
+/**
+ * The free part of a `width` x `height` screen, given the title card's box and the panel's (CSS px).
+ * Each covers a band: the title card and a short box at the top (the folded panel's bar) the top,
+ * a full-width box at the bottom (the sheet, open or folded) the bottom, a tall box at the right
+ * (the open card or drawer) the right side.
+ */
+export function freePart(width: number, height: number, boxes: readonly (DOMRectReadOnly | Rect | null)[]): Rect {
+  const free = { left: 0, top: 0, right: width, bottom: height };
+  for (const box of boxes) {
+    if (!box || box.right - box.left < 1 || box.bottom - box.top < 1) continue;
+    const boxWidth = box.right - box.left, boxHeight = box.bottom - box.top;
+    if (boxWidth > 0.9 * width && box.bottom > height - 2) free.bottom = Math.min(free.bottom, box.top);
+    else if (box.top < 40 && box.left > width / 2 && boxHeight > height / 3) free.right = Math.min(free.right, box.left);
+    else if (box.top < 40 && boxHeight <= height / 3) free.top = Math.max(free.top, box.bottom);
+  }
+  return free;
+}
+
+/** Longer than lil-gui's open / fold animation (0.3 s). */
+const SETTLE_MS = 800;
+
+/** Every list in the panel at its own height, and no open / fold animation left running. */
+function settle(panel: HTMLElement): void {
+  for (const gui of [panel, ...panel.querySelectorAll<HTMLElement>('.lil-gui')]) {
+    const list = gui.querySelector<HTMLElement>(':scope > .lil-children');
+    if (!list || !gui.classList.contains('lil-transition')) continue;
+    list.style.height = '';
+    gui.classList.remove('lil-transition');
+  }
+}
+
 export class ViewCentre {
-  private shiftX = 0;
-  private shiftY = 0;
-  private applied = '';
+  private free: Rect;
   /** Where the open card or drawer begins (px from the left), or the window's width. */
   freeWidth = window.innerWidth;
 
-  constructor(private readonly panel: HTMLElement, private readonly isOpen: () => boolean) {
+  constructor(private readonly panel: HTMLElement) {
+    this.free = { left: 0, top: 0, right: window.innerWidth, bottom: window.innerHeight };
     const measure = () => this.measure();
     const observer = new ResizeObserver(measure);
     observer.observe(panel);
@@ -23,31 +53,31 @@ export class ViewCentre {
     if (title) observer.observe(title);
     window.addEventListener('resize', measure);
     this.measure();
+    // lil-gui opens and folds a panel by animating its list to a height it measured, and lets the
+    // list take its own height again when the animation ends; when the animation is cut short
+    // (seen on phones: one opening in three under load) the list keeps that height, and the open
+    // sheet stood 152 px taller than its controls (625 px for 473), over the dancers' band. Once
+    // the animation is long over, any list still held at a height gets its own again.
+    panel.addEventListener('click', (event) => {
+      if (event.target instanceof Element && event.target.closest('.lil-title')) setTimeout(() => settle(panel), SETTLE_MS);
+    });
   }
 
-  /** Measured only when the panel, the title card or the window changes size, never per frame. */
   private measure(): void {
-    const rect = this.panel.getBoundingClientRect();
-    const width = window.innerWidth, height = window.innerHeight;
-    const open = this.isOpen();
-    // A card or drawer at the top right (not a full-width sheet at the bottom).
-    const card = open && rect.top < 40 && rect.left > width / 2 && rect.height > 80;
-    this.shiftX = card ? Math.round((width - rect.left) / 2) : 0;
-    this.freeWidth = card ? rect.left : width;
-    // A sheet across the bottom, open (taller than its folded bar).
-    const sheet = open && rect.width > 0.9 * width && rect.bottom > height - 2 && rect.height > 80;
-    const titleBottom = document.getElementById('overlay')?.getBoundingClientRect().bottom ?? 0;
-    this.shiftY = sheet ? Math.max(0, Math.round(height / 2 - (titleBottom + rect.top) / 2)) : 0;
+    // A new object on a change (never per frame): the stage compares it by identity.
+    const title = document.getElementById('overlay');
+    this.free = freePart(window.innerWidth, window.innerHeight, [title?.getBoundingClientRect() ?? null, this.panel.getBoundingClientRect()]);
+    this.freeWidth = this.free.right;
   }
 
-  /** Apply the shift to the camera when it, or the canvas size, changed (call once per frame). */
+  /** The free part as last measured (client px). */
+  get part(): Rect {
+    return this.free;
+  }
+
+  /** Give the stage the free part (the canvas fills the window: client px are canvas px). The
+   *  stage acts only on a change: call once per frame. */
   update(stage: Stage): void {
-    const canvas = stage.canvas;
-    const width = canvas.clientWidth, height = canvas.clientHeight;
-    const key = `${this.shiftX} ${this.shiftY} ${width} ${height}`;
-    if (key === this.applied) return;
-    this.applied = key;
-    if (this.shiftX > 0 || this.shiftY > 0) stage.camera.setViewOffset(width, height, this.shiftX, this.shiftY, width, height);
-    else stage.camera.clearViewOffset();
+    stage.setFrame(this.free);
   }
 }

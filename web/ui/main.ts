@@ -36,6 +36,10 @@ import { RecordPanel } from './recordpanel';
 import { LeaderFileInput, MAX_AVATAR_BYTES, displayName } from './dropzone';
 import { showToast } from './toast';
 import { afterPaint, bootMark, bootSpan, bootTimings } from '../engine/boot';
+import { Music } from './music';
+import { CountDisplay } from './count';
+import { helpFacts } from './help';
+import { manifestTempo } from '../mirror/rollout';
 
 // Every static import above (three.js included) has been fetched, parsed and run by now.
 bootMark('main');
@@ -121,6 +125,10 @@ class Page {
   private readonly leaderFileInput: LeaderFileInput;
   private readonly avatarInput: HTMLInputElement;
   private readonly recordPanel: RecordPanel;
+  private readonly music: Music;
+  private readonly count: CountDisplay;
+  /** The manifest's tempo: the address names another only when it differs. */
+  private readonly defaultTempo: number;
 
   private simulation: Simulation | null = null;
   /** The visitor's pause (Space, the pause button). */
@@ -168,7 +176,8 @@ class Page {
     private readonly fetcher: Fetcher,
     private readonly loading: LoadingBar,
   ) {
-    this.defaults = defaultSettings(manifest.defaultTemperature);
+    this.defaultTempo = manifestTempo(manifest);
+    this.defaults = defaultSettings(manifest.defaultTemperature, this.defaultTempo);
     this.settings = readSettings(location.search, this.defaults);
     this.hasCcm = 'follower_ccm' in manifest.models;
     if (!this.hasCcm) this.settings.model = 'ours';
@@ -183,6 +192,7 @@ class Page {
     for (const dancer of ['leader', 'follower'] as const) {
       const stage = this.stage;
       Object.defineProperty(hook[dancer], 'screen', { enumerable: true, get: () => stage.screenPoint(dancer) });
+      Object.defineProperty(hook[dancer], 'outline', { enumerable: true, get: () => stage.outline(dancer) });
     }
     Object.defineProperty(hook, 'camera', { enumerable: true, get: () => this.stage.getOrbit() });
     Object.defineProperty(hook, 'ghostHips', { enumerable: true, get: () => this.ghostPoses.slice(0, this.settings.ghosts).map((p) => [p[0], p[2]]) });
@@ -196,6 +206,21 @@ class Page {
     this.hud.setStatus('loading the dancers…');
     const credit = document.getElementById('credit');
     if (credit) credit.textContent = manifest.credit ?? '';
+    // The music starts with the first key press or tap (browsers' autoplay rules): the dance's
+    // silent count runs until then, and the band joins it where it is.
+    this.music = new Music(this.settings.tempo, this.settings.music, () => this.simulation?.beat ?? 0);
+    const startMusic = () => {
+      if (this.settings.speed === 1) this.music.gesture();
+    };
+    window.addEventListener('keydown', startMusic, { capture: true });
+    window.addEventListener('pointerdown', startMusic, { capture: true });
+    this.count = new CountDisplay(document.getElementById('overlay')!);
+    Object.defineProperty(hook, 'music', {
+      enumerable: true,
+      get: () => ({ state: this.music.state, context: this.music.contextState, scheduled: this.music.scheduled, dropped: this.music.dropped, heard: this.music.heardBeat(), time: this.music.heardTime(), tempo: this.music.playingTempo, problem: this.music.problem }),
+    });
+    Object.defineProperty(hook, 'beat', { enumerable: true, get: () => this.simulation?.beat ?? 0 });
+    Object.defineProperty(hook, 'tempo', { enumerable: true, get: () => this.settings.tempo });
 
     this.controls = new Controls({
       surface: this.stage.canvas,
@@ -203,6 +228,7 @@ class Page {
       onPause: () => this.togglePause(),
       onReset: () => this.reset(),
       onTurn: (direction) => this.askTurn(direction),
+      onFrame: () => this.resetView(),
     });
     const panel = (this.panel = this.createPanel());
     this.pauseButton = new PauseButton(() => this.togglePause());
@@ -213,7 +239,7 @@ class Page {
     hook.askTurn = (direction) => this.askTurn(direction); // tests lead a turn the way T does
     // After a click on a control the keys belong to the dance again (controls.ts).
     releaseFocusAfterUse(document.body);
-    this.viewCentre = new ViewCentre(panel.gui.domElement, () => !panel.gui._closed);
+    this.viewCentre = new ViewCentre(panel.gui.domElement);
     // A drag or a wheel turn moved the camera: the address follows it until it stands still.
     this.stage.controls.addEventListener('end', () => {
       clearTimeout(this.cameraCheck);
@@ -260,13 +286,19 @@ class Page {
       models: this.hasCcm ? ['ours', 'ccm', 'compare'] : ['ours'],
       onModel: (choice) => this.useModel(choice).catch(this.keepDancingIfUpdated),
       onGhosts: () => this.exclusive(() => this.refreshGhosts()).catch(this.fail),
+      onTempo: (bpm) => this.music.setTempo(bpm),
+      onMusic: (on) => this.music.setEnabled(on),
       onReset: () => this.reset(),
       onResetView: () => this.resetView(),
       onShare: () => this.share(),
       onSkeleton: this.stage.bodies === 'skinned' ? (on) => (this.stage.skeleton = on) : undefined,
       onSettingsChange: () => this.writeAddress(),
       details: this.hud.details,
-      onHelp: (open) => (this.helpOpen = hook.helpOpen = open),
+      onHelp: (open) => {
+        this.helpOpen = hook.helpOpen = open;
+        this.music?.hold(this.paused || open);
+      },
+      facts: helpFacts(this.manifest, this.defaults.temperature),
     });
   }
 
@@ -358,6 +390,7 @@ class Page {
 
   private togglePause(): void {
     this.paused = !this.paused;
+    this.music.hold(this.paused || this.helpOpen);
     hook.paused = this.paused;
     this.pauseButton.show(this.paused);
     this.hud.setStatus(this.status());
@@ -382,7 +415,7 @@ class Page {
     const orbit = this.stage.getOrbit();
     this.cameraPlace = formatCamera(orbit);
     const camera = this.cameraPlace === formatCamera(DEFAULT_ORBIT) ? null : orbit;
-    const query = addressQuery(location.search, this.settings, camera, this.defaults.temperature);
+    const query = addressQuery(location.search, this.settings, camera, this.defaults.temperature, this.defaultTempo);
     const url = `${location.origin}${location.pathname}?${query}${location.hash}`;
     history.replaceState(history.state, '', url);
     return url;
@@ -501,6 +534,12 @@ class Page {
     const began = performance.now();
     let steps = 0;
     while (this.simulation && this.accumulator >= DT) {
+      // The count this step is on: while the music plays, what the listener hears now, less the
+      // steps still owed after this one (the backlog is dance time not yet shown).
+      const tempo = this.settings.tempo;
+      const heard = this.music.heardBeat();
+      this.simulation.setCount(heard === null ? null : heard - ((this.accumulator - DT) * tempo) / 60, tempo);
+      hook.countAt = performance.now();
       await this.simulation.step(this.controls.getSteer(), this.settings.temperature);
       this.accumulator -= DT;
       steps++;
@@ -519,6 +558,7 @@ class Page {
       if (performance.now() - began > Math.max(MIN_STEP_BUDGET_MS, this.drawMs)) break;
     }
     if (steps > 0) this.recordPanel.update();
+    if (steps > 0 && this.simulation) this.count.show(this.simulation.beat);
     this.steppedMs += performance.now() - began;
   }
 
@@ -632,6 +672,7 @@ class Page {
     compare.placeLabels(stage, midX, midZ, this.viewCentre.freeWidth);
     stage.render();
     hook.drawn = (hook.drawn ?? 0) + 1;
+    hook.afterDraw?.();
     if (hook.frame > 0 && !('first-drawn' in bootTimings)) {
       bootMark('first-drawn');
       afterPaint((at) => {

@@ -85,6 +85,11 @@ export class Music {
     return this.groove?.dropped ?? 0;
   }
 
+  /** The tempo the band plays now (a new one takes over once rendered); null before it plays. */
+  get playingTempo(): number | null {
+    return this.groove?.tempo ?? null;
+  }
+
   get contextState(): string {
     return this.ctx?.state ?? 'none';
   }

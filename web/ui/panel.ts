@@ -7,7 +7,8 @@ import GUI from 'lil-gui';
 import type { Settings } from './share';
 import { LIMITS } from './share';
 import type { FollowerChoice } from '../engine/types';
-import { Help } from './help';
+import { Help, type HelpFacts } from './help';
+import { CLIP_SECONDS } from './clip';
 
 export interface PanelOptions {
   settings: Settings;
@@ -15,6 +16,9 @@ export interface PanelOptions {
   models: FollowerChoice[];
   onModel(model: FollowerChoice): void;
   onGhosts(count: number): void;
+  /** The music's tempo changed (beats a minute), or it was muted / switched on. */
+  onTempo(bpm: number): void;
+  onMusic(on: boolean): void;
   onReset(): void;
   onResetView(): void;
   onShare(): void;
@@ -26,6 +30,8 @@ export interface PanelOptions {
   details?: HTMLElement;
   /** The help opened or closed (the dance holds still while it is open). */
   onHelp?(open: boolean): void;
+  /** The numbers the help states (the manifest's: help.ts HelpFacts). */
+  facts: HelpFacts;
 }
 
 /** What the intention adds on this data, as measured (docs/results.md, "The paper's claim,
@@ -48,8 +54,9 @@ export const MODEL_LABELS: Record<FollowerChoice, string> = {
 export const CONTROLS = {
   model: ['partner', 'Which network dances with you: one that first guesses where your body is going (your intention), a baseline that does not, or both side by side with a copy of you each.'],
   temperature: ['variety', 'Low: the partner always makes its most likely move; high: it picks more varied, sometimes wilder moves.'],
-  speed: ['speed', 'Plays the whole dance slower or faster.'],
-  ghosts: ['possible reactions', 'Up to 8 faint partners, one colour each: copies of her that branched off within the last second and dance on with moves of their own.'],
+  tempo: ['tempo', `The music’s beats a minute (${LIMITS.tempo[0]}-${LIMITS.tempo[1]}); both dancers hear it and dance on its count.`],
+  music: ['music', 'Plays the salsa band (from your first key or tap); off, the dance keeps its count in silence.'],
+  ghosts: ['possible reactions', `Up to ${LIMITS.ghosts[1]} faint partners, one colour each: copies of her that branched off within the last second and dance on with moves of their own.`],
   trajectories: ['floor paths', "Each dancer's path on the floor, a second ahead."],
   intentions: ['show what the partner expects', "Purple lines: where the partner expects your head, hands and feet to go over the next second."],
   reset: ['start again (R)', 'Both dancers go back to the opening pose, and the camera to its first view.'],
@@ -72,13 +79,13 @@ const [label, help] = [(k: keyof typeof CONTROLS) => CONTROLS[k][0], (k: keyof t
  * sentences above are in the help's "more" fold. */
 export const BRIEF: readonly (readonly [string, string])[] = [
   ['arrows · WASD · finger', 'Lead the blue dancer.'],
-  ['drag · wheel · 2 fingers', 'Move the camera.'],
+  ['drag · wheel · 2 fingers', 'Move the camera; a double tap brings both dancers back.'],
   ['pause (Space)', 'Holds the dance, or lets it go on.'],
-  ['↻ turn ↺ (T, Shift+T)', 'Your dancer leads her turn; she only reads his motion.'],
-  ['● clip · corners', 'Save a 6 s video · full screen.'],
+  ['R- · L-hand turn (T, Shift+T)', 'He raises that hand to lead her turn; she may turn either way.'],
+  ['● clip · corners', `Save a ${CLIP_SECONDS} s video · full screen.`],
   ['partner', 'Reads your intention, a baseline that does not, or both side by side.'],
   ['variety', 'Low: her likeliest move; high: wilder ones.'],
-  ['speed', 'The whole dance slower or faster.'],
+  ['tempo · music', 'The band’s beats a minute · sound on or off; both dance on its count.'],
   ['possible reactions', 'Faint partners, a colour each: other moves she could make now.'],
   ['floor paths', 'Each dancer’s path, a second ahead.'],
   ['show what the partner expects', 'Purple: where she expects your head, hands and feet.'],
@@ -109,7 +116,8 @@ export class Panel {
     const model = this.gui.add(settings, 'model', choices).name(label('model')).onChange((m: FollowerChoice) => options.onModel(m));
     model.domElement.title = help('model');
     this.gui.add(settings, 'temperature', ...LIMITS.temperature, 0.05).name(label('temperature'));
-    this.gui.add(settings, 'speed', ...LIMITS.speed, 0.25).name(label('speed'));
+    this.gui.add(settings, 'tempo', ...LIMITS.tempo, 1).name(label('tempo')).onChange((bpm: number) => options.onTempo(bpm));
+    this.gui.add(settings, 'music').name(label('music')).onChange((on: boolean) => options.onMusic(on));
     this.gui.add(settings, 'ghosts', ...LIMITS.ghosts, 1).name(label('ghosts')).onChange((k: number) => options.onGhosts(k));
     this.gui.add(settings, 'trajectories').name(label('trajectories'));
     this.gui.add(settings, 'intentions').name(label('intentions'));
@@ -128,6 +136,7 @@ export class Panel {
       note: INTENTION_NOTE,
       details: options.details,
       onToggle: options.onHelp,
+      facts: options.facts,
     });
   }
 

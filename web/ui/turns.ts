@@ -1,24 +1,38 @@
 // "Lead a turn": the two buttons beside pause (a phone has no T key). Each asks the leader model
-// to lead the partner's turn now, to her right or to her left (Simulation.askTurn); the follower
-// is never told: she turns only if she reads it in the leader's motion.
+// to lead the partner's turn now (Simulation.askTurn): he raises his right hand over her (T) or
+// his left (Shift+T). The follower is never told: she turns only if she reads it in his motion,
+// and today she may turn either way whichever hand he raises (issue 51), so the buttons name the
+// hand, not a direction. On a phone the word "hand" folds away (one row of buttons: style.css).
+
+/** [direction for Simulation.askTurn, hand letter, hand, key]. */
+const TURNS = [
+  [-1, 'R', 'right', 'T'],
+  [1, 'L', 'left', 'Shift+T'],
+] as const;
+
+/** What a turn button says it does, in its tooltip and to a screen reader. */
+export function turnTitle(hand: 'right' | 'left', key: string): string {
+  return `lead a turn: he raises his ${hand} hand over her (${key}); she may turn either way`;
+}
 
 export class TurnButtons {
   private readonly buttons: HTMLButtonElement[] = [];
   private shown = 0;
 
-  /** `onTurn(direction)`: -1 her right (clockwise seen from above), +1 her left. */
+  /** `onTurn(direction)`: -1 his right hand raised (T), +1 his left (Shift+T). */
   constructor(onTurn: (direction: number) => void) {
     const row = document.querySelector('#overlay .title-row') ?? document.body;
-    for (const [direction, label, title] of [
-      [-1, '↻ turn', 'lead her turn to her right (T)'],
-      [1, '↺ turn', 'lead her turn to her left (Shift+T)'],
-    ] as const) {
+    for (const [direction, letter, hand, key] of TURNS) {
       const button = document.createElement('button');
       button.type = 'button';
       button.className = 'pause-button turn-button';
-      button.textContent = label;
-      button.title = title;
-      button.setAttribute('aria-label', title);
+      // "R-hand turn": the letter, "-hand" (hidden on a phone), " turn".
+      const word = document.createElement('span');
+      word.className = 'turn-hand';
+      word.textContent = '-hand';
+      button.append(letter, word, ' turn');
+      button.title = turnTitle(hand, key);
+      button.setAttribute('aria-label', button.title);
       button.addEventListener('click', () => onTurn(direction));
       row.append(button);
       this.buttons.push(button);
@@ -29,6 +43,6 @@ export class TurnButtons {
   show(direction: number): void {
     if (direction === this.shown) return;
     this.shown = direction;
-    this.buttons.forEach((b, i) => b.classList.toggle('leading', direction === (i === 0 ? -1 : 1)));
+    this.buttons.forEach((b, i) => b.classList.toggle('leading', direction === TURNS[i][0]));
   }
 }
