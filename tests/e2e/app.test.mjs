@@ -293,9 +293,7 @@ describe('phone', () => {
       await sleep(200);
     }
   };
-  /** Boxes that share more than a pixel each way (a legend 16.8 px tall on a whole pixel's row
-   *  can touch a sheet by 0.8 px: nothing a visitor sees, and it came and went between runs). */
-  const overlap = (a, b) => a.x + 1 < b.x + b.w && b.x + 1 < a.x + a.w && a.y + 1 < b.y + b.h && b.y + 1 < a.y + a.h;
+  const overlap = (a, b) => a.x < b.x + b.w && b.x < a.x + a.w && a.y < b.y + b.h && b.y < a.y + a.h;
   const check = (b, state) => {
     const open = b.panel.h > 60;
     const pairs = [['title', 'hud'], ['title', 'panel'], ['hud', 'panel'], ['title', 'leader'], ['title', 'follower'], ['panel', 'leader'], ['panel', 'follower']];
