@@ -218,13 +218,13 @@ const NOT_TEXT = new Set(['button', 'checkbox', 'color', 'file', 'image', 'radio
  */
 export function releaseFocusAfterUse(root: HTMLElement): void {
   let pointer = false;
-  let mouse = false;
+  let pointerType = '';
   root.addEventListener('pointerdown', (event) => {
     pointer = true;
-    mouse = event.pointerType === 'mouse';
+    pointerType = event.pointerType;
   }, { capture: true });
   window.addEventListener('keydown', () => (pointer = false), { capture: true });
-  guideNumberBoxes(root, () => pointer && mouse);
+  guideNumberBoxes(root, () => (pointer ? pointerType : 'keyboard'));
   root.addEventListener('click', () => {
     const active = document.activeElement;
     // A click on a menu opens it: the menu keeps the focus until a choice is made ('change').
@@ -245,9 +245,11 @@ export const NUMBER_BOX_IDLE_MS = 2500;
  * still and the number creep up. So while one has the focus, a line over it says what the arrows
  * do now and how to give them back; Enter gives them back (lil-gui blurs), and so does a moment
  * with nothing typed after a mouse click (NUMBER_BOX_IDLE_MS: typing a number takes keys, which
- * restart the wait). A box reached with Tab keeps the keys until Tab or Enter moves on.
+ * restart the wait). A box reached with Tab keeps the keys until Tab or Enter moves on. A box
+ * tapped on a touch screen gets neither (its keyboard has no arrows, and typing takes a while).
+ * `focusedBy()`: how the focus came, 'mouse', 'touch', 'pen' or 'keyboard'.
  */
-function guideNumberBoxes(root: HTMLElement, clicked: () => boolean): void {
+function guideNumberBoxes(root: HTMLElement, focusedBy: () => string): void {
   const hint = document.createElement('div');
   hint.className = 'keys-hint';
   hint.setAttribute('role', 'status');
@@ -267,7 +269,9 @@ function guideNumberBoxes(root: HTMLElement, clicked: () => boolean): void {
     const target = event.target;
     if (!(target instanceof HTMLInputElement) || !typesText(target) || !target.closest('.lil-number')) return;
     box = target;
-    byMouse = clicked();
+    const by = focusedBy();
+    byMouse = by === 'mouse';
+    if (by === 'touch') return;
     hint.hidden = false;
     // Over the box, inside the window (a panel at the right edge).
     const r = target.getBoundingClientRect();

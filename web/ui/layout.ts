@@ -26,17 +26,22 @@ export function freePart(width: number, height: number, boxes: readonly (DOMRect
   return free;
 }
 
-/** Longer than lil-gui's open / fold animation (0.3 s). */
-const SETTLE_MS = 800;
-
-/** Every list in the panel at its own height, and no open / fold animation left running. */
-function settle(panel: HTMLElement): void {
-  for (const gui of [panel, ...panel.querySelectorAll<HTMLElement>('.lil-gui')]) {
-    const list = gui.querySelector<HTMLElement>(':scope > .lil-children');
-    if (!list || !gui.classList.contains('lil-transition')) continue;
-    list.style.height = '';
-    gui.classList.remove('lil-transition');
-  }
+/**
+ * lil-gui opens a folder by animating its list from one height to another over two animation
+ * frames, and ends the animation (the list takes its own height again) at the first transition
+ * that ends on the list. On a page that draws slowly (a phone, 8 possible reactions) a short
+ * transition of the list's own ends between those two frames, and the second frame then set the
+ * list to the height it measured and left it there: the open sheet stood 152 px taller than its
+ * controls (625 px for 473), over the dancers. A height set on a list outside its animation is
+ * taken off again.
+ */
+function keepListsAtOwnHeight(panel: HTMLElement): void {
+  new MutationObserver((records) => {
+    for (const { target } of records) {
+      if (!(target instanceof HTMLElement) || !target.classList.contains('lil-children') || !target.style.height) continue;
+      if (!target.parentElement?.classList.contains('lil-transition')) target.style.height = '';
+    }
+  }).observe(panel, { subtree: true, attributes: true, attributeFilter: ['style'] });
 }
 
 export class ViewCentre {
@@ -53,14 +58,7 @@ export class ViewCentre {
     if (title) observer.observe(title);
     window.addEventListener('resize', measure);
     this.measure();
-    // lil-gui opens and folds a panel by animating its list to a height it measured, and lets the
-    // list take its own height again when the animation ends; when the animation is cut short
-    // (seen on phones: one opening in three under load) the list keeps that height, and the open
-    // sheet stood 152 px taller than its controls (625 px for 473), over the dancers' band. Once
-    // the animation is long over, any list still held at a height gets its own again.
-    panel.addEventListener('click', (event) => {
-      if (event.target instanceof Element && event.target.closest('.lil-title')) setTimeout(() => settle(panel), SETTLE_MS);
-    });
+    keepListsAtOwnHeight(panel);
   }
 
   private measure(): void {
