@@ -88,7 +88,7 @@ def figures_table(res: dict) -> list[str]:
             return "n/a"
         show = (lambda x: pct(x)) if share else (lambda x: fmt(x, digits))
         text = show(v)
-        if ref.get(k) and k not in ("recall", "precision"):
+        if ref.get(k) and k not in ("recall", "precision", "direction"):
             text += f" ({v / ref[k]:.2f}×)"
         if m.get(f"{k}_min") is not None and m.get(f"{k}_min") != m.get(f"{k}_max"):
             text += f" [{show(m[f'{k}_min'])}..{show(m[f'{k}_max'])}]"
@@ -98,13 +98,14 @@ def figures_table(res: dict) -> list[str]:
          "The follower's turns, spins, body motion and travel in the free-running runs beside the "
          "played-back leader, as a ratio to the recorded follower's, with the lowest..highest seed "
          "in brackets; recall and precision of its turns against the recorded follower's (same "
-         "direction, within 0.75 s).", "",
-         "| method | turns/min | spin frames % | body motion m/s | travel m/s | turn recall % | turn precision % |",
-         "|---|---|---|---|---|---|---|"]
+         "direction, within 0.75 s); the way: of its turns that meet a recorded one either way, the "
+         "share that go the recorded way (the ceiling: training.evaluation.turn_direction).", "",
+         "| method | turns/min | spin frames % | body motion m/s | travel m/s | turn recall % | turn precision % | the way % |",
+         "|---|---|---|---|---|---|---|---|"]
     for name, m in res["methods"].items():
         L.append(f"| {name} | {cell(m, 'turns_per_min', 1)} | {cell(m, 'spin_frames', share=True)} | "
                  f"{cell(m, 'body_motion')} | {cell(m, 'travel')} | {cell(m, 'recall', share=True)} | "
-                 f"{cell(m, 'precision', share=True)} |")
+                 f"{cell(m, 'precision', share=True)} | {cell(m, 'direction', share=True)} |")
     return L
 
 

@@ -150,7 +150,7 @@ def latents(encoder, r: dict) -> np.ndarray:
 
 # The figure measures (figures.py) every run reports: pooled over the takes, then means over seeds
 # with the worst seed beside them (mean_metrics).
-FIGURE_KEYS = ["turns_per_min", "spin_frames", "body_motion", "travel", "recall", "precision"]
+FIGURE_KEYS = ["turns_per_min", "spin_frames", "body_motion", "travel", "recall", "precision", "direction"]
 
 
 def run_metrics(runs: list[dict], refs: list[dict], encoder, ref_latents: np.ndarray,

@@ -135,8 +135,11 @@ def summarize(items: list[dict]) -> dict:
            **{k: sum(i[k] * i["minutes"] for i in items) / minutes for k in ("spin_frames", "body_motion", "travel")}}
     if all("matched" in i for i in items):
         m, a, f, r = (sum(i[k] for i in items) for k in ("matched", "matched_any_direction", "found", "recorded"))
+        # direction: of her turns that meet a recorded one (either way, within MATCH_SECONDS), the
+        # share that also go its way (turn_direction.py measures how far the leader shows it).
         out.update(recall=m / r if r else float("nan"), precision=m / f if f else float("nan"),
-                   recall_any_direction=a / r if r else float("nan"))
+                   recall_any_direction=a / r if r else float("nan"),
+                   direction=m / a if a else float("nan"))
     return out
 
 
