@@ -46,11 +46,14 @@ function keepListsAtOwnHeight(panel: HTMLElement): void {
 
 export class ViewCentre {
   private free: Rect;
+  /** The free part less the top and bottom bands (loadingUpdate). */
+  private sides: Rect;
   /** Where the open card or drawer begins (px from the left), or the window's width. */
   freeWidth = window.innerWidth;
 
   constructor(private readonly panel: HTMLElement) {
     this.free = { left: 0, top: 0, right: window.innerWidth, bottom: window.innerHeight };
+    this.sides = this.free;
     const measure = () => this.measure();
     const observer = new ResizeObserver(measure);
     observer.observe(panel);
@@ -66,6 +69,7 @@ export class ViewCentre {
     const title = document.getElementById('overlay');
     this.free = freePart(window.innerWidth, window.innerHeight, [title?.getBoundingClientRect() ?? null, this.panel.getBoundingClientRect()]);
     this.freeWidth = this.free.right;
+    this.sides = { left: 0, top: 0, right: this.free.right, bottom: window.innerHeight };
   }
 
   /** The free part as last measured (client px). */
@@ -77,5 +81,16 @@ export class ViewCentre {
    *  stage acts only on a change: call once per frame. */
   update(stage: Stage): void {
     stage.setFrame(this.free);
+  }
+
+  /**
+   * While the models load: only an open card or drawer at the right moves the picture's centre.
+   * The picture shown from the first paint (index.html's poster, scripts/poster.mjs) is drawn
+   * before any script runs, so it can follow the open panel (a fixed width, in its CSS) but not the
+   * title card's height, which depends on the words' wrapping; the loading scene stands where
+   * the picture did, and the dance, from its first step, in the part the page leaves it.
+   */
+  loadingUpdate(stage: Stage): void {
+    stage.setFrame(this.sides);
   }
 }

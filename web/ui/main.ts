@@ -625,7 +625,7 @@ class Page {
     // task, and they took most of the main thread while loading). The same until the first step
     // of the first dance is in: a draw of the not yet moving pair would only delay that step.
     const dancing = this.simulation !== null && hook.frame > 0;
-    if (!dancing) this.viewCentre.update(this.stage);
+    if (!dancing) this.viewCentre.loadingUpdate(this.stage);
     if (dancing || this.stage.needsRender()) this.draw(Math.min(1, this.accumulator / DT), elapsed);
     const guards = this.simulation ? this.simulation.guards() : NO_GUARDS;
     this.hud.update(now, { stepMs: hook.stepMs, fps: this.fps, threads: hook.threads, modelBytes: hook.modelBytes, guards });
@@ -654,7 +654,8 @@ class Page {
     }
     const compare = this.compare;
     compare.update(stage);
-    this.viewCentre.update(stage);
+    if (this.simulation !== null && hook.frame > 0) this.viewCentre.update(stage);
+    else this.viewCentre.loadingUpdate(stage);
     for (let i = 0; i < stage.followers.length; i++) {
       stage.followers[i].setCount(i < count ? 1 : 0);
       if (i < count) {
