@@ -226,6 +226,8 @@ MODELS = {
     # Both hear the music (features "music" block) and train on the tempo copies too, so that they
     # dance on the count from 150 to 200 beats a minute (docs/music.md).
     "follower": replace(steady(OURS), state_dropout=0.5, turn_weight=4.0, own_rollouts_from=10, tempo_copies=True),
+    "follower_long_own": replace(steady(OURS), state_dropout=0.5, turn_weight=4.0, tempo_copies=True,
+                                 epochs=6, lr=3e-4, own_rollouts_from=0, own_rollouts_horizon=30),
     "follower_ccm": replace(steady(CCM), state_dropout=0.5, turn_weight=4.0, own_rollouts_from=10, tempo_copies=True),
     # Measured, not shipped (docs/results.md, "She reads his hand" and "He turns on his own"): only
     # the turn starts his raised hand leads weigh more (unled_turn_weight). At 8x she reads his hand
@@ -307,6 +309,18 @@ MODELS = {
     # pooled, body motion 0.84x, travel 1.01x, and she spins 0.94x (1.44x before), but she follows
     # 72 % of the requests and fell in the soak (seed 64) following his lunge. At 8x he turns 1.40x
     # and she, beside him, 1.64x (seeds 0-49).
+    # Fine-tuned from the shipped leader (--init-from runs/models/leader): the hands plan shown in
+    # 80 % of samples, 4 matching epochs at a third of the rate, own rollouts from the first.
+    "leader_plan": replace(LEADER_BEFORE_CONTACT, lambda_foot_contact=100.0, recorded_contacts=True,
+                           contact_spare_turning=120.0, tempo_copies=True, hands_plan_dropout=0.2,
+                           epochs=4, lr=3e-4, own_rollouts_from=0),
+    "leader_plan_onsets": replace(LEADER_BEFORE_CONTACT, lambda_foot_contact=100.0, recorded_contacts=True,
+                                  contact_spare_turning=120.0, tempo_copies=True, hands_plan_dropout=0.2,
+                                  epochs=6, lr=3e-4, own_rollouts_from=0, turn_weight=4.0),
+    "leader_plan_figure": replace(LEADER_BEFORE_CONTACT, lambda_foot_contact=100.0, recorded_contacts=True,
+                                  contact_spare_turning=120.0, tempo_copies=True, hands_plan_dropout=0.2,
+                                  epochs=6, lr=3e-4, own_rollouts_from=0, turn_weight=4.0,
+                                  figure_dropout=0.3, figure_partner_dropout=0.5),
     "leader_own_turns_4": replace(LEADER_BEFORE_CONTACT, lambda_foot_contact=100.0, recorded_contacts=True,
                                   contact_spare_turning=120.0, own_turn_weight=4.0),
     "leader_own_turns_8": replace(LEADER_BEFORE_CONTACT, lambda_foot_contact=100.0, recorded_contacts=True,
@@ -568,7 +582,8 @@ def cosine(step: int, total: int, lr: float) -> float:
 
 
 def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = "cpu",
-                resume: bool = False, quiet: bool = False, rank: int = 0, world: int = 1) -> dict:
+                resume: bool = False, quiet: bool = False, rank: int = 0, world: int = 1,
+                init_from: str | None = None) -> dict:
     torch.manual_seed(cfg.seed)
     np.random.seed(cfg.seed)
     role = cfg.model.role
@@ -618,6 +633,17 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
         history, stage, epoch, seconds = ck["history"], ck["stage"], ck["epoch"], ck["seconds"]
         if rank == 0 and not quiet:
             print(f"{name}: resumed at {stage} epoch {epoch}")
+    elif init_from is not None:
+        # A fine-tune: the weights of another run (same sizes), its intention predictor kept as
+        # it is; this recipe's matching epochs train on with fresh optimizers.
+        ck = load_checkpoint(Path(init_from) / "checkpoint.pt")
+        if ck.get("stage") not in ("matching", "done") or ck["config"]["model"] != asdict(cfg.model):
+            raise TrainError(f"{init_from}: not a finished run of the same model sizes; cannot fine-tune from it")
+        predictor.load_state_dict(ck["predictor"]); matching.load_state_dict(ck["matching"])
+        disc.load_state_dict(ck["disc"])
+        stage = "matching"
+        if rank == 0 and not quiet:
+            print(f"{name}: fine-tuning {init_from} ({ck['history']['val_mse'][-1]:.4f} val mse there)")
     elif ckpt_path.exists() and not resume and rank == 0 and not quiet:
         print(f"{name}: {ckpt_path} exists; training from scratch over it (use --resume to continue)")
     broadcast_parameters([predictor, matching, disc], world)
@@ -920,6 +946,8 @@ def main(argv=None) -> int:
                     help="keep the predictor's epoch with the lowest validation MSE (early stopping)")
     ap.add_argument("--smoke", action="store_true", help="tiny sizes and 2 epochs (CI)")
     ap.add_argument("--resume", action="store_true", help="continue from RUNS/NAME/checkpoint.pt")
+    ap.add_argument("--init-from", metavar="DIR", help="fine-tune: start from the weights of the run in DIR "
+                    "(its intention predictor kept), then this recipe's matching epochs")
     ap.add_argument("--device", default="cpu", help="cpu, cuda, cuda:N or auto")
     ap.add_argument("--threads", type=int, default=0, help="torch CPU threads (0 = torch default)")
     args = ap.parse_args(argv)
@@ -941,7 +969,8 @@ def main(argv=None) -> int:
             if args.smoke:
                 cfg = smoke(cfg)
             cfg = apply_overrides(cfg, args)
-            r = train_model(name, cfg, args.prepared, args.runs, device, args.resume, rank=rank, world=world)
+            r = train_model(name, cfg, args.prepared, args.runs, device, args.resume, rank=rank, world=world,
+                            init_from=args.init_from)
             if rank == 0:
                 mse = "" if r["val_mse"] is None else f", val mse {r['val_mse']:.4f}"
                 print(f"{name}: done in {r['seconds']:.0f} s{mse}")

@@ -1,0 +1,136 @@
+"""python -m training.evaluation.jitter: do the dancers' hips jitter, against the recorded couples'?
+
+Two figures per dancer, from the hip joint's world path at 30 fps:
+- **reversals a second**: frames where the hips' motion turns back, i.e. this frame's step and the
+  one before point more than 90 degrees apart (a dot product below zero), with both steps longer
+  than STILL (a hip standing still turns every way and says nothing);
+- **speed change**: the mean change of the hips' velocity from one frame to the next, in cm a frame
+  (|v(t) - v(t-1)| with v in cm a frame): a smooth path changes little between frames.
+
+Measured on the recorded couples (every take, as recorded) and on the page's loop in Python (the
+soak's duets, steered by its stick and with nobody steering, at the manifest's tempo): the bodies
+the networks leave ("raw") and the ones the page draws after its contact layer ("shown"). Each is
+printed with its ratio to the recorded dancer's and the worst seed.
+
+    python -m training.evaluation.jitter --seeds 20 --seconds 30 --out runs/jitter
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+from tqdm import tqdm
+
+from ..data.folders import add_folder
+from ..mirror.skeleton import FPS
+
+HIP = 0
+STILL = 0.002   # m a frame (6 cm/s): shorter steps are standing still
+
+
+def hip_jitter(positions: np.ndarray, fps: int = FPS) -> dict:
+    """World positions [T, 17, 3] -> reversals a second and the mean speed change (cm a frame)."""
+    v = np.diff(positions[:, HIP], axis=0)
+    a, b = v[1:], v[:-1]
+    moving = (np.linalg.norm(a, axis=-1) > STILL) & (np.linalg.norm(b, axis=-1) > STILL)
+    reversals = int(((np.sum(a * b, -1) < 0) & moving).sum())
+    seconds = len(positions) / fps
+    return {"reversals_per_s": reversals / seconds,
+            "speed_change_cm": float(np.linalg.norm(a - b, axis=-1).mean() * 100)}
+
+
+def recorded(data: str) -> dict:
+    """Each recorded dancer's figures, pooled over the takes (frame-weighted means)."""
+    from ..data.dataset import discover_takes, load_pair, pair_tracks
+    rows = {"leader": [], "follower": []}
+    for take in discover_takes(data):
+        lead, follow = pair_tracks(*load_pair(take))
+        rows["leader"].append((hip_jitter(lead.positions), len(lead.positions)))
+        rows["follower"].append((hip_jitter(follow.positions), len(follow.positions)))
+    return {role: {k: float(sum(r[k] * n for r, n in items) / sum(n for _, n in items)) for k in items[0][0]}
+            for role, items in rows.items()}
+
+
+def rollouts(args, steer: bool) -> list[dict]:
+    """Per seed: each dancer's figures, raw and shown."""
+    from .rhythm import load_dancers
+    from .soak import soak_one
+    manifest, leader, follower, temperature = load_dancers(args)
+    out = []
+    for seed in tqdm(range(args.first_seed, args.first_seed + args.seeds), desc="steered" if steer else "nobody steering",
+                     disable=args.quiet):
+        rec = {}
+        soak_one(manifest, leader, follower, seed, int(args.seconds * FPS), temperature, record=rec,
+                 tempo=args.tempo, steer=steer)
+        out.append({"seed": seed, **{f"{role}_{kind}": hip_jitter(rec[role if kind == "raw" else f"{role}_shown"])
+                                     for role in ("leader", "follower") for kind in ("raw", "shown")}})
+    return out
+
+
+def summarize(rows: list[dict], reference: dict) -> dict:
+    """Means over seeds, each with its ratio to the recorded dancer's and the worst (highest) seed."""
+    out = {}
+    for role in ("leader", "follower"):
+        for kind in ("raw", "shown"):
+            for k in ("reversals_per_s", "speed_change_cm"):
+                values = np.array([r[f"{role}_{kind}"][k] for r in rows])
+                worst = int(np.argmax(values))
+                out[f"{role}_{kind}_{k}"] = {"mean": float(values.mean()), "ratio": float(values.mean() / reference[role][k]),
+                                             "worst": float(values[worst]), "worst_seed": rows[worst]["seed"]}
+    return out
+
+
+def markdown(title: str, s: dict, reference: dict) -> str:
+    lines = [f"**{title}**", "", "| dancer | hip reversals a second | hips' speed change, cm a frame |", "|---|---|---|"]
+    for role in ("leader", "follower"):
+        ref = reference[role]
+        lines.append(f"| recorded {role} | {ref['reversals_per_s']:.2f} | {ref['speed_change_cm']:.2f} |")
+        for kind in ("raw", "shown"):
+            cells = []
+            for k in ("reversals_per_s", "speed_change_cm"):
+                c = s[f"{role}_{kind}_{k}"]
+                cells.append(f"{c['mean']:.2f} ({c['ratio']:.2f}×; worst seed {c['worst_seed']}: {c['worst']:.2f})")
+            lines.append(f"| {role}, {kind} | {' | '.join(cells)} |")
+    return "\n".join(lines) + "\n"
+
+
+def main(argv=None) -> int:
+    from . import options as O
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0], formatter_class=argparse.RawDescriptionHelpFormatter)
+    add_folder(ap, "data", "the recorded couples the figures are read against")
+    add_folder(ap, "models", "the dancers measured")
+    ap.add_argument("--follower", default="follower", help="follower model name in the manifest")
+    ap.add_argument("--seeds", type=int, default=20)
+    ap.add_argument("--first-seed", type=int, default=0)
+    ap.add_argument("--seconds", type=float, default=30.0)
+    ap.add_argument("--steer", choices=("both", "steered", "nobody"), default="both")
+    ap.add_argument("--out", default="runs/jitter", help="writes OUT/jitter.json and .md")
+    ap.add_argument("--quiet", action="store_true")
+    O.add_options(ap)
+    args = ap.parse_args(argv)
+    if args.seeds < 1 or args.seconds < 2:
+        print("error: --seeds 1 or more and --seconds 2 or more", file=sys.stderr)
+        return 2
+    t0 = time.time()
+    reference = recorded(args.data)
+    report, text = {"recorded": reference}, []
+    for steer in ([True, False] if args.steer == "both" else [args.steer == "steered"]):
+        name = "steered" if steer else "nobody steering"
+        rows = rollouts(args, steer)
+        report[name] = {"seeds": rows, "summary": summarize(rows, reference)}
+        text.append(markdown(f"{args.seeds} seeds × {args.seconds:g} s, {name}", report[name]["summary"], reference))
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "jitter.json").write_text(json.dumps(report, indent=1))
+    (out / "jitter.md").write_text("\n".join(text))
+    print("\n".join(text))
+    print(f"wrote {out}/jitter.json and .md in {time.time() - t0:.0f} s")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
