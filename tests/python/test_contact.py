@@ -10,7 +10,7 @@ import torch
 
 from training.evaluation import metrics as M
 from training.learning import partner_losses as P
-from training.mirror.contact import SEPARATION, ContactLayer, separate, spine_gap
+from training.mirror.contact import HIP_GLIDE, SEPARATION, ContactLayer, separate, spine_gap
 from training.mirror.footik import ANKLE_FLOOR, MAX_STANCE, FootLock, cap_stance, two_bone_ik
 from training.mirror.skeleton import FEET, PARENTS
 
@@ -147,6 +147,34 @@ def test_contact_layer_brings_near_hands_together_and_keeps_bones():
     ContactLayer().apply(standing(0, 0), b, [0, 0], [0, 0], 0.0, 0.0)
     assert np.allclose(b, far)
     assert np.allclose(bone_lengths(b), lengths)
+
+
+def test_contact_layer_glides_each_body_over_the_floor():
+    """The first step shows each body where its network put it; a jump over the floor is shown a
+    (1 - HIP_GLIDE) share of the way each step, the whole body together, its height unchanged;
+    with a foot planted the offset stays; clear() shows it where it is again."""
+    layer = ContactLayer()
+    lead, follow = standing(0, 0), standing(3, 0)
+    a, b = lead.copy(), follow.copy()
+    layer.apply(a, b, [0, 0], [0, 0], 0.0, 0.0)
+    assert np.allclose(b, follow)
+    moved = standing(3, 1.0)
+    b = moved.copy()
+    layer.apply(lead.copy(), b, [0, 0], [0, 0], 0.0, 0.0)
+    assert np.allclose(b[:, 2] - moved[:, 2], -HIP_GLIDE * 1.0)
+    assert np.allclose(b[:, [0, 1]], moved[:, [0, 1]])
+    b = moved.copy()
+    layer.apply(lead.copy(), b, [0, 0], [0, 0], 0.0, 0.0)
+    assert np.allclose(b[:, 2] - moved[:, 2], -HIP_GLIDE ** 2)
+    # A planted foot: the body keeps its offset and moves as the network moves it.
+    on = standing(3, 1.5)
+    b = on.copy()
+    layer.apply(lead.copy(), b, [0, 0], [1, 0], 0.0, 0.0)
+    assert np.allclose(b[:, 2] - on[:, 2], -HIP_GLIDE ** 2)
+    layer.clear()
+    b = moved.copy()
+    layer.apply(lead.copy(), b, [0, 0], [0, 0], 0.0, 0.0)
+    assert np.allclose(b, moved)
 
 
 def test_partner_terms_are_zero_on_the_recording_and_bite_on_error(prepared3):

@@ -9,6 +9,8 @@
 //    HAND_REACH, is drawn toward a grip around its midpoint by two-bone IK of both arms, fully at
 //    HAND_FULL and closer, with a weight that rises and falls smoothly;
 // 3. planted feet stay planted: FootLock on both dancers, last, so a body moved by 1. keeps its feet.
+// First of all, each body's path over the floor glides while no foot is planted (HIP_GLIDE): the
+// whole body is moved to where its hips' smoothed path is; the feet, locked last, stay planted.
 
 import { CONTACT_THRESHOLD, FootLock, twoBoneIk } from './footik';
 import { HANDS, PARENTS, SPINE } from './skeleton';
@@ -40,6 +42,11 @@ export const MIN_ELBOW_BEND = 0.6;
 /** The follower's feet lock from a lower contact than the leader's: its network, at its own
  *  variety, is unsure of its feet, which slid while low (training/mirror/contact.py: measured). */
 export const FOLLOWER_CONTACT = 0.3;
+/** While no foot is planted, each step the shown hips keep this share of the distance between
+ *  where they were shown and where the network puts them now (horizontal only); while one is, the
+ *  body keeps its offset. Her hips turned back 3.8x as often as the recorded follower's, 2.0-2.3x
+ *  with it (training/mirror/contact.py: measured). */
+export const HIP_GLIDE = 0.7;
 
 type Positions = Float32Array | Float64Array;
 
@@ -168,12 +175,42 @@ export class ContactLayer {
   readonly hands = [0, 0];
   /** m each body was moved apart this step. */
   pushed = 0;
+  /** Each dancer's shown hips (x, z); NaN: not yet shown. */
+  readonly glides = new Float64Array([NaN, NaN, NaN, NaN]);
+  /** ... and how far they are shown from the network's (x, z). */
+  readonly offsets = new Float64Array(4);
 
-  /** Forget every lock and the hold (after a reset or a jump of either dancer). */
+  /** Forget every lock, the hold and the glides (after a reset or a jump of either dancer). */
   clear(): void {
     this.leaderFeet.clear();
     this.followerFeet.clear();
     this.hold = 0;
+    this.glides.fill(NaN);
+    this.offsets.fill(0);
+  }
+
+  /** Move body k (0 leader, 1 follower) to its hips' smoothed path over the floor (HIP_GLIDE),
+   *  as far as no foot is planted (1 - the larger contact): while one is, the body keeps the
+   *  offset it had and moves as the network moves it, and the locked foot stays where it is. */
+  glide(k: number, positions: Positions, contacts: ArrayLike<number>): void {
+    const hx = positions[0], hz = positions[2], g = this.glides, o = this.offsets;
+    if (Number.isNaN(g[2 * k])) {
+      g[2 * k] = hx;
+      g[2 * k + 1] = hz;
+      o[2 * k] = 0;
+      o[2 * k + 1] = 0;
+    }
+    const free = 1 - clamp01(Math.max(contacts[0], contacts[1]));
+    const ox = o[2 * k] + free * (HIP_GLIDE * (g[2 * k] - hx) - o[2 * k]);
+    const oz = o[2 * k + 1] + free * (HIP_GLIDE * (g[2 * k + 1] - hz) - o[2 * k + 1]);
+    for (let i = 0; i < positions.length; i += 3) {
+      positions[i] += ox;
+      positions[i + 2] += oz;
+    }
+    g[2 * k] = hx + ox;
+    g[2 * k + 1] = hz + oz;
+    o[2 * k] = ox;
+    o[2 * k + 1] = oz;
   }
 
   /** Make the shown poses (world 17 x 3, copies: changed in place) read as partner dancing. */
@@ -181,6 +218,8 @@ export class ContactLayer {
     leader: Positions, follower: Positions, leaderContacts: ArrayLike<number>, followerContacts: ArrayLike<number>,
     leaderHeading: number, followerHeading: number,
   ): void {
+    this.glide(0, leader, leaderContacts);
+    this.glide(1, follower, followerContacts);
     this.pushed = separate(leader, follower);
     closestHands(leader, follower, pair);
     const i = pair[0], j = pair[1], d = pair[2];
