@@ -98,6 +98,11 @@ class TrainConfig:
     # the spot: Diversity 13 against the recording's 24). Hidden now and then, the pose has to be
     # carried by the code, which the decoder then keeps reading.
     state_dropout: float = 0.0
+    # Share of samples whose past paths and past key joints (both dancers': what says when the last
+    # steps fell) are shown at their mean. Teacher-forced, the last second of motion tells when the
+    # next step falls so well that the count adds little (a half-beat shift of it changes the step
+    # by a tenth of the ankles' speed: docs/music.md); hidden, only the pose and the music do.
+    past_dropout: float = 0.0
     # Train on the tempo copies too (prepare's train_tempo.npz): more varied samples, same steps.
     tempo_copies: bool = False
     # Weight of the samples where the follower's turn starts (turn_onsets) in the reconstruction
@@ -321,6 +326,11 @@ MODELS = {
                                   contact_spare_turning=120.0, tempo_copies=True, hands_plan_dropout=0.2,
                                   epochs=6, lr=3e-4, own_rollouts_from=0, turn_weight=4.0,
                                   figure_dropout=0.3, figure_partner_dropout=0.5),
+    # Fine-tuned from the shipped leader: the past paths and key joints hidden in half the samples
+    # (past_dropout), so that the count, not the last steps, says when the next one falls.
+    "leader_past_dropout": replace(LEADER_BEFORE_CONTACT, lambda_foot_contact=100.0, recorded_contacts=True,
+                                   contact_spare_turning=120.0, tempo_copies=True, epochs=6, lr=3e-4,
+                                   own_rollouts_from=0, past_dropout=0.5),
     "leader_own_turns_4": replace(LEADER_BEFORE_CONTACT, lambda_foot_contact=100.0, recorded_contacts=True,
                                   contact_spare_turning=120.0, own_turn_weight=4.0),
     "leader_own_turns_8": replace(LEADER_BEFORE_CONTACT, lambda_foot_contact=100.0, recorded_contacts=True,
@@ -667,6 +677,9 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
     slices = feat.block_slices(feat.LEADER_INPUT_LAYOUT if role == "leader" else feat.FOLLOWER_INPUT_LAYOUT)
     own = torch.cat([torch.arange(slices[k].start, slices[k].stop)
                      for k in ("self_trajectory_past", "self_key_joints_past", "self_pose")])
+    pasts = torch.cat([torch.arange(slices[k].start, slices[k].stop)
+                       for k in ("partner_trajectory_past", "partner_key_joints_past",
+                                 "self_trajectory_past", "self_key_joints_past")])
 
     def inputs(idx, proximity: bool = False):
         """Normalized inputs of a batch as the networks read them (with state noise), which samples
@@ -689,10 +702,14 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
             x, lowered = lower_partner(x, cfg.partner_lowered_share, cfg.partner_lowered_depth, gen)
             altered = lowered if altered is None else altered | lowered
         clean = ((x - stats["input_mean"]) / stats["input_std"]).to(device)
-        if cfg.state_noise == 0:
+        if cfg.state_noise == 0 and cfg.past_dropout == 0:
             return clean, moved, altered, clean
         noisy = clean.clone()
-        noisy[:, own] += cfg.state_noise * torch.randn(len(noisy), len(own), generator=gen).to(device)
+        if cfg.state_noise:
+            noisy[:, own] += cfg.state_noise * torch.randn(len(noisy), len(own), generator=gen).to(device)
+        if cfg.past_dropout:
+            hidden = (torch.rand(len(noisy), generator=gen) < cfg.past_dropout).to(device)
+            noisy[hidden.nonzero()[:, 0][:, None], pasts[None].to(device)] = 0.0
         return noisy, moved, altered, clean
 
     def save(stage_, epoch_):
