@@ -80,3 +80,33 @@ def test_summarize_pools_minutes_and_counts():
     assert s["minutes"] == pytest.approx(2 * 180 / FPS / 60)
     assert s["turns_per_min"] == pytest.approx(1 / s["minutes"])
     assert s["recall"] == pytest.approx(0.5) and s["precision"] == pytest.approx(1.0)
+
+
+def test_the_way_counts_her_turns_that_meet_a_recorded_one_and_go_its_way():
+    """summarize's direction: of her turns that meet a recorded one either way, the share that go
+    the recorded way (a turn the other way meets it but does not count)."""
+    turn = np.concatenate([np.zeros(60), np.linspace(0, 2 * np.pi, 30), np.full(90, 2 * np.pi)])
+    same = {**Fg.dancer(body(turn)), **Fg.against(body(turn), body(turn))}
+    other = {**Fg.dancer(body(-turn)), **Fg.against(body(-turn), body(turn))}
+    assert Fg.summarize([same])["direction"] == pytest.approx(1.0)
+    assert Fg.summarize([other])["direction"] == pytest.approx(0.0)
+    assert Fg.summarize([same, other])["direction"] == pytest.approx(0.5)
+
+
+def test_hip_jitter_counts_reversals_and_speed_change():
+    """A hip walking a straight line at a steady speed never turns back; one that steps back and
+    forth turns back every frame, and its velocity changes by twice its speed each frame."""
+    from training.evaluation.jitter import hip_jitter
+    t = np.arange(FPS * 2)
+    straight = np.zeros((len(t), N_JOINTS, 3))
+    straight[:, 0, 0] = 0.01 * t
+    assert hip_jitter(straight) == {"reversals_per_s": 0.0, "speed_change_cm": pytest.approx(0.0, abs=1e-9)}
+    zigzag = np.zeros((len(t), N_JOINTS, 3))
+    zigzag[:, 0, 0] = 0.01 * (t % 2)
+    j = hip_jitter(zigzag)
+    assert j["reversals_per_s"] == pytest.approx((len(t) - 2) / 2.0)
+    assert j["speed_change_cm"] == pytest.approx(2.0)
+    # Standing still (steps under 2 mm) is not turning back.
+    shiver = np.zeros((len(t), N_JOINTS, 3))
+    shiver[:, 0, 0] = 0.001 * (t % 2)
+    assert hip_jitter(shiver)["reversals_per_s"] == 0.0

@@ -77,3 +77,22 @@ def test_a_follower_whose_intention_forecasts_the_led_turn_trains_and_keeps_the_
     x = torch.from_numpy(load_split(str(prepared3), "validation", "follower")["input"][:3])
     out, intention, code = run.model(x, torch.tensor([0.5]), torch.full((3, cfg.model.latent), 0.5))
     assert out.shape == (3, feat.OUTPUT_SIZE) and intention.shape == (3, feat.INTENTION_SIZE)
+
+
+def test_turn_direction_reads_the_leader_before_each_turn():
+    """turn_direction.turn_samples: each recorded turn gives the row `lead` frames before it and its
+    way; a turn too early to be read is left out."""
+    import numpy as np
+    from training.evaluation.turn_direction import HIS_HANDS, HIS_PATH, HIS_REST, turn_samples
+    from training.mirror import features as feat
+    frames = np.arange(30, 130)
+    x = np.zeros((len(frames), feat.INPUT_SIZE))
+    x[:, 0] = frames                                    # the first column says which frame a row is
+    s = {"frames": frames, "input": x, "turns": [(40, 1), (100, -1), (120, 1)]}
+    rows, ways = turn_samples(s, "leader", 15)
+    assert list(rows[:, 0]) == [85, 105] and list(ways) == [-1, 1]
+    # The parts of "leader" do not overlap and lie in his blocks of her input.
+    parts = np.concatenate([HIS_HANDS, HIS_PATH, HIS_REST])
+    assert len(np.unique(parts)) == len(parts)
+    b = feat.block_slices(feat.FOLLOWER_INPUT_LAYOUT)
+    assert parts.min() >= b["partner_trajectory_past"].start and parts.max() < b["partner_pose"].stop
