@@ -4,7 +4,7 @@
 
 import { describe, expect, it } from 'vitest';
 import {
-  ContactLayer, HAND_FULL, HAND_REACH, SEPARATION, closestOnSegments, reachWeight, separate, spineGap,
+  ContactLayer, HAND_FULL, HAND_REACH, HIP_GLIDE, HipGlide, SEPARATION, closestOnSegments, reachWeight, separate, spineGap,
 } from '../../web/mirror/contact';
 import { expectClose, fixture } from './fixture';
 
@@ -59,5 +59,36 @@ describe('contact geometry', () => {
     expect(reachWeight(HAND_FULL - 0.01)).toBe(1);
     expect(reachWeight(HAND_REACH + 0.01)).toBe(0);
     expect(reachWeight((HAND_FULL + HAND_REACH) / 2)).toBeCloseTo(0.5, 12);
+  });
+});
+
+describe('HipGlide (the shown path over the floor)', () => {
+  const body = (x: number, z: number) => {
+    const p = new Float64Array(17 * 3);
+    for (let j = 0; j < 17; j++) {
+      p[3 * j] = x;
+      p[3 * j + 1] = 0.1 * j;
+      p[3 * j + 2] = z;
+    }
+    return p;
+  };
+  it('shows a jump a (1 - HIP_GLIDE) share of the way while free, keeps its offset while a foot is planted', () => {
+    const glide = new HipGlide();
+    const first = body(3, 0);
+    glide.apply(first, [0, 0]);
+    expect(Array.from(first)).toEqual(Array.from(body(3, 0)));
+    const jumped = body(3, 1);
+    glide.apply(jumped, [0, 0]);
+    for (let j = 0; j < 17; j++) {
+      expect(jumped[3 * j + 2] - 1).toBeCloseTo(-HIP_GLIDE, 12);
+      expect(jumped[3 * j + 1]).toBeCloseTo(0.1 * j, 12);
+    }
+    const planted = body(3, 1.5);
+    glide.apply(planted, [1, 0]);
+    expect(planted[2] - 1.5).toBeCloseTo(-HIP_GLIDE, 12);
+    glide.clear();
+    const again = body(3, 1.5);
+    glide.apply(again, [0, 0]);
+    expect(Array.from(again)).toEqual(Array.from(body(3, 1.5)));
   });
 });

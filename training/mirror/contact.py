@@ -110,8 +110,32 @@ def move_hand(positions: np.ndarray, hand: int, target: np.ndarray) -> None:
     two_bone_ik(positions, PARENTS[elbow], elbow, hand, target, ELBOW_POLE, MIN_ELBOW_BEND)
 
 
+class HipGlide:
+    """One dancer's shown path over the floor (HIP_GLIDE): where its hips were shown, and how far
+    from the network's."""
+
+    def __init__(self):
+        self.shown = None               # the shown hips (x, z), None: not yet shown
+        self.offset = np.zeros(2)       # shown minus the network's (x, z)
+
+    def clear(self) -> None:
+        self.shown = None
+
+    def apply(self, positions: np.ndarray, contacts) -> None:
+        """Move the body [17, 3] (world, in place) to its hips' smoothed path over the floor, as far
+        as no foot is planted (1 - the larger contact): while one is, the body keeps the offset it
+        had and moves as the network moves it, and the locked foot stays where it is."""
+        hips = positions[0, [0, 2]]
+        if self.shown is None:
+            self.shown, self.offset = hips.copy(), np.zeros(2)
+        free = 1.0 - float(np.clip(np.max(contacts), 0.0, 1.0))
+        self.offset = self.offset + free * (HIP_GLIDE * (self.shown - hips) - self.offset)
+        positions[:, [0, 2]] += self.offset
+        self.shown = hips + self.offset
+
+
 class ContactLayer:
-    """State kept between steps: both dancers' foot locks and the hand hold."""
+    """State kept between steps: both dancers' glides, foot locks and the hand hold."""
 
     def __init__(self):
         self.leader_feet = FootLock(CONTACT_THRESHOLD)
@@ -119,36 +143,23 @@ class ContactLayer:
         self.hold = 0.0                 # 0..1: how far the closest hands are drawn together
         self.hands = (0, 0)             # the pair held (indices into HANDS: leader's, follower's)
         self.pushed = 0.0               # m each body was moved apart this step
-        self.glides = [None, None]      # each dancer's shown hips (x, z), None: not yet shown
-        self.offsets = [None, None]     # ... and how far they are shown from the network's
+        self.leader_glide = HipGlide()
+        self.follower_glide = HipGlide()
 
     def clear(self) -> None:
         """Forget every lock, the hold and the glides (after a reset or a jump of either dancer)."""
         self.leader_feet.clear()
         self.follower_feet.clear()
         self.hold = 0.0
-        self.glides = [None, None]
-        self.offsets = [None, None]
-
-    def glide(self, k: int, positions: np.ndarray, contacts) -> None:
-        """Move body k (0 leader, 1 follower) to its hips' smoothed path over the floor (HIP_GLIDE),
-        as far as no foot is planted (1 - the larger contact): while one is, the body keeps the
-        offset it had and moves as the network moves it, and the locked foot stays where it is."""
-        hips = positions[0, [0, 2]]
-        if self.glides[k] is None:
-            self.glides[k], self.offsets[k] = hips.copy(), np.zeros(2)
-        free = 1.0 - float(np.clip(np.max(contacts), 0.0, 1.0))
-        glided = HIP_GLIDE * (self.glides[k] - hips)
-        offset = self.offsets[k] + free * (glided - self.offsets[k])
-        positions[:, [0, 2]] += offset
-        self.glides[k], self.offsets[k] = hips + offset, offset
+        self.leader_glide.clear()
+        self.follower_glide.clear()
 
     def apply(self, leader: np.ndarray, follower: np.ndarray, leader_contacts, follower_contacts,
               leader_heading: float, follower_heading: float) -> None:
         """Make the shown poses leader, follower [17, 3] (world, copies: changed in place) read
         as partner dancing."""
-        self.glide(0, leader, leader_contacts)
-        self.glide(1, follower, follower_contacts)
+        self.leader_glide.apply(leader, leader_contacts)
+        self.follower_glide.apply(follower, follower_contacts)
         self.pushed = separate(leader, follower)
         i, j, d = closest_hands(leader, follower)
         target = reach_weight(d)

@@ -7,7 +7,7 @@
 
 import { FUTURE_OFFSETS, INPUT_SIZE, INTENTION_SIZE, KEYS, OUTPUT_SIZE, followerInput } from '../mirror/features';
 import { KEY_JOINTS, type Motion, POSITIONS_SIZE, ROTATIONS_SIZE } from '../mirror/skeleton';
-import { ContactLayer, FOLLOWER_CONTACT } from '../mirror/contact';
+import { ContactLayer, FOLLOWER_CONTACT, HipGlide } from '../mirror/contact';
 import { FootLock } from '../mirror/footik';
 import { type GuardSettings, type Ranges, hipSlackFor, mostUpright, nearestPlan, showsPlan, slackFor, uprightMargin } from '../mirror/guard';
 import { LeaderPlayback } from './playback';
@@ -28,7 +28,9 @@ class View implements DancerView {
   readonly contacts = new Float32Array(2);
   /** Per hand (left, right): how far the contact layer draws it to the partner's, 0..1. */
   readonly hands = new Float32Array(2);
-  /** Foot locks of a follower beyond the first (compare mode): the contact layer has the others. */
+  /** Path glide and foot locks of a follower beyond the first (compare mode), as ours gets them
+   *  from the contact layer: both partners drawn alike, so the comparison is fair. */
+  readonly glide = new HipGlide();
   readonly feet = new FootLock(FOLLOWER_CONTACT);
   resets = -1;
 
@@ -333,7 +335,7 @@ export class DuetSimulation implements Simulation {
 
   /**
    * The contact layer (web/mirror/contact.ts) on the views: between the leader and the first follower
-   * (the duet on screen); a compare-mode follower keeps only its own foot locks.
+   * (the duet on screen); a compare-mode follower keeps its own glide and foot locks.
    */
   private showContacts(jumped: boolean): void {
     const leader = this.duet.leader, first = this.duet.followers[0];
@@ -348,8 +350,12 @@ export class DuetSimulation implements Simulation {
     fv.hands[layer.hands[1]] = layer.hold;
     for (let i = 1; i < this.followerViews.length; i++) {
       const view = this.followerViews[i], f = this.duet.followers[i];
-      if (jumped || f.resets !== view.resets) view.feet.clear();
+      if (jumped || f.resets !== view.resets) {
+        view.glide.clear();
+        view.feet.clear();
+      }
       view.resets = f.resets;
+      view.glide.apply(view.positions, f.contacts);
       view.feet.apply(view.positions, f.contacts, f.heading);
     }
   }

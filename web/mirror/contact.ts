@@ -165,7 +165,41 @@ export function moveHand(positions: Positions, hand: number, tx: number, ty: num
 
 const pair = new Float64Array(3);
 
-/** State kept between steps: both dancers' foot locks and the hand hold. */
+/** One dancer's shown path over the floor (HIP_GLIDE): where its hips were shown, and how far
+ *  from the network's. */
+export class HipGlide {
+  /** The shown hips (x, z); NaN: not yet shown. */
+  readonly shown = new Float64Array([NaN, NaN]);
+  /** Shown minus the network's (x, z). */
+  readonly offset = new Float64Array(2);
+
+  clear(): void {
+    this.shown.fill(NaN);
+  }
+
+  /** Move the body (world 17 x 3, in place) to its hips' smoothed path over the floor, as far as
+   *  no foot is planted (1 - the larger contact): while one is, the body keeps the offset it had
+   *  and moves as the network moves it, and the locked foot stays where it is. */
+  apply(positions: Positions, contacts: ArrayLike<number>): void {
+    const hx = positions[0], hz = positions[2], shown = this.shown, o = this.offset;
+    if (Number.isNaN(shown[0])) {
+      shown[0] = hx;
+      shown[1] = hz;
+      o.fill(0);
+    }
+    const free = 1 - clamp01(Math.max(contacts[0], contacts[1]));
+    o[0] += free * (HIP_GLIDE * (shown[0] - hx) - o[0]);
+    o[1] += free * (HIP_GLIDE * (shown[1] - hz) - o[1]);
+    for (let i = 0; i < positions.length; i += 3) {
+      positions[i] += o[0];
+      positions[i + 2] += o[1];
+    }
+    shown[0] = hx + o[0];
+    shown[1] = hz + o[1];
+  }
+}
+
+/** State kept between steps: both dancers' glides, foot locks and the hand hold. */
 export class ContactLayer {
   readonly leaderFeet = new FootLock(CONTACT_THRESHOLD);
   readonly followerFeet = new FootLock(FOLLOWER_CONTACT);
@@ -175,42 +209,17 @@ export class ContactLayer {
   readonly hands = [0, 0];
   /** m each body was moved apart this step. */
   pushed = 0;
-  /** Each dancer's shown hips (x, z); NaN: not yet shown. */
-  readonly glides = new Float64Array([NaN, NaN, NaN, NaN]);
-  /** ... and how far they are shown from the network's (x, z). */
-  readonly offsets = new Float64Array(4);
+  /** Each dancer's path over the floor (HipGlide). */
+  readonly leaderGlide = new HipGlide();
+  readonly followerGlide = new HipGlide();
 
   /** Forget every lock, the hold and the glides (after a reset or a jump of either dancer). */
   clear(): void {
     this.leaderFeet.clear();
     this.followerFeet.clear();
     this.hold = 0;
-    this.glides.fill(NaN);
-    this.offsets.fill(0);
-  }
-
-  /** Move body k (0 leader, 1 follower) to its hips' smoothed path over the floor (HIP_GLIDE),
-   *  as far as no foot is planted (1 - the larger contact): while one is, the body keeps the
-   *  offset it had and moves as the network moves it, and the locked foot stays where it is. */
-  glide(k: number, positions: Positions, contacts: ArrayLike<number>): void {
-    const hx = positions[0], hz = positions[2], g = this.glides, o = this.offsets;
-    if (Number.isNaN(g[2 * k])) {
-      g[2 * k] = hx;
-      g[2 * k + 1] = hz;
-      o[2 * k] = 0;
-      o[2 * k + 1] = 0;
-    }
-    const free = 1 - clamp01(Math.max(contacts[0], contacts[1]));
-    const ox = o[2 * k] + free * (HIP_GLIDE * (g[2 * k] - hx) - o[2 * k]);
-    const oz = o[2 * k + 1] + free * (HIP_GLIDE * (g[2 * k + 1] - hz) - o[2 * k + 1]);
-    for (let i = 0; i < positions.length; i += 3) {
-      positions[i] += ox;
-      positions[i + 2] += oz;
-    }
-    g[2 * k] = hx + ox;
-    g[2 * k + 1] = hz + oz;
-    o[2 * k] = ox;
-    o[2 * k + 1] = oz;
+    this.leaderGlide.clear();
+    this.followerGlide.clear();
   }
 
   /** Make the shown poses (world 17 x 3, copies: changed in place) read as partner dancing. */
@@ -218,8 +227,8 @@ export class ContactLayer {
     leader: Positions, follower: Positions, leaderContacts: ArrayLike<number>, followerContacts: ArrayLike<number>,
     leaderHeading: number, followerHeading: number,
   ): void {
-    this.glide(0, leader, leaderContacts);
-    this.glide(1, follower, followerContacts);
+    this.leaderGlide.apply(leader, leaderContacts);
+    this.followerGlide.apply(follower, followerContacts);
     this.pushed = separate(leader, follower);
     closestHands(leader, follower, pair);
     const i = pair[0], j = pair[1], d = pair[2];
