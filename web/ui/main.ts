@@ -624,7 +624,7 @@ class Page {
     // models (in the phone bench, at 4x CPU, each redraw of the standing pair was a 0.2-0.5 s
     // task, and they took most of the main thread while loading). The same until the first step
     // of the first dance is in: a draw of the not yet moving pair would only delay that step.
-    const dancing = this.simulation !== null && hook.frame > 0;
+    const dancing = this.dancing;
     if (!dancing) this.viewCentre.loadingUpdate(this.stage);
     if (dancing || this.stage.needsRender()) this.draw(Math.min(1, this.accumulator / DT), elapsed);
     const guards = this.simulation ? this.simulation.guards() : NO_GUARDS;
@@ -638,6 +638,11 @@ class Page {
       this.frames = 0;
       this.fpsSince = now;
     }
+  }
+
+  /** Whether the first dance has its first step in (before: the loading scene). */
+  private get dancing(): boolean {
+    return this.simulation !== null && hook.frame > 0;
   }
 
   private draw(alpha: number, elapsed: number): void {
@@ -654,7 +659,7 @@ class Page {
     }
     const compare = this.compare;
     compare.update(stage);
-    if (this.simulation !== null && hook.frame > 0) this.viewCentre.update(stage);
+    if (this.dancing) this.viewCentre.update(stage);
     else this.viewCentre.loadingUpdate(stage);
     for (let i = 0; i < stage.followers.length; i++) {
       stage.followers[i].setCount(i < count ? 1 : 0);
