@@ -13,6 +13,7 @@ the networks leave ("raw") and the ones the page draws after its contact layer (
 printed with its ratio to the recorded dancer's and the worst seed.
 
     python -m training.evaluation.jitter --seeds 20 --seconds 30 --out runs/jitter
+    python -m training.evaluation.jitter --plot OUT.png --plot-seed 7 --steer nobody   # one duet, seen from above
 """
 from __future__ import annotations
 
@@ -35,12 +36,9 @@ STILL = 0.002   # m a frame (6 cm/s): shorter steps are standing still
 def hip_jitter(positions: np.ndarray, fps: int = FPS) -> dict:
     """World positions [T, 17, 3] -> reversals a second and the mean speed change (cm a frame)."""
     v = np.diff(positions[:, HIP], axis=0)
-    a, b = v[1:], v[:-1]
-    moving = (np.linalg.norm(a, axis=-1) > STILL) & (np.linalg.norm(b, axis=-1) > STILL)
-    reversals = int(((np.sum(a * b, -1) < 0) & moving).sum())
     seconds = len(positions) / fps
-    return {"reversals_per_s": reversals / seconds,
-            "speed_change_cm": float(np.linalg.norm(a - b, axis=-1).mean() * 100)}
+    return {"reversals_per_s": int(reversal_frames(positions).sum()) / seconds,
+            "speed_change_cm": float(np.linalg.norm(v[1:] - v[:-1], axis=-1).mean() * 100)}
 
 
 def recorded(data: str) -> dict:
@@ -69,6 +67,47 @@ def rollouts(args, steer: bool) -> list[dict]:
         out.append({"seed": seed, **{f"{role}_{kind}": hip_jitter(rec[role if kind == "raw" else f"{role}_shown"])
                                      for role in ("leader", "follower") for kind in ("raw", "shown")}})
     return out
+
+
+def reversal_frames(positions: np.ndarray) -> np.ndarray:
+    """[T, 17, 3] -> [T - 2] bool: the frames where the hips' step turns back (hip_jitter's count)."""
+    v = np.diff(positions[:, HIP], axis=0)
+    a, b = v[1:], v[:-1]
+    moving = (np.linalg.norm(a, axis=-1) > STILL) & (np.linalg.norm(b, axis=-1) > STILL)
+    return (np.sum(a * b, -1) < 0) & moving
+
+
+def plot(path: str, args, seed: int, steer: bool, seconds: float = 4.0) -> None:
+    """Her hips over the floor, seen from above, as the network put them and as the page draws
+    them: the `seconds` of one duet (of its --seconds) where the network's hips turn back most, a
+    dot a frame. Jitter is a path that doubles back."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from .rhythm import load_dancers
+    from .soak import soak_one
+    manifest, leader, follower, temperature = load_dancers(args)
+    rec = {}
+    soak_one(manifest, leader, follower, seed, int(args.seconds * FPS), temperature, record=rec,
+             tempo=args.tempo, steer=steer)
+    width = int(seconds * FPS)
+    counts = np.convolve(reversal_frames(rec["follower"]).astype(float), np.ones(width), "valid")
+    start = int(np.argmax(counts))
+    sl = slice(start, start + width)
+    fig, axes = plt.subplots(1, 2, figsize=(10, 5), sharex=True, sharey=True)
+    for ax, key, title in ((axes[0], "follower", "as the network put them"), (axes[1], "follower_shown", "as the page draws them")):
+        p = rec[key][sl, HIP]
+        j = hip_jitter(rec[key][sl])
+        ax.plot(p[:, 0], p[:, 2], "-", color="#c33", lw=0.8)
+        ax.plot(p[:, 0], p[:, 2], ".", color="#c33", ms=3)
+        ax.set_title(f"her hips {title}: {j['reversals_per_s']:.2f} reversals a second", fontsize=10)
+        ax.set_aspect("equal")
+        ax.set_xlabel("x (m)")
+    axes[0].set_ylabel("z (m)")
+    fig.suptitle(f"seed {seed}, {'steered' if steer else 'nobody steering'}: {start / FPS:.1f}-{(start + width) / FPS:.1f} s, "
+                 "where her hips turn back most; a dot a frame")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
 
 
 def summarize(rows: list[dict], reference: dict) -> dict:
@@ -110,11 +149,17 @@ def main(argv=None) -> int:
     ap.add_argument("--steer", choices=("both", "steered", "nobody"), default="both")
     ap.add_argument("--out", default="runs/jitter", help="writes OUT/jitter.json and .md")
     ap.add_argument("--quiet", action="store_true")
+    ap.add_argument("--plot", metavar="FILE", help="only draw her hips' path, raw and drawn, of --plot-seed (PNG)")
+    ap.add_argument("--plot-seed", type=int, default=0)
     O.add_options(ap)
     args = ap.parse_args(argv)
     if args.seeds < 1 or args.seconds < 2:
         print("error: --seeds 1 or more and --seconds 2 or more", file=sys.stderr)
         return 2
+    if args.plot:
+        plot(args.plot, args, args.plot_seed, args.steer != "nobody")
+        print(f"wrote {args.plot}")
+        return 0
     t0 = time.time()
     reference = recorded(args.data)
     report, text = {"recorded": reference}, []
