@@ -31,6 +31,7 @@ if str(REPO) not in sys.path:      # run as a script from anywhere
 from training.mirror import features as feat  # noqa: E402
 from training.mirror import guard as G  # noqa: E402
 from training.mirror import music  # noqa: E402
+from training.mirror import on_count as OC  # noqa: E402
 from training.mirror import rollout as ro  # noqa: E402
 from training.mirror.contact import ContactLayer  # noqa: E402
 from training.mirror.bvh import BvhError, forward_kinematics, local_transforms, parse_bvh  # noqa: E402
@@ -413,6 +414,27 @@ def hip_slack_cases() -> list[dict]:
     return out
 
 
+def on_count_cases(rng: np.random.Generator, outputs: np.ndarray, ranges: dict, offsets) -> dict:
+    """training/mirror/on_count.py on inputs of each role whose music block is a count (random
+    otherwise), three steps of each dancer's chooser, and the choice among the upright fixture's
+    outputs at margins where all, some and none of them stand."""
+    cases = {}
+    for role, size in (("leader", feat.LEADER_INPUT_SIZE), ("follower", feat.INPUT_SIZE)):
+        chooser = OC.OnCount(role, 4, 0.8)
+        steps = []
+        for beat in (3.37, 3.39, 3.41):
+            x = rng.normal(0, 0.7, size)
+            x[-music.MUSIC_SIZE:] = music.music_block(np.array(beat), np.array(2.9))
+            steps.append({"input": exact(x), "footwork": out7(OC.footwork_now(x, role)),
+                          "count": out7(OC.count_next(x)), "target": out7(chooser.target(x))})
+        cases[role] = steps
+    standing = G.upright_margin(outputs, ranges, offsets)
+    target = 1.0   # m/s: nearer the second body's footwork (0.97) than the first's (1.08)
+    return {"roles": cases, "outputs": exact(outputs), "footworkNext": out7(OC.footwork_next(outputs)),
+            "standing": out7(standing), "target": out7(target),
+            "best": {str(m): OC.nearest_count(outputs, target, standing, m) for m in (-9.0, 0.0, 0.05, 9.0)}}
+
+
 def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_offsets, follow_offsets) -> dict:
     vectors_f = np.round(rng.normal(size=(5, 3)), 6)
     vectors_u = np.round(rng.normal(size=(5, 3)), 6)
@@ -526,6 +548,7 @@ def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_o
                    "planBestStanding": G.nearest_plan(outputs, plan_input, ranges, follow_offsets, 0.05)}
     return {
         "NOW": ro.NOW, "TRACK_FRAMES": ro.TRACK_FRAMES, "guards": guards, "upright": uprightness,
+        "onCount": on_count_cases(np.random.default_rng(SEED + 3), outputs, ranges, follow_offsets),
         "rotationsFromVectors": {"forward": exact(vectors_f), "up": exact(vectors_u),
                                  "expected": out7(ro.rotations_from_vectors(vectors_f, vectors_u))},
         "offsets": {"leader": exact(lead_offsets), "follower": exact(follow_offsets)},

@@ -182,6 +182,36 @@ describe('createSimulation', () => {
     expect(plain.sim.guards().upright).toBe(0);
   });
 
+  it('onCount: every step each dancer draws its samples at once and keeps a standing one; the guard takes over when none stands', async () => {
+    const ranges = { hip_low: 0.7, head_above_hip_low: 0.4, feet_wide: 1.07, angle_high: [2.5, 0.59] };
+    const counted = {
+      leaderTemperature: 0.5, guard: { samples: 4, margin: 0.05 }, leaderGuard: { samples: 4, margin: 0.05 },
+      onCount: { samples: 3, strength: 1 }, plausibility: ranges,
+    };
+    const { sim, lead, follow } = simulation([{ role: 'follower', tipped: [0, 1] }], { role: 'leader', tipped: [0] }, counted);
+    await sim.step(steer, 1);
+    expect(lead.runs).toBe(0); // no single run: the batch of 3 alone, at his variety
+    expect(lead.batchSizes).toEqual([3]);
+    expect(lead.temperatures).toEqual([0.5]);
+    expect(follow[0].runs).toBe(0);
+    expect(follow[0].batchSizes).toEqual([3]);
+    expect(sim.guards().upright).toBe(0); // a standing sample was kept (her third, his second or third)
+    const p = sim.followers[0].positions;
+    expect(p[4 * 3 + 1] - p[1]).toBeGreaterThan(0.4);
+    // None of her 3 stands: her guard draws its 4 and takes the most upright (the fourth stands).
+    const fallen = simulation([{ role: 'follower', tipped: [0, 1, 2] }], { role: 'leader' }, counted);
+    await fallen.sim.step(steer, 1);
+    expect(fallen.follow[0].batchSizes).toEqual([3, 4]);
+    expect(fallen.sim.guards().upright).toBe(1);
+    const q = fallen.sim.followers[0].positions;
+    expect(q[4 * 3 + 1] - q[1]).toBeGreaterThan(0.4);
+    // Without onCount each takes its one sample, as before.
+    const plain = simulation([{ role: 'follower' }], { role: 'leader' }, { ...counted, onCount: undefined });
+    await plain.sim.step(steer, 1);
+    expect(plain.lead.batchSizes).toEqual([]);
+    expect(plain.follow[0].batchSizes).toEqual([]);
+  });
+
   it('with keepPlan, a request draws his samples at once and keeps the standing one whose lead hand is nearest the plan', async () => {
     const ranges = { hip_low: 0.7, head_above_hip_low: 0.4, feet_wide: 1.07, angle_high: [2.5, 0.59] };
     const keep = { leaderTemperature: 0.5, leaderGuard: { samples: 4, margin: 0.05, keepPlan: true }, plausibility: ranges };

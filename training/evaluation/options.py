@@ -15,6 +15,7 @@ from __future__ import annotations
 import argparse
 
 from ..mirror.guard import UprightGuard, Variety
+from ..mirror.on_count import STRENGTH as ON_COUNT_STRENGTH, OnCount
 from ..mirror.music import DEFAULT_TEMPO
 
 
@@ -44,6 +45,11 @@ def add_options(ap: argparse.ArgumentParser) -> None:
                     help="her guard also chooses when a step would take her hips down more than M metres "
                          "(to below guard.HIP_DROP_BELOW; measured, not in the page; default: the manifest's "
                          "guard.hipDrop, else never)")
+    ap.add_argument("--on-count", type=int, default=None, metavar="K",
+                    help="both dancers' guards choose, every step, the one of K samples whose footwork follows "
+                         "the count (training/mirror/on_count.py; 0: off; default: the manifest's onCount.samples)")
+    ap.add_argument("--on-count-strength", type=float, default=None, metavar="S",
+                    help="how far the footwork aimed at swings with the beat, 0-1 (default: the manifest's onCount.strength)")
     ap.add_argument("--leader-guard", type=int, default=None, metavar="K",
                     help="the leader's upright guard with K samples (0: off; default: the manifest's "
                          "leaderGuard, acting at its margin)")
@@ -90,6 +96,17 @@ def resolve(args, manifest: dict) -> str | None:
         return f"--guard {args.guard}: 0 (off) or at least 2 samples to choose from"
     if min(args.temperature, args.follower_temperature) < 0:
         return "a temperature (variety) cannot be negative"
+    on_count = manifest.get("onCount") or {}
+    if getattr(args, "on_count", None) is None:
+        args.on_count = int(on_count.get("samples", 0))
+    if getattr(args, "on_count_strength", None) is None:
+        args.on_count_strength = float(on_count.get("strength", ON_COUNT_STRENGTH))
+    if args.on_count < 0 or args.on_count == 1:
+        return f"--on-count {args.on_count}: 0 (off) or at least 2 samples to choose from"
+    if not 0 <= args.on_count_strength <= 1:
+        return f"--on-count-strength {args.on_count_strength:g}: 0 to 1"
+    if args.on_count and not (args.guard or args.leader_guard):
+        return "--on-count chooses inside the upright guards: it needs --guard or --leader-guard"
     if args.guard and not manifest.get("plausibility"):
         return "the upright guard needs the manifest's plausibility range: re-export the models"
     return None
@@ -109,7 +126,7 @@ def follower_policy(policy, manifest: dict, args, leader_temperature: float):
                             manifest["skeleton"]["offsets"]["follower"], hip_margin=None if hips is None else float(hips),
                             partner_low=None if low is None else float(low),
                             partner_low_hip_margin=None if low is None or low_margin is None else float(low_margin),
-                            hip_drop=None if drop is None else float(drop))
+                            hip_drop=None if drop is None else float(drop), on_count=on_count_for("follower", args))
     return policy if temperature is None else Variety(policy, temperature)
 
 
@@ -125,11 +142,22 @@ def leader_policy(policy, manifest: dict, args):
         return UprightGuard(policy, manifest["plausibility"], samples, None, float(settings.get("margin", 0.0)),
                             manifest["skeleton"]["offsets"]["leader"], None if head is None else float(head),
                             hip_margin=None if hips is None else float(hips),
-                            keep_plan=bool(settings.get("keepPlan", False)))
+                            keep_plan=bool(settings.get("keepPlan", False)), on_count=on_count_for("leader", args))
     return policy
 
 
+def on_count_for(role: str, args) -> OnCount | None:
+    """A dancer's chooser on the count as the options ask (None: off)."""
+    samples = getattr(args, "on_count", 0) or 0
+    if not samples:
+        return None
+    return OnCount(role, samples, getattr(args, "on_count_strength", ON_COUNT_STRENGTH))
+
+
 def restart_count(policy) -> None:
-    """Zero the guard's count before a duet (a plain policy has none)."""
+    """Zero the guard's count before a duet (a plain policy has none), and forget the footwork its
+    chooser on the count has seen."""
     if hasattr(policy, "guarded"):
         policy.guarded = 0
+    if getattr(policy, "on_count", None) is not None:
+        policy.on_count.mean = None

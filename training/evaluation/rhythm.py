@@ -177,7 +177,10 @@ def duet_rhythm(manifest, leader, follower, seed: int, frames: int, temperature:
                 tempo: float, steered: bool) -> dict:
     """One of the soak's duets (steered by its stick, or by nobody), at a tempo: its rhythm."""
     from .soak import soak_one
+    from .options import restart_count
     record: dict = {}
+    for policy in (leader, follower):   # each duet starts from its own footwork (on_count.OnCount)
+        restart_count(policy)
     soak_one(manifest, leader, follower, seed, frames, temperature, record=record, tempo=tempo,
              steer=steered)
     # The first second is the standing start: the rhythm of the dance after it.

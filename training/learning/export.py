@@ -27,7 +27,7 @@ import numpy as np
 import torch
 
 from ..mirror import features as feat
-from ..mirror import music
+from ..mirror import music, on_count
 from ..data.dataset import DataError, discover_takes, load_pair
 from ..data.folders import add_folder
 from .models import OutputEncoderStep, StepModel
@@ -193,6 +193,9 @@ def write_manifest(out: Path, models: dict[str, StepModel], data: str, prepared:
                         **({} if LEADER_HEAD_MARGIN is None else {"headMargin": LEADER_HEAD_MARGIN}),
                         **({} if LEADER_HIP_MARGIN is None else {"hipMargin": LEADER_HIP_MARGIN}),
                         **({"keepPlan": True} if LEADER_KEEP_PLAN else {})},
+        # Both guards choose, every step, the sample whose footwork follows the count
+        # (training/mirror/on_count.py, web/mirror/on_count.ts).
+        "onCount": {"samples": on_count.SAMPLES, "strength": on_count.STRENGTH},
         # The training dancers' range (evaluation.plausibility): soak counts a collapse against it
         # and training.evaluation.seeds judges every steered frame against it.
         "plausibility": plausibility_ranges(prepared),

@@ -20,6 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import features as feat
+from .on_count import OnCount, nearest_count
 from .rollout import MIN_ANKLE_HEIGHT, rotations_from_vectors
 from .skeleton import FEET, HANDS, HEAD, forward_kinematics_reduced
 from ..evaluation.plausibility import CHEST
@@ -236,13 +237,17 @@ class UprightGuard:
     drawn step takes her hips down by more than that, to below `hip_drop_below` (drops).
     `keep_plan` (his): while his input shows a hands plan, every step draws the samples and takes
     the standing one whose lead hand is nearest the plan (nearest_plan); `kept` counts those
-    steps, `guarded` the ones among them where none stood."""
+    steps, `guarded` the ones among them where none stood. `on_count` (both dancers', an
+    on_count.OnCount): every other step draws its samples and takes the standing one whose
+    footwork follows the count (on_count.nearest_count); when none of them stands, the guard draws
+    its own samples and takes the most upright, as it always does."""
 
     def __init__(self, policy, ranges: dict, samples: int = SAMPLES, temperature: float | None = None,
                  margin: float = MARGIN, offsets: np.ndarray | None = None, head_margin: float | None = None,
                  hip_margin: float | None = None, partner_low: float | None = None,
                  partner_low_hip_margin: float | None = None, keep_plan: bool = False,
-                 hip_drop: float | None = None, hip_drop_below: float = HIP_DROP_BELOW):
+                 hip_drop: float | None = None, hip_drop_below: float = HIP_DROP_BELOW,
+                 on_count: OnCount | None = None):
         if samples < 2:
             raise ValueError("the guard needs at least 2 samples to choose from")
         self.policy, self.ranges, self.samples, self.temperature = policy, ranges, samples, temperature
@@ -254,6 +259,9 @@ class UprightGuard:
             raise ValueError("judging her hips' drop needs the dancer's bones (offsets)")
         if keep_plan and offsets is None:
             raise ValueError("keeping the hand to the plan needs the dancer's bones (offsets)")
+        if on_count is not None and offsets is None:
+            raise ValueError("stepping on the count needs the dancer's bones (offsets)")
+        self.on_count = on_count
         self.guarded = self.kept = 0
 
     def __call__(self, x: np.ndarray, temperature: float, rng: np.random.Generator) -> dict:
@@ -266,6 +274,21 @@ class UprightGuard:
             self.kept += 1
             if upright_margin(many["output"][best], self.ranges, self.offsets, slack, hips)[0] < self.margin:
                 self.guarded += 1
+            return {k: v[best:best + 1] for k, v in many.items()}
+        if self.on_count is not None:
+            target = self.on_count.target(x)
+            many = self.policy(np.repeat(np.atleast_2d(x), self.on_count.samples, 0), t, rng)
+            joints = drawn_joints(many["output"], self.offsets)
+            standing = drawn_margin(joints, self.ranges, slack, hips)
+            if self.hip_drop is not None:   # a drop judged per candidate, as below for one
+                standing = np.array([-np.inf if drops(x, joints[i:i + 1], self.hip_drop, self.hip_drop_below)
+                                     else m for i, m in enumerate(standing)])
+            best = nearest_count(many["output"], target, standing, self.margin)
+            if best >= 0:
+                return {k: v[best:best + 1] for k, v in many.items()}
+            self.guarded += 1
+            many = self.policy(np.repeat(np.atleast_2d(x), self.samples, 0), t, rng)
+            best = most_upright(many["output"], self.ranges, self.offsets, slack, hips)
             return {k: v[best:best + 1] for k, v in many.items()}
         out = self.policy(x, t, rng)
         if self.hip_drop is None:

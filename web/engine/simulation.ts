@@ -1,15 +1,17 @@
 // The page's Simulation: policies in, DancerViews out. One step runs the duet loop of rollout.ts
 // (the mirror of training/mirror/rollout.py) with the page's policies, then refreshes what the page draws
 // (the contact layer's poses: web/mirror/contact.ts; planned paths, intentions). Also here: the
-// follower's upright guard (web/mirror/guard.ts: a batch of fresh samples on the rare step whose body
-// would leave the recording's range), sampled ghosts and leader playback from a recording. Nothing
-// else in this file changes a number the models see.
+// upright guards (web/mirror/guard.ts: a batch of fresh samples on the rare step whose body would
+// leave the recording's range), the steps on the count (web/mirror/on_count.ts: every step, the
+// standing sample whose footwork follows the beat), sampled ghosts and leader playback from a
+// recording. Nothing else in this file changes a number the models see.
 
 import { FUTURE_OFFSETS, INPUT_SIZE, INTENTION_SIZE, KEYS, OUTPUT_SIZE, followerInput } from '../mirror/features';
 import { KEY_JOINTS, type Motion, POSITIONS_SIZE, ROTATIONS_SIZE } from '../mirror/skeleton';
 import { ContactLayer, FOLLOWER_CONTACT, HipGlide } from '../mirror/contact';
 import { FootLock } from '../mirror/footik';
 import { type GuardSettings, type Ranges, hipSlackFor, mostUpright, nearestPlan, showsPlan, slackFor, uprightMargin } from '../mirror/guard';
+import { OnCount, nearestCount } from '../mirror/on_count';
 import { LeaderPlayback } from './playback';
 import { StepTimer } from './timing';
 import {
@@ -71,12 +73,19 @@ export class DuetSimulation implements Simulation {
   private readonly followerInputs: Float32Array[];
   // Own copies of each model's result: two roles may never share a policy's result arrays.
   private readonly leaderOutput = new Float32Array(OUTPUT_SIZE);
-  private readonly guardCounts = { resets: 0, leashed: 0, upright: 0 };
+  private readonly guardCounts = { resets: 0, leashed: 0, upright: 0, counted: 0 };
   /** Steps in which an upright guard took another of a dancer's samples (follower or leader). */
   private upright = 0;
+  /** Dancers' steps whose sample was chosen on the count (on_count.ts), leader and followers. */
+  private counted = 0;
   private readonly uprightGuard: { settings: GuardSettings; ranges: Ranges } | null;
   /** The leader's guard (the same test at the manifest's leaderGuard margin). */
   private readonly leaderGuard: { settings: GuardSettings; ranges: Ranges } | null;
+  /** Each dancer's chooser on the count (the manifest's onCount, inside its guard); null: off. */
+  private readonly leaderOnCount: OnCount | null;
+  private readonly followerOnCount: (OnCount | null)[];
+  /** Each candidate's upright margin, for the choice on the count. */
+  private standing = new Float64Array(0);
   /** The leader model's own variety (the manifest's); the slider sets the followers'. */
   private readonly leaderTemperature: number | null;
   private readonly followerOutputs: Float32Array[];
@@ -104,6 +113,9 @@ export class DuetSimulation implements Simulation {
     this.uprightGuard = g && g.samples >= 2 && manifest.plausibility ? { settings: g, ranges: manifest.plausibility } : null;
     const lg = manifest.leaderGuard;
     this.leaderGuard = lg && lg.samples >= 2 && manifest.plausibility ? { settings: lg, ranges: manifest.plausibility } : null;
+    const oc = manifest.onCount && manifest.onCount.samples >= 2 ? manifest.onCount : null;
+    this.leaderOnCount = oc && this.leaderGuard ? new OnCount('leader', oc.samples, oc.strength) : null;
+    this.followerOnCount = followers.map(() => (oc && this.uprightGuard ? new OnCount('follower', oc.samples, oc.strength) : null));
     this.duet = startDuet(manifest, followers.length);
     this.shownBeat = this.duet.beat;
     this.leaderView = new View(false);
@@ -120,6 +132,8 @@ export class DuetSimulation implements Simulation {
     this.shownBeat = this.duet.beat;
     this.ghostBranched = []; // the possible reactions branch again from the new start
     this.upright = 0;
+    this.counted = 0;
+    for (const c of [this.leaderOnCount, ...this.followerOnCount]) if (c) c.mean = null;
     this.playback?.start(this.duet.leader.track);
     this.timer.clear();
     this.updateViews(true);
@@ -176,6 +190,7 @@ export class DuetSimulation implements Simulation {
     stepInputs(duet, playing ? null : this.leaderPolicy.input, this.followerInputs);
     if (!playing) await this.stepLeader(this.leaderTemperature ?? temperature);
     for (let i = 0; i < this.followerPolicies.length; i++) {
+      if (await this.followerOnTheCount(i, temperature)) continue;
       const result = await this.followerPolicies[i].run(temperature);
       this.followerOutputs[i].set(result.output);
       if (result.intention) this.followerIntentions[i]?.set(result.intention);
@@ -211,6 +226,45 @@ export class DuetSimulation implements Simulation {
     this.upright++;
   }
 
+  /**
+   * Follower i's step on the count (web/mirror/on_count.ts): her samples drawn at once, the standing
+   * one whose footwork is nearest what the count asks taken. Returns false when she has no chooser;
+   * when none of the samples stands, her guard draws its own and takes the most upright.
+   */
+  private async followerOnTheCount(i: number, temperature: number): Promise<boolean> {
+    const onCount = this.followerOnCount[i];
+    const guard = this.uprightGuard;
+    if (!onCount || !guard) return false;
+    const offsets = this.duet.followers[i].offsets;
+    const policy = this.followerPolicies[i];
+    const { margin, hipMargin, partnerLow, partnerLowHipMargin } = guard.settings;
+    const hipSlack = hipSlackFor(policy.input, margin, hipMargin, partnerLow, partnerLowHipMargin);
+    const target = onCount.target(policy.input);
+    const k = onCount.samples;
+    const input = policy.batchInput(k);
+    for (let n = 0; n < k; n++) input.set(policy.input, n * INPUT_SIZE);
+    const { output, intention } = await policy.runBatch(k, temperature);
+    const standing = this.standingOf(output, k, guard.ranges, offsets, 0, hipSlack);
+    const best = nearestCount(output, k, OUTPUT_SIZE, target, standing, margin);
+    if (best < 0) {
+      this.followerOutputs[i].set(output.subarray(0, OUTPUT_SIZE));   // judged below as any step is
+      if (intention) this.followerIntentions[i]?.set(intention.subarray(0, INTENTION_SIZE));
+      await this.keepUpright(i, temperature);
+      return true;
+    }
+    this.followerOutputs[i].set(output.subarray(best * OUTPUT_SIZE, (best + 1) * OUTPUT_SIZE));
+    if (intention) this.followerIntentions[i]?.set(intention.subarray(best * INTENTION_SIZE, (best + 1) * INTENTION_SIZE));
+    this.counted++;
+    return true;
+  }
+
+  /** The upright margin of each of k outputs (guard.ts), in one reused array. */
+  private standingOf(output: ArrayLike<number>, k: number, ranges: Ranges, offsets: ArrayLike<number>, slack: number, hipSlack: number): Float64Array {
+    if (this.standing.length < k) this.standing = new Float64Array(k);
+    for (let n = 0; n < k; n++) this.standing[n] = uprightMargin(output, n * OUTPUT_SIZE, ranges, offsets, slack, hipSlack);
+    return this.standing;
+  }
+
   /** The leader's output of this step, under the same guard (mirror/guard.py's UprightGuard wraps
    *  his policy alike): his head judged from the headMargin, his hips from the hipMargin, when the
    *  manifest has them. With keepPlan, while a request runs, every step draws the samples at once
@@ -227,7 +281,21 @@ export class DuetSimulation implements Simulation {
     const slack = slackFor(policy.input, margin, headMargin);
     const hipSlack = hipSlackFor(policy.input, margin, hipMargin);
     const plan = keepPlan === true && showsPlan(policy.input);
-    if (!plan) {
+    const onCount = plan ? null : this.leaderOnCount;
+    if (onCount) {
+      // His step on the count (on_count.ts): the standing sample whose footwork follows the beat.
+      const target = onCount.target(policy.input);
+      const n = onCount.samples;
+      const batch = policy.batchInput(n);
+      for (let s = 0; s < n; s++) batch.set(policy.input, s * policy.input.length);
+      const { output } = await policy.runBatch(n, temperature);
+      const best = nearestCount(output, n, OUTPUT_SIZE, target, this.standingOf(output, n, guard.ranges, offsets, slack, hipSlack), margin);
+      if (best >= 0) {
+        this.leaderOutput.set(output.subarray(best * OUTPUT_SIZE, (best + 1) * OUTPUT_SIZE));
+        this.counted++;
+        return;
+      }
+    } else if (!plan) {
       const result = await policy.run(temperature);
       this.leaderOutput.set(result.output);
       if (uprightMargin(this.leaderOutput, 0, guard.ranges, offsets, slack, hipSlack) >= margin) return;
@@ -279,9 +347,10 @@ export class DuetSimulation implements Simulation {
   }
 
   /** Called every animation frame by the HUD: sums into one reused object, allocates nothing. */
-  guards(): { resets: number; leashed: number; upright: number } {
+  guards(): { resets: number; leashed: number; upright: number; counted: number } {
     const g = this.guardCounts;
     g.upright = this.upright;
+    g.counted = this.counted;
     g.resets = this.duet.leader.resets;
     g.leashed = this.duet.leader.leashed;
     for (const f of this.duet.followers) {

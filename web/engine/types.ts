@@ -3,6 +3,7 @@
 // models, pose) is the simulation's business.
 
 import type { GuardSettings, Ranges } from '../mirror/guard';
+import type { OnCountSettings } from '../mirror/on_count';
 import type { Motion } from '../mirror/skeleton';
 import type { RecordableDuet } from '../ui/record';
 
@@ -67,8 +68,9 @@ export interface Simulation {
   stepMs(): { median: number; p95: number };
   /** Guard counts since the start: dancers reset after absurd model output, frames the leash
    *  drew a follower toward the leader (see rollout.ts), and steps the upright guard took another
-   *  of a follower's samples (web/mirror/guard.ts). */
-  guards(): { resets: number; leashed: number; upright: number };
+   *  of a follower's samples (web/mirror/guard.ts), and dancers' steps whose sample was chosen on
+   *  the count (web/mirror/on_count.ts). */
+  guards(): { resets: number; leashed: number; upright: number; counted: number };
   /**
    * Drive the leader from a recorded motion (30 fps) instead of the leader model, or go back to
    * the model with null. Throws, changing nothing, on a motion it cannot play.
@@ -155,6 +157,9 @@ export interface Manifest {
   guard?: GuardSettings;
   /** The leader's upright guard, the same with its own margin; absent: no guard. */
   leaderGuard?: GuardSettings;
+  /** Both guards' choice on the count (web/mirror/on_count.ts): samples each step and the pull's
+   *  strength; absent: each dancer takes its one sample. */
+  onCount?: OnCountSettings;
   /** The recording's range (training/evaluation/plausibility.py); the guard judges against it. */
   plausibility?: Ranges;
   /** What the dancers hear: the tempo (beats a minute) when the address names none, and what the

@@ -221,6 +221,8 @@ class Page {
     });
     Object.defineProperty(hook, 'beat', { enumerable: true, get: () => this.simulation?.beat ?? 0 });
     Object.defineProperty(hook, 'tempo', { enumerable: true, get: () => this.settings.tempo });
+    // Dancers' steps whose sample was chosen on the count (web/mirror/on_count.ts): the tests see it act.
+    Object.defineProperty(hook, 'counted', { enumerable: true, get: () => this.simulation?.guards().counted ?? 0 });
 
     this.controls = new Controls({
       surface: this.stage.canvas,
