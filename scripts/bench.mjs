@@ -7,6 +7,8 @@
 //   npm run bench                 # threads 1 and 2
 //   node scripts/bench.mjs --seconds 20 --json
 //   npm run bench -- --leading    # the same, T pressed every 2 s: every step leads her turn
+//   npm run bench -- --count-cost # each thread count also without the manifest's onCount, alternating:
+//                                 # what choosing on the count costs a step, as a ratio in one run
 //   npm run bench -- --phone      # a phone on a mobile network: see scripts/bench_phone.mjs
 //   npm run bench -- --phone --boot-only --query threads=1   # only the two visits, extra URL settings
 //
@@ -26,6 +28,9 @@ const json = args.includes('--json');
 // While a turn is led the leader's guard draws its samples every step (leaderGuard.keepPlan), so the
 // step costs more then: --leading presses T every 2 s (a request lasts 2.5 s) to time those steps.
 const leading = args.includes('--leading');
+// Both dancers choose each step among onCount.samples at once (web/mirror/on_count.ts): --count-cost
+// also runs the page with the manifest's onCount taken out, so the two step times share one machine state.
+const countCost = args.includes('--count-cost');
 
 /** Waits `ms`, pressing T every 2 s when --leading. */
 async function dance(page, ms) {
@@ -38,9 +43,18 @@ async function dance(page, ms) {
 
 const mb = (bytes) => `${(bytes / 1e6).toFixed(2)} MB`;
 
-async function run(url, threads) {
+async function run(url, threads, withoutCount = false) {
   const browser = await launch(); // fresh profile: a cold load, nothing cached
   const { page } = browser;
+  if (withoutCount) {
+    // The manifest as shipped, less onCount: each dancer takes its one sample (the worker's fetch too).
+    await browser.context.route('**/models/manifest.json', async (route) => {
+      const response = await route.fetch();
+      const manifest = await response.json();
+      delete manifest.onCount;
+      await route.fulfill({ response, json: manifest });
+    });
+  }
   const downloads = new Map();
   page.on('response', async (response) => {
     try {
@@ -85,6 +99,8 @@ async function run(url, threads) {
     return {
       threads: state.threads,
       requestedThreads: threads,
+      onCount: !withoutCount,
+      counted: state.counted ?? 0,
       crossOriginIsolated: await page.evaluate(() => crossOriginIsolated),
       stepMs: state.stepMs,
       stepsPerSecond: state.frame / seconds,
@@ -112,7 +128,10 @@ await build('dist');
 const server = await startServer({ mode: 'preview', outDir: 'dist' });
 const results = [];
 try {
-  for (const threads of threadCounts) results.push(await run(server.url, threads));
+  for (const threads of threadCounts) {
+    results.push(await run(server.url, threads));
+    if (countCost) results.push(await run(server.url, threads, true));
+  }
 } finally {
   await server.stop();
 }
@@ -121,13 +140,20 @@ if (json) {
   console.log(JSON.stringify(results, null, 1));
 } else {
   for (const r of results) {
-    console.log(`\nthreads ${r.threads} (asked ${r.requestedThreads}, cross-origin isolated: ${r.crossOriginIsolated})${leading ? ', T every 2 s' : ''}`);
+    const count = countCost ? (r.onCount ? `, on the count (${r.counted} dancer-steps chosen)` : ', without onCount') : '';
+    console.log(`\nthreads ${r.threads} (asked ${r.requestedThreads}, cross-origin isolated: ${r.crossOriginIsolated})${leading ? ', T every 2 s' : ''}${count}`);
     console.log(`  step            median ${r.stepMs.median.toFixed(2)} ms   p95 ${r.stepMs.p95.toFixed(2)} ms`);
     console.log(`  cold load       ${(r.coldLoadMs / 1000).toFixed(2)} s to the first dancing frame on screen`);
     console.log(`  models          ${mb(r.modelBytes)}`);
     console.log(`  page weight     ${mb(r.pageBytes)} raw, ${mb(r.pageGzipBytes)} gzip (${mb(r.transferredBytes)} sent by vite preview)`);
     console.log(`  display         ${r.fps.toFixed(1)} fps (software WebGL in headless Chromium)`);
     if (r.consoleErrors.length) console.log(`  console errors: ${r.consoleErrors.join(' | ')}`);
+  }
+  if (countCost) {
+    for (let i = 0; i + 1 < results.length; i += 2) {
+      const [on, off] = [results[i], results[i + 1]];
+      console.log(`\nchoosing on the count, ${on.threads} thread${on.threads === 1 ? '' : 's'}: step median ${(on.stepMs.median / off.stepMs.median).toFixed(2)}x the step without it (${on.stepMs.median.toFixed(2)} / ${off.stepMs.median.toFixed(2)} ms)`);
+    }
   }
   const largest = Object.entries(results[0].files).sort((a, b) => b[1].gzip - a[1].gzip).slice(0, 6);
   console.log('\nlargest downloads (gzip):');

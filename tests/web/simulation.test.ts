@@ -85,6 +85,14 @@ class FakePolicy implements StepPolicy {
     return { output: b.output, intention: null };
   }
 
+  /** k samples of `input` (the page's guards and its choice on the count): as k rows of it. */
+  async runDraws(k: number, temperature: number) {
+    const rows = this.batchInput(k);
+    for (let i = 0; i < k; i++) rows.set(this.input, i * this.size);
+    const { output } = await this.runBatch(k, temperature);
+    return { output, intention: this.result.intention };
+  }
+
   private fill(input: Float32Array, at: number, out: Float32Array, to: number, sample: number) {
     const o = this.options;
     const self = blockSlices(o.role === 'leader' ? LEADER_INPUT_LAYOUT : FOLLOWER_INPUT_LAYOUT).self_pose.start;

@@ -67,8 +67,8 @@ def export_onnx(model: StepModel, path: Path) -> None:
     names = ["output", "intention", "code"] if cfg.intention else ["output", "code"]
     torch.onnx.export(model, (x, t, u), str(path), opset_version=OPSET, dynamo=False,
                       input_names=["input", "temperature", "noise"], output_names=names,
-                      dynamic_axes={"input": {0: "batch"}, "noise": {0: "batch"},
-                                    **{n: {0: "batch"} for n in names}})
+                      dynamic_axes={"input": {0: "batch"}, "noise": {0: "samples"},
+                                    **{n: {0: "batch" if n == "intention" else "samples"} for n in names}})
 
 
 def export_output_encoder(model: StepModel, path: Path) -> None:

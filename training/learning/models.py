@@ -183,7 +183,11 @@ class Discriminator(nn.Module):
 
 class StepModel(nn.Module):
     """One animation step on raw features: normalize -> intention -> input encoder -> sample ->
-    decoder -> de-normalize. Inputs: input [B, 660], temperature [1], noise [B, C*D] uniform (0,1).
+    decoder -> de-normalize. Inputs: input [B, 660], temperature [1], noise [B, C*D] uniform (0,1):
+    one sample per input row; or input [1, ...] with noise [K, C*D]: K samples of one input, the
+    encoders run once and only the sampling and the decoder K times (the guards' and the count's
+    choices, web/mirror/guard.ts and on_count.ts). Outputs output and code have noise's rows,
+    intention input's (it does not depend on the noise).
     """
 
     def __init__(self, cfg: ModelConfig, predictor: IntentionPredictor | None,
@@ -204,9 +208,10 @@ class StepModel(nn.Module):
     def forward(self, x, temperature, noise):
         xn = (x - self.input_mean) / self.input_std
         logits, _, intention_n = code_logits(self.predictor, self.matching, xn)
-        b, c = x.shape[0], self.cfg.channels
+        c, d = self.cfg.channels, self.cfg.classes
         u = noise.clamp(1e-7, 1 - 1e-7)
-        z = logits.reshape(b, c, -1) + temperature.reshape(1, 1, 1) * -torch.log(-torch.log(u.reshape(b, c, -1)))
+        # [B or 1, C, D] + [B or K, C, D]: one input's logits broadcast over its K draws
+        z = logits.reshape(-1, c, d) + temperature.reshape(1, 1, 1) * -torch.log(-torch.log(u.reshape(-1, c, d)))
         code = z.argmax(-1)
         y = self.decode(code, xn)
         out = y * self.output_std + self.output_mean

@@ -37,6 +37,7 @@ export class Policy implements StepPolicy {
   private readonly temperature = new Float32Array(1);
   private readonly temperatureTensor: Tensor;
   private readonly batches = new Map<number, Batch>();
+  private readonly draws = new Map<number, Batch>();
   private readonly fetches: string[];
   private readonly uniform: () => number;
   private readonly single: Batch;
@@ -80,6 +81,38 @@ export class Policy implements StepPolicy {
     copyOut(outputs.output, batch.result.output);
     if (batch.result.intention) copyOut(outputs.intention, batch.result.intention);
     return batch.result;
+  }
+
+  /**
+   * k samples of `input` at once, each with its own noise: the encoders run once, the sampling and
+   * the decoder k times (the guards' and the count's choices). Returns output [k × 323] and the
+   * intention [90], one: it does not depend on the noise.
+   */
+  async runDraws(k: number, temperature: number): Promise<PolicyResult> {
+    const batch = this.drawsOf(k);
+    this.temperature[0] = temperature;
+    fillUniform(batch.noise, this.uniform);
+    const outputs = await this.session.run(batch.feeds, this.fetches);
+    copyOut(outputs.output, batch.result.output);
+    if (batch.result.intention) copyOut(outputs.intention, batch.result.intention);
+    return batch.result;
+  }
+
+  private drawsOf(k: number): Batch {
+    let batch = this.draws.get(k);
+    if (!batch) {
+      const noiseSize = this.entry.channels * this.entry.classes;
+      const noise = new Float32Array(k * noiseSize);
+      batch = {
+        size: k,
+        input: this.input,
+        noise,
+        feeds: { input: this.single.feeds.input, temperature: this.temperatureTensor, noise: new ort.Tensor('float32', noise, [k, noiseSize]) },
+        result: { output: new Float32Array(k * OUTPUT_SIZE), intention: this.entry.intention ? new Float32Array(INTENTION_SIZE) : null },
+      };
+      this.draws.set(k, batch);
+    }
+    return batch;
   }
 
   private batch(k: number): Batch {
@@ -141,19 +174,22 @@ export async function createPolicy(manifest: Manifest, name: string, bytes: Uint
     );
   }
   checkSession(name, entry, session);
-  await warmUp(session, entry, warmBatches(manifest, entry));
+  await warmUp(session, entry, warmDraws(manifest, entry));
   return new Policy(name, entry, session, seed);
 }
 
 /**
- * The batch sizes a model runs at: one step, and the batch of its dancer's upright guard
- * (simulation.ts). The guard acts in well under 1 % of steps, so its first batch can come minutes
- * into a dance; warmed up here, that step does not wait for new buffers. (The WebAssembly memory
- * can still take one growth step later: tests/e2e/soak.test.mjs.)
+ * The draws of one input a model runs at: one step, the samples of its dancer's choice on the
+ * count (every step), and those of its upright guard (simulation.ts). The guard acts in well under
+ * 1 % of steps, so its first draws can come minutes into a dance; warmed up here, that step does
+ * not wait for new buffers. (The WebAssembly memory can still take one growth step later:
+ * tests/e2e/soak.test.mjs.)
  */
-function warmBatches(manifest: Manifest, entry: ModelEntry): number[] {
+function warmDraws(manifest: Manifest, entry: ModelEntry): number[] {
   const guard = entry.role === 'leader' ? manifest.leaderGuard : manifest.guard;
-  return guard && guard.samples >= 2 ? [1, guard.samples] : [1];
+  if (!guard || guard.samples < 2) return [1];
+  const count = manifest.onCount && manifest.onCount.samples >= 2 ? [manifest.onCount.samples] : [];
+  return [...new Set([1, guard.samples, ...count])];
 }
 
 /**
@@ -162,12 +198,12 @@ function warmBatches(manifest: Manifest, entry: ModelEntry): number[] {
  * then): done here, it overlaps with the other downloads instead of delaying the first dancing
  * frame. Tensors of its own, so the policy's noise stream (and so the dance for a seed) is untouched.
  */
-async function warmUp(session: Session, entry: ModelEntry, batches: number[]): Promise<void> {
+async function warmUp(session: Session, entry: ModelEntry, draws: number[]): Promise<void> {
   const width = inputSize(entry);
   const noise = entry.channels * entry.classes;
-  for (const k of batches) {
+  for (const k of draws) {
     const outputs = await session.run({
-      input: new ort.Tensor('float32', new Float32Array(k * width), [k, width]),
+      input: new ort.Tensor('float32', new Float32Array(width), [1, width]),
       temperature: new ort.Tensor('float32', new Float32Array([1]), [1]),
       noise: new ort.Tensor('float32', new Float32Array(k * noise).fill(0.5), [k, noise]),
     }, entry.intention ? ['output', 'intention'] : ['output']);

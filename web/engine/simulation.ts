@@ -205,8 +205,9 @@ export class DuetSimulation implements Simulation {
   /**
    * The upright guard (web/mirror/guard.ts) on follower i's output of this step: when the body it
    * would draw comes within the margin of the recording's range (her hips within the hipMargin, or
-   * the partnerLowHipMargin while she sees his hips low), run the same input with fresh samples and
-   * keep the most upright (each one step on from the same state: no jump).
+   * the partnerLowHipMargin while she sees his hips low), draw fresh samples of the same input
+   * (runDraws: the encoders once) and keep the most upright (each one step on from the same state:
+   * no jump).
    */
   private async keepUpright(i: number, temperature: number): Promise<void> {
     const guard = this.uprightGuard;
@@ -217,12 +218,10 @@ export class DuetSimulation implements Simulation {
     const hipSlack = hipSlackFor(policy.input, margin, hipMargin, partnerLow, partnerLowHipMargin);
     if (uprightMargin(this.followerOutputs[i], 0, guard.ranges, offsets, 0, hipSlack) >= guard.settings.margin) return;
     const k = guard.settings.samples;
-    const input = policy.batchInput(k);
-    for (let n = 0; n < k; n++) input.set(policy.input, n * INPUT_SIZE);
-    const { output, intention } = await policy.runBatch(k, temperature);
+    const { output, intention } = await policy.runDraws(k, temperature);
     const best = mostUpright(output, k, OUTPUT_SIZE, guard.ranges, offsets, 0, hipSlack);
     this.followerOutputs[i].set(output.subarray(best * OUTPUT_SIZE, (best + 1) * OUTPUT_SIZE));
-    if (intention) this.followerIntentions[i]?.set(intention.subarray(best * INTENTION_SIZE, (best + 1) * INTENTION_SIZE));
+    if (intention) this.followerIntentions[i]?.set(intention);
     this.upright++;
   }
 
@@ -241,19 +240,16 @@ export class DuetSimulation implements Simulation {
     const hipSlack = hipSlackFor(policy.input, margin, hipMargin, partnerLow, partnerLowHipMargin);
     const target = onCount.target(policy.input);
     const k = onCount.samples;
-    const input = policy.batchInput(k);
-    for (let n = 0; n < k; n++) input.set(policy.input, n * INPUT_SIZE);
-    const { output, intention } = await policy.runBatch(k, temperature);
+    const { output, intention } = await policy.runDraws(k, temperature);
+    if (intention) this.followerIntentions[i]?.set(intention);
     const standing = this.standingOf(output, k, guard.ranges, offsets, 0, hipSlack);
     const best = nearestCount(output, k, OUTPUT_SIZE, target, standing, margin);
     if (best < 0) {
       this.followerOutputs[i].set(output.subarray(0, OUTPUT_SIZE));   // judged below as any step is
-      if (intention) this.followerIntentions[i]?.set(intention.subarray(0, INTENTION_SIZE));
       await this.keepUpright(i, temperature);
       return true;
     }
     this.followerOutputs[i].set(output.subarray(best * OUTPUT_SIZE, (best + 1) * OUTPUT_SIZE));
-    if (intention) this.followerIntentions[i]?.set(intention.subarray(best * INTENTION_SIZE, (best + 1) * INTENTION_SIZE));
     this.counted++;
     return true;
   }
@@ -286,9 +282,7 @@ export class DuetSimulation implements Simulation {
       // His step on the count (on_count.ts): the standing sample whose footwork follows the beat.
       const target = onCount.target(policy.input);
       const n = onCount.samples;
-      const batch = policy.batchInput(n);
-      for (let s = 0; s < n; s++) batch.set(policy.input, s * policy.input.length);
-      const { output } = await policy.runBatch(n, temperature);
+      const { output } = await policy.runDraws(n, temperature);
       const best = nearestCount(output, n, OUTPUT_SIZE, target, this.standingOf(output, n, guard.ranges, offsets, slack, hipSlack), margin);
       if (best >= 0) {
         this.leaderOutput.set(output.subarray(best * OUTPUT_SIZE, (best + 1) * OUTPUT_SIZE));
@@ -300,9 +294,7 @@ export class DuetSimulation implements Simulation {
       this.leaderOutput.set(result.output);
       if (uprightMargin(this.leaderOutput, 0, guard.ranges, offsets, slack, hipSlack) >= margin) return;
     }
-    const input = policy.batchInput(k);
-    for (let n = 0; n < k; n++) input.set(policy.input, n * policy.input.length);
-    const { output } = await policy.runBatch(k, temperature);
+    const { output } = await policy.runDraws(k, temperature);
     const best = plan
       ? nearestPlan(output, k, OUTPUT_SIZE, policy.input, guard.ranges, offsets, margin, slack, hipSlack)
       : mostUpright(output, k, OUTPUT_SIZE, guard.ranges, offsets, slack, hipSlack);

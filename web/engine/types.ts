@@ -100,6 +100,9 @@ export interface StepPolicy {
   batchInput(k: number): Float32Array;
   /** k samples at once, each with its own noise: reads batchInput(k), returns [k × ...] results. */
   runBatch(k: number, temperature: number): Promise<PolicyResult>;
+  /** k samples of `input` at once, each with its own noise (the encoders run once): output
+   *  [k × 323], intention [90] (one: it does not depend on the noise). */
+  runDraws(k: number, temperature: number): Promise<PolicyResult>;
 }
 
 /** What the shell hands to the simulation factory. */
