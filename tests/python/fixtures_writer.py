@@ -422,11 +422,15 @@ def on_count_cases(rng: np.random.Generator, outputs: np.ndarray, ranges: dict, 
     for role, size in (("leader", feat.LEADER_INPUT_SIZE), ("follower", feat.INPUT_SIZE)):
         chooser = OC.OnCount(role, 4, 0.8)
         steps = []
-        for beat in (3.37, 3.39, 3.41):
+        # facing 5 frames ago, turned by 0.05 rad (a step), 0.2 rad (a walk round) and 0.8 rad (a spin)
+        for beat, turned in ((3.37, 0.05), (3.39, 0.2), (3.41, 0.8)):
             x = rng.normal(0, 0.7, size)
+            x[OC.LAST_FACING[role]:OC.LAST_FACING[role] + 2] = np.sin(turned), np.cos(turned)
             x[-music.MUSIC_SIZE:] = music.music_block(np.array(beat), np.array(2.9))
+            target = chooser.target(x)
             steps.append({"input": exact(x), "footwork": out7(OC.footwork_now(x, role)),
-                          "count": out7(OC.count_next(x)), "target": out7(chooser.target(x))})
+                          "count": out7(OC.count_next(x)), "turnRate": out7(OC.turn_rate(x, role)),
+                          "target": None if target is None else out7(target), "mean": out7(chooser.mean)})
         cases[role] = steps
     standing = G.upright_margin(outputs, ranges, offsets)
     target = 1.0   # m/s: nearer the second body's footwork (0.97) than the first's (1.08)

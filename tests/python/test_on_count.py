@@ -129,3 +129,25 @@ def test_options_take_it_from_the_manifest_and_refuse_what_cannot_choose():
 
 def policy_stub(x, temperature, rng):
     return {"output": np.zeros((len(np.atleast_2d(x)), feat.OUTPUT_SIZE))}
+
+
+def test_a_turn_is_left_to_the_network():
+    """Turning faster than TURNING (her facing 0.8 rad round in 5 frames: 4.8 rad/s), the chooser
+    aims at nothing and the guard takes the network's one sample, as on any unguarded step."""
+    x = input_at("follower", 0.3, 0.5)
+    c = OC.LAST_FACING["follower"]
+    x[c:c + 2] = np.sin(0.8), np.cos(0.8)
+    assert OC.turn_rate(x, "follower") == pytest.approx(0.8 * FPS / feat.KEY_STEP)
+    chooser = OC.OnCount("follower", samples=3)
+    assert chooser.target(x) is None and chooser.mean == pytest.approx(1.0)   # the mean still moves on
+    calls = []
+
+    def policy(x, temperature, rng):
+        calls.append(len(np.atleast_2d(x)))
+        return {"output": np.stack([output(1.0)] * len(np.atleast_2d(x)))}
+
+    guard = UprightGuard(policy, RANGES, samples=4, margin=0.05, offsets=OFFSETS, on_count=chooser)
+    guard(x, 1.0, np.random.default_rng(0))
+    x[c:c + 2] = 0.0, 1.0                       # facing as 5 frames ago: the count chooses again
+    guard(x, 1.0, np.random.default_rng(0))
+    assert calls == [1, 3] and guard.guarded == 0

@@ -4,7 +4,7 @@
 
 import { describe, expect, it } from 'vitest';
 import { OUTPUT_SIZE } from '../../web/mirror/features';
-import { OnCount, countNext, footworkNext, footworkNow, nearestCount } from '../../web/mirror/on_count';
+import { OnCount, TURNING, countNext, footworkNext, footworkNow, nearestCount, turnRate } from '../../web/mirror/on_count';
 import { expectClose, fixture } from './fixture';
 
 const data = fixture('rollout').onCount;
@@ -17,10 +17,21 @@ describe('the footwork each dancer aims at on the count', () => {
         const x = Float32Array.from(step.input);
         expectClose([footworkNow(x, role)], step.footwork, `${role} footwork now`);
         expectClose([countNext(x)], step.count, `${role} count at the next step`);
-        expectClose([chooser.target(x)], step.target, `${role} target`);
+        expectClose([turnRate(x, role)], step.turnRate, `${role} turn rate`);
+        const target = chooser.target(x);
+        if (step.target === null) expect(target, `${role} turning: no target`).toBeNull();
+        else expectClose([target as number], step.target, `${role} target`);
+        expectClose([chooser.mean as number], step.mean, `${role} footwork mean`);
       }
     });
   }
+
+  it('leaves a turn to the network: the last step of each role turns faster than TURNING', () => {
+    for (const role of ['leader', 'follower'] as const) {
+      const turning = data.roles[role].map((s: { turnRate: number[]; target: number[] | null }) => [s.turnRate[0] > TURNING, s.target === null]);
+      expect(turning).toEqual([[false, false], [false, false], [true, true]]);
+    }
+  });
 
   it('refuses a chooser with fewer than two samples', () => {
     expect(() => new OnCount('leader', 1)).toThrow(/at least 2 samples/);

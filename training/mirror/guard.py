@@ -238,9 +238,9 @@ class UprightGuard:
     `keep_plan` (his): while his input shows a hands plan, every step draws the samples and takes
     the standing one whose lead hand is nearest the plan (nearest_plan); `kept` counts those
     steps, `guarded` the ones among them where none stood. `on_count` (both dancers', an
-    on_count.OnCount): every other step draws its samples and takes the standing one whose
-    footwork follows the count (on_count.nearest_count); when none of them stands, the guard draws
-    its own samples and takes the most upright, as it always does."""
+    on_count.OnCount): every other step (but those of a turn) draws its samples and takes the
+    standing one whose footwork follows the count (on_count.nearest_count); when none of them
+    stands, the guard draws its own samples and takes the most upright, as it always does."""
 
     def __init__(self, policy, ranges: dict, samples: int = SAMPLES, temperature: float | None = None,
                  margin: float = MARGIN, offsets: np.ndarray | None = None, head_margin: float | None = None,
@@ -275,8 +275,8 @@ class UprightGuard:
             if upright_margin(many["output"][best], self.ranges, self.offsets, slack, hips)[0] < self.margin:
                 self.guarded += 1
             return {k: v[best:best + 1] for k, v in many.items()}
-        if self.on_count is not None:
-            target = self.on_count.target(x)
+        target = None if self.on_count is None else self.on_count.target(x)
+        if target is not None:
             many = self.policy(np.repeat(np.atleast_2d(x), self.on_count.samples, 0), t, rng)
             joints = drawn_joints(many["output"], self.offsets)
             standing = drawn_margin(joints, self.ranges, slack, hips)

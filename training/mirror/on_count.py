@@ -16,6 +16,10 @@ network's own reaction from the same state: nothing jumps, nobody's input change
 still reads the leader and hears the music with no command. The choice only nudges, step by step,
 when each dancer's feet speed up and slow down.
 
+While a dancer turns faster than TURNING, the network's own sample is taken: a spin moves the
+ankles fast whatever the count, so the pull broke her turns off (0.84x to 0.69x the recorded
+follower's turns a minute, 10 seeds of `lead`); left to the network, they stay (0.75x).
+
 Measured (python -m training.evaluation.rhythm, docs/music.md): with 8 samples at strength 1 the
 steps land on the beat about as the recorded ones do; fewer samples or a weaker pull land fewer.
 """
@@ -30,6 +34,7 @@ from .skeleton import FEET, FPS
 SAMPLES = 8           # candidates each step (one batched run of the network)
 STRENGTH = 1.0        # 0: the footwork's own mean; 1: from still on the beat to twice the mean between
 MEAN_SECONDS = 1.0    # how long the dancer's own footwork is averaged over (about three steps)
+TURNING = 3.0         # rad/s: faster than this the dancer is in a turn, left to the network (a spin: 6-9)
 
 # Where each role's input holds its own ankles' velocity (pose block: position, velocity, forward,
 # up per joint), and where the output holds the next step's; the count now is the music block's key
@@ -38,6 +43,10 @@ _POSE_JOINT = feat.POSE_SIZE // feat.N_JOINTS
 _NOW_KEY = int(np.nonzero(MUSIC_OFFSETS == 0)[0][0]) * 4
 ANKLE_VELOCITY_IN = {
     role: [feat.block_slices(layout)["self_pose"].start + _POSE_JOINT * j + 3 for j in FEET]
+    for role, layout in (("leader", feat.LEADER_INPUT_LAYOUT), ("follower", feat.FOLLOWER_INPUT_LAYOUT))}
+# The facing of the dancer's newest past trajectory key (KEY_STEP frames ago) in its root space now.
+LAST_FACING = {
+    role: feat.block_slices(layout)["self_trajectory_past"].start + (feat.KEYS - 1) * 4 + 2
     for role, layout in (("leader", feat.LEADER_INPUT_LAYOUT), ("follower", feat.FOLLOWER_INPUT_LAYOUT))}
 ANKLE_VELOCITY_OUT = [feat.block_slices(feat.OUTPUT_LAYOUT)["pose"].start + _POSE_JOINT * j + 3 for j in FEET]
 
@@ -51,6 +60,13 @@ def footwork_next(outputs: np.ndarray) -> np.ndarray:
     """The footwork each output [B, 323] would draw at the next step [B]."""
     outputs = np.atleast_2d(outputs)
     return sum(np.linalg.norm(outputs[:, c:c + 3], axis=-1) for c in ANKLE_VELOCITY_OUT)
+
+
+def turn_rate(x: np.ndarray, role: str) -> float:
+    """How fast the dancer turns now (rad/s, unsigned) from its input [I]: its facing KEY_STEP frames
+    ago, seen from its root now."""
+    c = LAST_FACING[role]
+    return float(abs(np.arctan2(x[c], x[c + 1])) * FPS / feat.KEY_STEP)
 
 
 def count_next(x: np.ndarray) -> float:
@@ -71,11 +87,15 @@ class OnCount:
         self.role, self.samples, self.strength = role, samples, strength
         self.mean: float | None = None
 
-    def target(self, x: np.ndarray) -> float:
-        """The footwork the next step aims at, for input x [I] (this step's: it moves the mean on)."""
-        now = footwork_now(np.atleast_2d(x)[0], self.role)
+    def target(self, x: np.ndarray) -> float | None:
+        """The footwork the next step aims at, for input x [I] (this step's: it moves the mean on);
+        None while the dancer turns faster than TURNING (the network's own sample is taken)."""
+        x = np.atleast_2d(x)[0]
+        now = footwork_now(x, self.role)
         self.mean = now if self.mean is None else self.mean + (now - self.mean) / (MEAN_SECONDS * FPS)
-        return self.mean * (1.0 - self.strength * np.cos(2 * np.pi * count_next(np.atleast_2d(x)[0])))
+        if turn_rate(x, self.role) > TURNING:
+            return None
+        return self.mean * (1.0 - self.strength * np.cos(2 * np.pi * count_next(x)))
 
 
 def nearest_count(outputs: np.ndarray, target: float, standing: np.ndarray, margin: float) -> int:

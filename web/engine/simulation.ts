@@ -227,8 +227,9 @@ export class DuetSimulation implements Simulation {
 
   /**
    * Follower i's step on the count (web/mirror/on_count.ts): her samples drawn at once, the standing
-   * one whose footwork is nearest what the count asks taken. Returns false when she has no chooser;
-   * when none of the samples stands, her guard draws its own and takes the most upright.
+   * one whose footwork is nearest what the count asks taken. Returns false when she has no chooser
+   * or turns (then her step is taken as any other); when none of the samples stands, her guard
+   * draws its own and takes the most upright.
    */
   private async followerOnTheCount(i: number, temperature: number): Promise<boolean> {
     const onCount = this.followerOnCount[i];
@@ -236,9 +237,10 @@ export class DuetSimulation implements Simulation {
     if (!onCount || !guard) return false;
     const offsets = this.duet.followers[i].offsets;
     const policy = this.followerPolicies[i];
+    const target = onCount.target(policy.input);
+    if (target === null) return false; // she turns: her own sample, as any step
     const { margin, hipMargin, partnerLow, partnerLowHipMargin } = guard.settings;
     const hipSlack = hipSlackFor(policy.input, margin, hipMargin, partnerLow, partnerLowHipMargin);
-    const target = onCount.target(policy.input);
     const k = onCount.samples;
     const { output, intention } = await policy.runDraws(k, temperature);
     if (intention) this.followerIntentions[i]?.set(intention);
@@ -278,9 +280,10 @@ export class DuetSimulation implements Simulation {
     const hipSlack = hipSlackFor(policy.input, margin, hipMargin);
     const plan = keepPlan === true && showsPlan(policy.input);
     const onCount = plan ? null : this.leaderOnCount;
-    if (onCount) {
-      // His step on the count (on_count.ts): the standing sample whose footwork follows the beat.
-      const target = onCount.target(policy.input);
+    // His step on the count (on_count.ts): the standing sample whose footwork follows the beat;
+    // while he turns, his own sample as any step.
+    const target = onCount ? onCount.target(policy.input) : null;
+    if (onCount && target !== null) {
       const n = onCount.samples;
       const { output } = await policy.runDraws(n, temperature);
       const best = nearestCount(output, n, OUTPUT_SIZE, target, this.standingOf(output, n, guard.ranges, offsets, slack, hipSlack), margin);

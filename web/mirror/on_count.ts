@@ -7,15 +7,19 @@
 // dancer's guard draws `samples` of the network's next step from the same input and takes the
 // standing one whose footwork is nearest mean · (1 − strength · cos 2π·count at the next step), where
 // mean is the dancer's own footwork over about the last second (simulation.ts). Every candidate is
-// the network's own reaction from the same state: nothing jumps, and nobody's input changes.
+// the network's own reaction from the same state: nothing jumps, and nobody's input changes. While
+// a dancer turns faster than TURNING the network's own sample is taken: a spin moves the ankles fast
+// whatever the count, and the pull broke her turns off.
 
-import { FOLLOWER_INPUT_LAYOUT, LEADER_INPUT_LAYOUT, OUTPUT_LAYOUT, POSE_SIZE, blockSlices } from './features';
+import { FOLLOWER_INPUT_LAYOUT, KEY_STEP, KEYS, LEADER_INPUT_LAYOUT, OUTPUT_LAYOUT, POSE_SIZE, blockSlices } from './features';
 import { MUSIC_OFFSETS, MUSIC_SIZE } from './music';
 import { FEET, FPS, N_JOINTS } from './skeleton';
 
 export const SAMPLES = 8;
 export const STRENGTH = 1.0;
 export const MEAN_SECONDS = 1.0;
+/** rad/s: faster than this the dancer is in a turn, left to the network (a spin: 6-9). */
+export const TURNING = 3.0;
 
 /** The manifest's "onCount": samples each step, and how far the footwork aimed at swings (0-1). */
 export interface OnCountSettings {
@@ -30,6 +34,11 @@ const NOW_KEY = MUSIC_OFFSETS.indexOf(0) * 4;
 export const ANKLE_VELOCITY_IN: Readonly<Record<Role, readonly number[]>> = {
   leader: FEET.map((j) => blockSlices(LEADER_INPUT_LAYOUT).self_pose.start + POSE_JOINT * j + 3),
   follower: FEET.map((j) => blockSlices(FOLLOWER_INPUT_LAYOUT).self_pose.start + POSE_JOINT * j + 3),
+};
+/** The facing of the dancer's newest past trajectory key (KEY_STEP frames ago) in its root space now. */
+export const LAST_FACING: Readonly<Record<Role, number>> = {
+  leader: blockSlices(LEADER_INPUT_LAYOUT).self_trajectory_past.start + (KEYS - 1) * 4 + 2,
+  follower: blockSlices(FOLLOWER_INPUT_LAYOUT).self_trajectory_past.start + (KEYS - 1) * 4 + 2,
 };
 export const ANKLE_VELOCITY_OUT: readonly number[] = FEET.map((j) => blockSlices(OUTPUT_LAYOUT).pose.start + POSE_JOINT * j + 3);
 
@@ -51,6 +60,12 @@ export function footworkNext(output: ArrayLike<number>, at = 0): number {
   return sum;
 }
 
+/** How fast the dancer turns now (rad/s, unsigned): its facing KEY_STEP frames ago, seen from its root now. */
+export function turnRate(input: ArrayLike<number>, role: Role): number {
+  const c = LAST_FACING[role];
+  return (Math.abs(Math.atan2(input[c], input[c + 1])) * FPS) / KEY_STEP;
+}
+
 /** The count at the next step (beats, its fraction only) from the music block ending the input. */
 export function countNext(input: ArrayLike<number>): number {
   const music = input.length - MUSIC_SIZE;
@@ -70,10 +85,12 @@ export class OnCount {
     if (samples < 2) throw new Error('choosing on the count needs at least 2 samples');
   }
 
-  /** The footwork the next step aims at, for this step's input (it moves the mean on). */
-  target(input: ArrayLike<number>): number {
+  /** The footwork the next step aims at, for this step's input (it moves the mean on); null while
+   *  the dancer turns faster than TURNING (the network's own sample is taken). */
+  target(input: ArrayLike<number>): number | null {
     const now = footworkNow(input, this.role);
     this.mean = this.mean === null ? now : this.mean + (now - this.mean) / (MEAN_SECONDS * FPS);
+    if (turnRate(input, this.role) > TURNING) return null;
     return this.mean * (1 - this.strength * Math.cos(2 * Math.PI * countNext(input)));
   }
 }
