@@ -73,14 +73,8 @@ export class Policy implements StepPolicy {
   }
 
   /** k samples at once, each with its own noise: reads batchInput(k), returns [k × ...] results. */
-  async runBatch(k: number, temperature: number): Promise<PolicyResult> {
-    const batch = this.batch(k);
-    this.temperature[0] = temperature;
-    fillUniform(batch.noise, this.uniform);
-    const outputs = await this.session.run(batch.feeds, this.fetches);
-    copyOut(outputs.output, batch.result.output);
-    if (batch.result.intention) copyOut(outputs.intention, batch.result.intention);
-    return batch.result;
+  runBatch(k: number, temperature: number): Promise<PolicyResult> {
+    return this.runWith(this.batch(k), temperature);
   }
 
   /**
@@ -88,8 +82,12 @@ export class Policy implements StepPolicy {
    * the decoder k times (the guards' and the count's choices). Returns output [k × 323] and the
    * intention [90], one: it does not depend on the noise.
    */
-  async runDraws(k: number, temperature: number): Promise<PolicyResult> {
-    const batch = this.drawsOf(k);
+  runDraws(k: number, temperature: number): Promise<PolicyResult> {
+    return this.runWith(this.drawsOf(k), temperature);
+  }
+
+  /** One session run on a batch's feeds with fresh noise, its results copied into the batch's arrays. */
+  private async runWith(batch: Batch, temperature: number): Promise<PolicyResult> {
     this.temperature[0] = temperature;
     fillUniform(batch.noise, this.uniform);
     const outputs = await this.session.run(batch.feeds, this.fetches);
