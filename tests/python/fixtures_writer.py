@@ -422,8 +422,8 @@ def on_count_cases(rng: np.random.Generator, outputs: np.ndarray, ranges: dict, 
     for role, size in (("leader", feat.LEADER_INPUT_SIZE), ("follower", feat.INPUT_SIZE)):
         chooser = OC.OnCount(role, 4, 0.8)
         steps = []
-        # facing 5 frames ago, turned by 0.05 rad (a step), 0.2 rad (a walk round) and 0.8 rad (a spin)
-        for beat, turned in ((3.37, 0.05), (3.39, 0.2), (3.41, 0.8)):
+        # facing 5 frames ago, turned by 0.05 rad (a step), 0.2 rad (a slow walk round) and 1.2 rad (a spin)
+        for beat, turned in ((3.37, 0.05), (3.39, 0.2), (3.41, 1.2)):
             x = rng.normal(0, 0.7, size)
             x[OC.LAST_FACING[role]:OC.LAST_FACING[role] + 2] = np.sin(turned), np.cos(turned)
             x[-music.MUSIC_SIZE:] = music.music_block(np.array(beat), np.array(2.9))
@@ -432,11 +432,23 @@ def on_count_cases(rng: np.random.Generator, outputs: np.ndarray, ranges: dict, 
                           "count": out7(OC.count_next(x)), "turnRate": out7(OC.turn_rate(x, role)),
                           "target": None if target is None else out7(target), "mean": out7(chooser.mean)})
         cases[role] = steps
+    # The choice among the upright fixture's bodies, from a follower's input whose own hips and
+    # ankles stand where the first body draws them, her hips having come in against the first's
+    # step and along the second's: the first turns them back, the second goes on.
+    x = rng.normal(0, 0.7, feat.INPUT_SIZE)
+    joints = G.drawn_joints(outputs, offsets)
+    x[OC.POSITION_IN["follower"]] = joints[0, OC.STEPPED]
+    x[OC.HIP_VELOCITY_IN["follower"]] = 0
+    steps = OC.drawn_steps(outputs, joints, x, "follower")
+    s0, s1 = steps[0, 0], steps[1, 0]
+    x[OC.HIP_VELOCITY_IN["follower"]] = (s1 / np.linalg.norm(s1) - s0 / np.linalg.norm(s0)) * 0.01 * FPS
+    footwork, back = OC.drawn_footwork(steps), OC.hips_turn_back(steps, x, "follower")
     standing = G.upright_margin(outputs, ranges, offsets)
-    target = 1.0   # m/s: nearer the second body's footwork (0.97) than the first's (1.08)
-    return {"roles": cases, "outputs": exact(outputs), "footworkNext": out7(OC.footwork_next(outputs)),
-            "standing": out7(standing), "target": out7(target),
-            "best": {str(m): OC.nearest_count(outputs, target, standing, m) for m in (-9.0, 0.0, 0.05, 9.0)}}
+    target = float(0.55 * footwork[0] + 0.45 * footwork[1])   # nearer the first, unless its hips count
+    return {"roles": cases, "outputs": exact(outputs), "input": exact(x), "steps": out7(steps.reshape(len(outputs), -1)),
+            "footwork": out7(footwork), "turnBack": back.tolist(), "standing": out7(standing), "target": out7(target),
+            "best": {f"{m}/{h}": OC.nearest_count(footwork, back, target, standing, m, h)
+                     for m in (-9.0, 0.0, 0.05, 9.0) for h in (0.0, 1.0)}}
 
 
 def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_offsets, follow_offsets) -> dict:

@@ -8,7 +8,8 @@ from training.evaluation import options as O
 from training.mirror import features as feat
 from training.mirror import music
 from training.mirror import on_count as OC
-from training.mirror.guard import POSE, UprightGuard
+from training.mirror.guard import POSE, UprightGuard, drawn_joints
+from training.mirror.rollout import MIN_ANKLE_HEIGHT
 from training.mirror.skeleton import FEET, FPS, HEAD
 
 RANGES = {"hip_low": 0.7, "head_above_hip_low": 0.6, "feet_wide": 1.0, "angle_high": [3.0, 0.6]}
@@ -21,21 +22,26 @@ def input_at(role: str, beat: float, ankle_speed: float, bps: float = 2.9) -> np
     x = np.zeros(feat.LEADER_INPUT_SIZE if role == "leader" else feat.INPUT_SIZE)
     for c in OC.ANKLE_VELOCITY_IN[role]:
         x[c] = ankle_speed
+    x[OC.POSITION_IN[role]] = STANDING[OC.STEPPED]
     x[-music.MUSIC_SIZE:] = music.music_block(np.array(beat), np.array(bps))
     return x
 
 
 def output(footwork: float, hip: float = 1.0) -> np.ndarray:
-    """An upright body (hips at `hip`) whose next step's ankles move footwork / 2 each."""
+    """An upright body (hips at `hip`) carried forward by its root so that each ankle moves
+    footwork / 2 (m/s) from where input_at has it."""
     out = np.zeros(feat.OUTPUT_SIZE)
     pose = out[POSE].reshape(feat.N_JOINTS, 12)
     pose[:, 1] = hip
     pose[HEAD, 1] = hip + 0.7
     pose[:, 6:9], pose[:, 9:12] = (0, 0, 1), (0, 1, 0)
-    for j in FEET:
-        pose[j, 3] = footwork / 2
     out[POSE] = pose.reshape(-1)
+    out[ROOT_UPDATE.start] = footwork / 2 / FPS
     return out
+
+
+ROOT_UPDATE = feat.block_slices(feat.OUTPUT_LAYOUT)["root_update"]
+STANDING = drawn_joints(output(0.0)[None], OFFSETS)[0]   # the body output draws before its root moves
 
 
 @pytest.mark.parametrize("role", ["leader", "follower"])
@@ -43,7 +49,34 @@ def test_it_reads_the_footwork_and_the_count_from_the_input(role):
     x = input_at(role, beat=7.3, ankle_speed=0.6, bps=3.0)
     assert OC.footwork_now(x, role) == pytest.approx(1.2)
     assert OC.count_next(x) % 1 == pytest.approx(0.3 + 3.0 / FPS)
-    assert OC.footwork_next(np.stack([output(0.8), output(2.0)])) == pytest.approx([0.8, 2.0])
+    outs = np.stack([output(0.8), output(2.0)])
+    steps = OC.drawn_steps(outs, drawn_joints(outs, OFFSETS), x, role)
+    assert OC.drawn_footwork(steps) == pytest.approx([0.8, 2.0])
+
+
+@pytest.mark.parametrize("role", ["leader", "follower"])
+def test_the_drawn_steps_are_the_steps_the_dancer_takes(take_tracks, take_pair, role):
+    """Given the recorded next frame as an output, drawn_steps gives the recorded move of the hips
+    and ankles (seen from the root now): the footwork is the recorded ankles' speed, and the hips
+    turn back on the frames jitter.py counts as reversals."""
+    from training.evaluation.jitter import reversal_frames
+    lead, follow = take_tracks
+    me, partner, offsets = (lead, follow, take_pair[0].offsets) if role == "leader" else (follow, lead, take_pair[1].offsets)
+    frames = np.arange(40, me.frames - 40)
+    x = (feat.leader_input(partner, me, frames) if role == "leader" else feat.follower_input(partner, me, frames))
+    outs = feat.output_features(me, frames)
+    joints = drawn_joints(outs, offsets)
+    kept = joints[:, FEET, 1].min(-1) > MIN_ANKLE_HEIGHT + 1e-9   # not lifted (the rollout lifts a body whose ankles sink)
+    moved = me.positions[frames + 1][:, OC.STEPPED] - me.positions[frames][:, OC.STEPPED]
+    seen = feat.to_root_space_directions(moved, me.heading[frames][:, None])
+    steps = np.stack([OC.drawn_steps(outs[i:i + 1], joints[i:i + 1], x[i], role)[0] for i in range(len(frames))])
+    np.testing.assert_allclose(steps[kept], seen[kept], atol=1e-5)
+    speed = np.linalg.norm(moved[:, 1:], axis=-1).sum(-1) * FPS
+    np.testing.assert_allclose(OC.drawn_footwork(steps)[kept], speed[kept], atol=1e-3)
+    back = np.array([OC.hips_turn_back(steps[i:i + 1], x[i], role)[0] for i in range(len(frames))])
+    counted = reversal_frames(me.positions)[frames - 1]   # its frame t - 1 is the turn into frame t + 1
+    assert kept.mean() > 0.9 and back.sum() > 5
+    assert (back == counted)[kept].mean() > 0.99
 
 
 def test_the_target_swings_with_the_beat_around_the_dancers_own_mean():
@@ -62,11 +95,27 @@ def test_the_target_swings_with_the_beat_around_the_dancers_own_mean():
         OC.OnCount("leader", samples=1)
 
 
-def test_nearest_count_takes_the_standing_sample_nearest_the_target():
-    outs = np.stack([output(0.2), output(1.0), output(1.4)])
-    assert OC.nearest_count(outs, 1.3, np.array([1.0, 1.0, 1.0]), 0.05) == 2
-    assert OC.nearest_count(outs, 1.3, np.array([1.0, 1.0, -0.2]), 0.05) == 1   # the nearest falls
-    assert OC.nearest_count(outs, 1.3, np.array([0.0, 0.01, -0.2]), 0.05) == -1
+def test_nearest_count_takes_the_standing_sample_nearest_the_target_its_hips_going_on():
+    footwork, back = np.array([0.2, 1.0, 1.4]), np.array([False, False, False])
+    assert OC.nearest_count(footwork, back, 1.3, np.array([1.0, 1.0, 1.0]), 0.05) == 2
+    assert OC.nearest_count(footwork, back, 1.3, np.array([1.0, 1.0, -0.2]), 0.05) == 1   # the nearest falls
+    assert OC.nearest_count(footwork, back, 1.3, np.array([0.0, 0.01, -0.2]), 0.05) == -1
+    # The nearest's hips would turn back: the next nearest is taken unless it misses by `hips` more.
+    back = np.array([False, False, True])
+    assert OC.nearest_count(footwork, back, 1.3, np.ones(3), 0.05, hips=1.0) == 1
+    assert OC.nearest_count(footwork, back, 1.3, np.ones(3), 0.05, hips=0.2) == 2
+    assert OC.nearest_count(footwork, np.ones(3, bool), 1.3, np.ones(3), 0.05, hips=1.0) == 2
+
+
+def test_the_hips_turn_back_when_their_step_reverses_the_last_one():
+    x = input_at("follower", 0.3, 0.5)
+    v = OC.HIP_VELOCITY_IN["follower"]
+    steps = np.zeros((4, 3, 3))
+    steps[:, 0] = [[0.01, 0, 0], [-0.01, 0, 0], [0, 0, 0.01], [-0.001, 0, 0]]   # on, back, sideways, nearly still
+    x[v] = 0.3, 0.0, 0.0    # 1 cm a frame along x into this frame
+    assert OC.hips_turn_back(steps, x, "follower").tolist() == [False, True, False, False]
+    x[v] = 0.03, 0.0, 0.0   # 1 mm a frame: standing, no way to turn back from
+    assert not OC.hips_turn_back(steps, x, "follower").any()
 
 
 def test_the_guard_chooses_on_the_count_every_step_and_guards_when_none_stands():
@@ -108,11 +157,11 @@ def test_options_take_it_from_the_manifest_and_refuse_what_cannot_choose():
     m = {"defaultTemperature": 1.0, "leaderTemperature": 0.5, "plausibility": RANGES,
          "skeleton": {"offsets": {"follower": OFFSETS.tolist(), "leader": OFFSETS.tolist()}},
          "guard": {"samples": 32, "margin": 0.05}, "leaderGuard": {"samples": 8, "margin": 0.07},
-         "onCount": {"samples": 8, "strength": 0.9}}
+         "onCount": {"samples": 8, "strength": 0.9, "hips": 0.7}}
     args = parse()
-    assert O.resolve(args, m) is None and (args.on_count, args.on_count_strength) == (8, 0.9)
+    assert O.resolve(args, m) is None and (args.on_count, args.on_count_strength, args.on_count_hips) == (8, 0.9, 0.7)
     lead, follow = O.leader_policy(policy_stub, m, args), O.follower_policy(policy_stub, m, args, 0.5)
-    assert (lead.on_count.role, lead.on_count.samples, lead.on_count.strength) == ("leader", 8, 0.9)
+    assert (lead.on_count.role, lead.on_count.samples, lead.on_count.strength, lead.on_count.hips) == ("leader", 8, 0.9, 0.7)
     assert follow.on_count.role == "follower" and follow.on_count is not lead.on_count
     lead.on_count.mean = 2.0
     O.restart_count(lead)
@@ -121,33 +170,45 @@ def test_options_take_it_from_the_manifest_and_refuse_what_cannot_choose():
     assert O.resolve(off, m) is None and O.leader_policy(policy_stub, m, off).on_count is None
     assert "--on-count 1" in O.resolve(parse("--on-count", "1"), m)
     assert "--on-count-strength" in O.resolve(parse("--on-count-strength", "2"), m)
+    assert "--on-count-hips" in O.resolve(parse("--on-count-hips", "-1"), m)
+    args = parse("--on-count-hips", "0")
+    assert O.resolve(args, m) is None and O.follower_policy(policy_stub, m, args, 0.5).on_count.hips == 0.0
     assert "needs --guard" in O.resolve(parse("--guard", "0", "--leader-guard", "0"), m)
     older = {k: v for k, v in m.items() if k != "onCount"}
     args = parse()
     assert O.resolve(args, older) is None and args.on_count == 0
+    args = parse()   # a manifest that does not say: on_count.HIPS, as the page takes it
+    assert O.resolve(args, {**m, "onCount": {"samples": 8, "strength": 0.9}}) is None and args.on_count_hips == OC.HIPS
 
 
 def policy_stub(x, temperature, rng):
     return {"output": np.zeros((len(np.atleast_2d(x)), feat.OUTPUT_SIZE))}
 
 
-def test_a_turn_is_left_to_the_network():
-    """Turning faster than TURNING (her facing 0.8 rad round in 5 frames: 4.8 rad/s), the chooser
-    aims at nothing and the guard takes the network's one sample, as on any unguarded step."""
+def test_a_turn_leaves_the_footwork_to_the_network_and_keeps_the_hips_going():
+    """Turning faster than her TURNING (her facing 1.2 rad round in 5 frames: 7.2 rad/s), the chooser
+    aims at no footwork: the guard takes the first standing sample whose hips go on, whatever its
+    feet do; with `hips` 0, the network's one sample, as on any unguarded step."""
     x = input_at("follower", 0.3, 0.5)
     c = OC.LAST_FACING["follower"]
-    x[c:c + 2] = np.sin(0.8), np.cos(0.8)
-    assert OC.turn_rate(x, "follower") == pytest.approx(0.8 * FPS / feat.KEY_STEP)
+    x[c:c + 2] = np.sin(1.2), np.cos(1.2)
+    x[OC.HIP_VELOCITY_IN["follower"]] = 0.3, 0.0, 0.0   # her hips came in along x, 1 cm a frame
+    assert OC.turn_rate(x, "follower") == pytest.approx(1.2 * FPS / feat.KEY_STEP)
     chooser = OC.OnCount("follower", samples=3)
     assert chooser.target(x) is None and chooser.mean == pytest.approx(1.0)   # the mean still moves on
     calls = []
 
-    def policy(x, temperature, rng):
-        calls.append(len(np.atleast_2d(x)))
-        return {"output": np.stack([output(1.0)] * len(np.atleast_2d(x)))}
+    def policy(x, temperature, rng):   # the first sample's root steps back along x, the others on
+        n = len(np.atleast_2d(x))
+        calls.append(n)
+        return {"output": np.stack([output(-0.6 if i == 0 else 0.6 * i) for i in range(n)]), "code": np.arange(n)[:, None]}
 
     guard = UprightGuard(policy, RANGES, samples=4, margin=0.05, offsets=OFFSETS, on_count=chooser)
-    guard(x, 1.0, np.random.default_rng(0))
+    assert guard(x, 1.0, np.random.default_rng(0))["code"][0, 0] == 1   # the first going on, not the nearest footwork
     x[c:c + 2] = 0.0, 1.0                       # facing as 5 frames ago: the count chooses again
     guard(x, 1.0, np.random.default_rng(0))
-    assert calls == [1, 3] and guard.guarded == 0
+    assert calls == [3, 3] and guard.guarded == 0
+    x[c:c + 2] = np.sin(1.2), np.cos(1.2)
+    calls.clear()
+    plain = UprightGuard(policy, RANGES, samples=4, margin=0.05, offsets=OFFSETS, on_count=OC.OnCount("follower", 3, hips=0.0))
+    assert plain(x, 1.0, np.random.default_rng(0))["code"][0, 0] == 0 and calls == [1]

@@ -1,10 +1,12 @@
 // web/mirror/on_count.ts against training/mirror/on_count.py: each dancer's footwork and count read
 // from its input, the footwork its next step aims at over three steps (the mean carried between
-// them), and the choice among samples where all, some and none of them stand.
+// them), each sample's drawn steps, footwork and hips, and the choice among samples where all, some
+// and none of them stand, a sample's hips weighed and not.
 
 import { describe, expect, it } from 'vitest';
 import { OUTPUT_SIZE } from '../../web/mirror/features';
-import { OnCount, TURNING, countNext, footworkNext, footworkNow, nearestCount, turnRate } from '../../web/mirror/on_count';
+import { uprightBody } from '../../web/mirror/guard';
+import { OnCount, TURNING, countNext, drawnFootwork, drawnSteps, footworkNow, hipsTurnBack, nearestCount, turnRate } from '../../web/mirror/on_count';
 import { expectClose, fixture } from './fixture';
 
 const data = fixture('rollout').onCount;
@@ -28,7 +30,7 @@ describe('the footwork each dancer aims at on the count', () => {
 
   it('leaves a turn to the network: the last step of each role turns faster than TURNING', () => {
     for (const role of ['leader', 'follower'] as const) {
-      const turning = data.roles[role].map((s: { turnRate: number[]; target: number[] | null }) => [s.turnRate[0] > TURNING, s.target === null]);
+      const turning = data.roles[role].map((s: { turnRate: number[]; target: number[] | null }) => [s.turnRate[0] > TURNING[role], s.target === null]);
       expect(turning).toEqual([[false, false], [false, false], [true, true]]);
     }
   });
@@ -39,18 +41,34 @@ describe('the footwork each dancer aims at on the count', () => {
 });
 
 describe('nearestCount', () => {
-  const outputs = Float32Array.from(data.outputs);
+  const outputs = Float64Array.from(data.outputs);
+  const input = Float64Array.from(data.input);
   const k = data.standing.length;
+  const ranges = fixture('rollout').upright.ranges;
+  const offsets = fixture('rollout').offsets.follower;
 
-  it('reads each sample\'s next footwork as Python does', () => {
-    expectClose(Array.from({ length: k }, (_, i) => footworkNext(outputs, i * OUTPUT_SIZE)), data.footworkNext, 'footwork next');
+  it('draws each sample\'s body, its steps, footwork and hips as Python does', () => {
+    const body = new Float64Array(3 * 17);
+    const steps = new Float64Array(9);
+    for (let i = 0; i < k; i++) {
+      expectClose([uprightBody(outputs, i * OUTPUT_SIZE, ranges, offsets, 0, 0, body)], [data.standing[i]], `margin ${i}`);
+      drawnSteps(outputs, i * OUTPUT_SIZE, body, input, 'follower', steps);
+      expectClose(Array.from(steps), data.steps.slice(9 * i, 9 * i + 9), `steps ${i}`);
+      expectClose([drawnFootwork(steps)], [data.footwork[i]], `footwork ${i}`);
+      expect(hipsTurnBack(steps, input, 'follower'), `hips of ${i}`).toBe(data.turnBack[i]);
+    }
+    // the case the fixture is for: the first sample's hips turn back, the second's go on
+    expect(data.turnBack.slice(0, 2)).toEqual([true, false]);
   });
 
-  it('takes the standing sample nearest the target, and none when none stands', () => {
-    for (const [margin, best] of Object.entries(data.best)) {
-      expect(nearestCount(outputs, k, OUTPUT_SIZE, data.target[0], data.standing, Number(margin)), `margin ${margin}`).toBe(best);
+  it('takes the standing sample nearest the target, its hips weighed, and none when none stands', () => {
+    for (const [key, best] of Object.entries(data.best)) {
+      const [margin, hips] = key.split('/').map(Number);
+      expect(nearestCount(data.footwork, data.turnBack, k, data.target[0], data.standing, margin, hips), key).toBe(best);
     }
-    // the case where the choice matters: all stand, the second is nearest; at 0.05 only the first stands
-    expect(new Set(Object.values(data.best))).toEqual(new Set([1, 0, -1]));
+    // the cases where the choice matters: nearest, passed over for its hips, only one standing, none
+    expect(new Set(Object.values(data.best))).toEqual(new Set([0, 1, -1]));
+    expect(data.best['0.0/0.0']).toBe(0);
+    expect(data.best['0.0/1.0']).toBe(1);
   });
 });

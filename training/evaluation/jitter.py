@@ -27,10 +27,10 @@ import numpy as np
 from tqdm import tqdm
 
 from ..data.folders import add_folder
+from ..mirror.on_count import STILL   # m a frame (6 cm/s): shorter steps are standing still
 from ..mirror.skeleton import FPS
 
 HIP = 0
-STILL = 0.002   # m a frame (6 cm/s): shorter steps are standing still
 
 
 def hip_jitter(positions: np.ndarray, fps: int = FPS) -> dict:

@@ -15,7 +15,7 @@ from __future__ import annotations
 import argparse
 
 from ..mirror.guard import UprightGuard, Variety
-from ..mirror.on_count import STRENGTH as ON_COUNT_STRENGTH, OnCount
+from ..mirror.on_count import HIPS as ON_COUNT_HIPS, STRENGTH as ON_COUNT_STRENGTH, OnCount
 from ..mirror.music import DEFAULT_TEMPO
 
 
@@ -50,6 +50,9 @@ def add_options(ap: argparse.ArgumentParser) -> None:
                          "the count (training/mirror/on_count.py; 0: off; default: the manifest's onCount.samples)")
     ap.add_argument("--on-count-strength", type=float, default=None, metavar="S",
                     help="how far the footwork aimed at swings with the beat, 0-1 (default: the manifest's onCount.strength)")
+    ap.add_argument("--on-count-hips", type=float, default=None, metavar="W",
+                    help="m/s added to the footwork's miss of a candidate whose hips turn back; 0: the hips left alone, "
+                         "and a turn's step the network's own (default: the manifest's onCount.hips)")
     ap.add_argument("--leader-guard", type=int, default=None, metavar="K",
                     help="the leader's upright guard with K samples (0: off; default: the manifest's "
                          "leaderGuard, acting at its margin)")
@@ -101,10 +104,14 @@ def resolve(args, manifest: dict) -> str | None:
         args.on_count = int(on_count.get("samples", 0))
     if getattr(args, "on_count_strength", None) is None:
         args.on_count_strength = float(on_count.get("strength", ON_COUNT_STRENGTH))
+    if getattr(args, "on_count_hips", None) is None:
+        args.on_count_hips = float(on_count.get("hips", ON_COUNT_HIPS))
     if args.on_count < 0 or args.on_count == 1:
         return f"--on-count {args.on_count}: 0 (off) or at least 2 samples to choose from"
     if not 0 <= args.on_count_strength <= 1:
         return f"--on-count-strength {args.on_count_strength:g}: 0 to 1"
+    if not args.on_count_hips >= 0:
+        return f"--on-count-hips {args.on_count_hips:g}: 0 (the hips left alone) or more m/s"
     if args.on_count and not (args.guard or args.leader_guard):
         return "--on-count chooses inside the upright guards: it needs --guard or --leader-guard"
     if args.guard and not manifest.get("plausibility"):
@@ -151,7 +158,8 @@ def on_count_for(role: str, args) -> OnCount | None:
     samples = getattr(args, "on_count", 0) or 0
     if not samples:
         return None
-    return OnCount(role, samples, getattr(args, "on_count_strength", ON_COUNT_STRENGTH))
+    return OnCount(role, samples, getattr(args, "on_count_strength", ON_COUNT_STRENGTH),
+                   getattr(args, "on_count_hips", ON_COUNT_HIPS))
 
 
 def restart_count(policy) -> None:

@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import features as feat
-from .on_count import OnCount, nearest_count
+from .on_count import OnCount, drawn_footwork, drawn_steps, hips_turn_back, nearest_count
 from .rollout import MIN_ANKLE_HEIGHT, rotations_from_vectors
 from .skeleton import FEET, HANDS, HEAD, forward_kinematics_reduced
 from ..evaluation.plausibility import CHEST
@@ -238,9 +238,10 @@ class UprightGuard:
     `keep_plan` (his): while his input shows a hands plan, every step draws the samples and takes
     the standing one whose lead hand is nearest the plan (nearest_plan); `kept` counts those
     steps, `guarded` the ones among them where none stood. `on_count` (both dancers', an
-    on_count.OnCount): every other step (but those of a turn) draws its samples and takes the
-    standing one whose footwork follows the count (on_count.nearest_count); when none of them
-    stands, the guard draws its own samples and takes the most upright, as it always does."""
+    on_count.OnCount): every step draws its samples and takes the standing one whose footwork
+    follows the count, one whose hips turn back passed over (while the dancer turns: the first
+    standing one whose hips go on; on_count.nearest_count); when none of them stands, the guard
+    draws its own samples and takes the most upright, as it always does."""
 
     def __init__(self, policy, ranges: dict, samples: int = SAMPLES, temperature: float | None = None,
                  margin: float = MARGIN, offsets: np.ndarray | None = None, head_margin: float | None = None,
@@ -276,14 +277,16 @@ class UprightGuard:
                 self.guarded += 1
             return {k: v[best:best + 1] for k, v in many.items()}
         target = None if self.on_count is None else self.on_count.target(x)
-        if target is not None:
+        if self.on_count is not None and (target is not None or self.on_count.hips > 0):
             many = self.policy(np.repeat(np.atleast_2d(x), self.on_count.samples, 0), t, rng)
             joints = drawn_joints(many["output"], self.offsets)
             standing = drawn_margin(joints, self.ranges, slack, hips)
             if self.hip_drop is not None:   # a drop judged per candidate, as below for one
                 standing = np.array([-np.inf if drops(x, joints[i:i + 1], self.hip_drop, self.hip_drop_below)
                                      else m for i, m in enumerate(standing)])
-            best = nearest_count(many["output"], target, standing, self.margin)
+            steps = drawn_steps(many["output"], joints, x, self.on_count.role)
+            best = nearest_count(drawn_footwork(steps), hips_turn_back(steps, x, self.on_count.role), target, standing,
+                                 self.margin, self.on_count.hips)
             if best >= 0:
                 return {k: v[best:best + 1] for k, v in many.items()}
             self.guarded += 1

@@ -7,11 +7,11 @@
 // recording. Nothing else in this file changes a number the models see.
 
 import { FUTURE_OFFSETS, INPUT_SIZE, INTENTION_SIZE, KEYS, OUTPUT_SIZE, followerInput } from '../mirror/features';
-import { KEY_JOINTS, type Motion, POSITIONS_SIZE, ROTATIONS_SIZE } from '../mirror/skeleton';
+import { KEY_JOINTS, type Motion, N_JOINTS, POSITIONS_SIZE, ROTATIONS_SIZE } from '../mirror/skeleton';
 import { ContactLayer, FOLLOWER_CONTACT, HipGlide } from '../mirror/contact';
 import { FootLock } from '../mirror/footik';
-import { type GuardSettings, type Ranges, hipSlackFor, mostUpright, nearestPlan, showsPlan, slackFor, uprightMargin } from '../mirror/guard';
-import { OnCount, nearestCount } from '../mirror/on_count';
+import { type GuardSettings, type Ranges, hipSlackFor, mostUpright, nearestPlan, showsPlan, slackFor, uprightBody, uprightMargin } from '../mirror/guard';
+import { OnCount, STEPPED, drawnFootwork, drawnSteps, hipsTurnBack, nearestCount } from '../mirror/on_count';
 import { LeaderPlayback } from './playback';
 import { StepTimer } from './timing';
 import {
@@ -86,6 +86,10 @@ export class DuetSimulation implements Simulation {
   private readonly followerOnCount: (OnCount | null)[];
   /** Each candidate's upright margin, for the choice on the count. */
   private standing = new Float64Array(0);
+  private footwork = new Float64Array(0);
+  private turnBack: boolean[] = [];
+  private readonly body = new Float64Array(3 * N_JOINTS);
+  private readonly steps = new Float64Array(3 * STEPPED.length);
   /** The leader model's own variety (the manifest's); the slider sets the followers'. */
   private readonly leaderTemperature: number | null;
   private readonly followerOutputs: Float32Array[];
@@ -114,8 +118,8 @@ export class DuetSimulation implements Simulation {
     const lg = manifest.leaderGuard;
     this.leaderGuard = lg && lg.samples >= 2 && manifest.plausibility ? { settings: lg, ranges: manifest.plausibility } : null;
     const oc = manifest.onCount && manifest.onCount.samples >= 2 ? manifest.onCount : null;
-    this.leaderOnCount = oc && this.leaderGuard ? new OnCount('leader', oc.samples, oc.strength) : null;
-    this.followerOnCount = followers.map(() => (oc && this.uprightGuard ? new OnCount('follower', oc.samples, oc.strength) : null));
+    this.leaderOnCount = oc && this.leaderGuard ? new OnCount('leader', oc.samples, oc.strength, oc.hips) : null;
+    this.followerOnCount = followers.map(() => (oc && this.uprightGuard ? new OnCount('follower', oc.samples, oc.strength, oc.hips) : null));
     this.duet = startDuet(manifest, followers.length);
     this.shownBeat = this.duet.beat;
     this.leaderView = new View(false);
@@ -227,9 +231,10 @@ export class DuetSimulation implements Simulation {
 
   /**
    * Follower i's step on the count (web/mirror/on_count.ts): her samples drawn at once, the standing
-   * one whose footwork is nearest what the count asks taken. Returns false when she has no chooser
-   * or turns (then her step is taken as any other); when none of the samples stands, her guard
-   * draws its own and takes the most upright.
+   * one whose footwork is nearest what the count asks taken, one whose hips turn back passed over;
+   * while she turns, the first standing one whose hips go on. Returns false when she has no chooser,
+   * or turns with hips weighing nothing (then her step is taken as any other); when none of the
+   * samples stands, her guard draws its own and takes the most upright.
    */
   private async followerOnTheCount(i: number, temperature: number): Promise<boolean> {
     const onCount = this.followerOnCount[i];
@@ -238,29 +243,44 @@ export class DuetSimulation implements Simulation {
     const offsets = this.duet.followers[i].offsets;
     const policy = this.followerPolicies[i];
     const target = onCount.target(policy.input);
-    if (target === null) return false; // she turns: her own sample, as any step
+    if (target === null && !(onCount.hips > 0)) return false; // she turns: her own sample, as any step
     const { margin, hipMargin, partnerLow, partnerLowHipMargin } = guard.settings;
     const hipSlack = hipSlackFor(policy.input, margin, hipMargin, partnerLow, partnerLowHipMargin);
     const k = onCount.samples;
     const { output, intention } = await policy.runDraws(k, temperature);
     if (intention) this.followerIntentions[i]?.set(intention);
-    const standing = this.standingOf(output, k, guard.ranges, offsets, 0, hipSlack);
-    const best = nearestCount(output, k, OUTPUT_SIZE, target, standing, margin);
+    const best = this.nearestOnCount(onCount, output, policy.input, target, guard.ranges, offsets, 0, hipSlack, margin);
     if (best < 0) {
       this.followerOutputs[i].set(output.subarray(0, OUTPUT_SIZE));   // judged below as any step is
       await this.keepUpright(i, temperature);
       return true;
     }
     this.followerOutputs[i].set(output.subarray(best * OUTPUT_SIZE, (best + 1) * OUTPUT_SIZE));
-    this.counted++;
+    if (target !== null) this.counted++;
     return true;
   }
 
-  /** The upright margin of each of k outputs (guard.ts), in one reused array. */
-  private standingOf(output: ArrayLike<number>, k: number, ranges: Ranges, offsets: ArrayLike<number>, slack: number, hipSlack: number): Float64Array {
-    if (this.standing.length < k) this.standing = new Float64Array(k);
-    for (let n = 0; n < k; n++) this.standing[n] = uprightMargin(output, n * OUTPUT_SIZE, ranges, offsets, slack, hipSlack);
-    return this.standing;
+  /** The standing candidate of the chooser's draws whose drawn footwork is nearest the target (none
+   *  while the dancer turns), a candidate whose hips turn back passed over unless the others miss by
+   *  onCount.hips more (on_count.ts nearestCount); -1 when none stands. Each body is drawn once for both judgements,
+   *  into arrays kept between steps. */
+  private nearestOnCount(
+    onCount: OnCount, output: ArrayLike<number>, input: ArrayLike<number>, target: number | null, ranges: Ranges,
+    offsets: ArrayLike<number>, slack: number, hipSlack: number, margin: number,
+  ): number {
+    const k = onCount.samples;
+    if (this.standing.length < k) {
+      this.standing = new Float64Array(k);
+      this.footwork = new Float64Array(k);
+      this.turnBack = new Array<boolean>(k).fill(false);
+    }
+    for (let n = 0; n < k; n++) {
+      this.standing[n] = uprightBody(output, n * OUTPUT_SIZE, ranges, offsets, slack, hipSlack, this.body);
+      drawnSteps(output, n * OUTPUT_SIZE, this.body, input, onCount.role, this.steps);
+      this.footwork[n] = drawnFootwork(this.steps);
+      this.turnBack[n] = hipsTurnBack(this.steps, input, onCount.role);
+    }
+    return nearestCount(this.footwork, this.turnBack, k, target, this.standing, margin, onCount.hips);
   }
 
   /** The leader's output of this step, under the same guard (mirror/guard.py's UprightGuard wraps
@@ -280,16 +300,16 @@ export class DuetSimulation implements Simulation {
     const hipSlack = hipSlackFor(policy.input, margin, hipMargin);
     const plan = keepPlan === true && showsPlan(policy.input);
     const onCount = plan ? null : this.leaderOnCount;
-    // His step on the count (on_count.ts): the standing sample whose footwork follows the beat;
-    // while he turns, his own sample as any step.
+    // His step on the count (on_count.ts): the standing sample whose footwork follows the beat and
+    // whose hips go on; while he turns, the first standing one whose hips go on.
     const target = onCount ? onCount.target(policy.input) : null;
-    if (onCount && target !== null) {
+    if (onCount && (target !== null || onCount.hips > 0)) {
       const n = onCount.samples;
       const { output } = await policy.runDraws(n, temperature);
-      const best = nearestCount(output, n, OUTPUT_SIZE, target, this.standingOf(output, n, guard.ranges, offsets, slack, hipSlack), margin);
+      const best = this.nearestOnCount(onCount, output, policy.input, target, guard.ranges, offsets, slack, hipSlack, margin);
       if (best >= 0) {
         this.leaderOutput.set(output.subarray(best * OUTPUT_SIZE, (best + 1) * OUTPUT_SIZE));
-        this.counted++;
+        if (target !== null) this.counted++;
         return;
       }
     } else if (!plan) {

@@ -93,6 +93,18 @@ export function uprightMargin(
   return drawnMargin(drawnJoints(output, at, offsets), r, headSlack, hipSlack);
 }
 
+/**
+ * uprightMargin of output[at..], the body it draws copied into `body` [17 · 3], lifted (guard.py
+ * drawn_joints then drawn_margin): the choice on the count reads that body's steps (on_count.ts).
+ */
+export function uprightBody(
+  output: ArrayLike<number>, at: number, r: Ranges, offsets: ArrayLike<number>, headSlack: number, hipSlack: number, body: Float64Array,
+): number {
+  const lift = drawnJoints(output, at, offsets);
+  for (let i = 0; i < joints.length; i++) body[i] = joints[i] + (i % 3 === 1 ? lift : 0);
+  return drawnMargin(lift, r, headSlack, hipSlack);
+}
+
 /** uprightMargin of the body drawnJoints last left in `joints`, lifted by `lift`. */
 function drawnMargin(lift: number, r: Ranges, headSlack: number, hipSlack: number): number {
   const hip = joints[1] + lift;

@@ -1,15 +1,18 @@
-// Mirror of training/mirror/on_count.py: steps on the count.
+// Mirror of training/mirror/on_count.py: steps on the count, the hips going on.
 //
 // Both networks hear the music, yet the last second of motion says more about when the next step
 // falls than the count does, so left to their own samples each keeps a tempo of its own. A dancer on
 // the count moves the feet between beats and lands them on the beat (the recorded footwork, the
 // summed speed of both ankles, swings once a beat, lowest where a foot lands). So each step the
-// dancer's guard draws `samples` of the network's next step from the same input and takes the
-// standing one whose footwork is nearest mean · (1 − strength · cos 2π·count at the next step), where
-// mean is the dancer's own footwork over about the last second (simulation.ts). Every candidate is
-// the network's own reaction from the same state: nothing jumps, and nobody's input changes. While
-// a dancer turns faster than TURNING the network's own sample is taken: a spin moves the ankles fast
-// whatever the count, and the pull broke her turns off.
+// dancer's guard draws `samples` of the network's next step from the same input, draws each body as
+// the page will (its bones, carried by its root update), and takes the standing one whose footwork
+// is nearest mean · (1 − strength · cos 2π·count at the next step), where mean is the dancer's own
+// footwork over about the last second. The footwork is read from the drawn ankles, not from the
+// velocities the network writes beside them, which follow the drawn ankles only loosely. A sample
+// whose hips turn back the way they came has `hips` m/s added to its miss: the networks' own hips
+// turn back far more often than the recorded dancers'. While a dancer turns faster than TURNING (a
+// fast spin), its footwork is left to the network and only its hips are weighed. Every candidate is
+// the network's own reaction from the same state: nothing jumps, and nobody's input changes.
 
 import { FOLLOWER_INPUT_LAYOUT, KEY_STEP, KEYS, LEADER_INPUT_LAYOUT, OUTPUT_LAYOUT, POSE_SIZE, blockSlices } from './features';
 import { MUSIC_OFFSETS, MUSIC_SIZE } from './music';
@@ -18,13 +21,20 @@ import { FEET, FPS, N_JOINTS } from './skeleton';
 export const SAMPLES = 8;
 export const STRENGTH = 1.0;
 export const MEAN_SECONDS = 1.0;
-/** rad/s: faster than this the dancer is in a turn, left to the network (a spin: 6-9). */
-export const TURNING = 3.0;
+/** rad/s: turning faster than this, the dancer's footwork is left to the network: his turns are
+ *  walks round (1.5-3 rad/s), hers spins (6-9). */
+export const TURNING: Readonly<Record<Role, number>> = { leader: 1.5, follower: 6.0 };
+/** m/s added to the footwork's miss of a candidate whose hips turn back. */
+export const HIPS = 1.0;
+/** m a frame (6 cm/s): a shorter step of the hips stands still, and turns no way. */
+export const STILL = 0.002;
 
-/** The manifest's "onCount": samples each step, and how far the footwork aimed at swings (0-1). */
+/** The manifest's "onCount": samples each step, how far the footwork aimed at swings (0-1), and
+ *  what a candidate whose hips turn back adds to its miss (m/s; HIPS when absent). */
 export interface OnCountSettings {
   samples: number;
   strength: number;
+  hips?: number;
 }
 
 export type Role = 'leader' | 'follower';
@@ -40,7 +50,14 @@ export const LAST_FACING: Readonly<Record<Role, number>> = {
   leader: blockSlices(LEADER_INPUT_LAYOUT).self_trajectory_past.start + (KEYS - 1) * 4 + 2,
   follower: blockSlices(FOLLOWER_INPUT_LAYOUT).self_trajectory_past.start + (KEYS - 1) * 4 + 2,
 };
-export const ANKLE_VELOCITY_OUT: readonly number[] = FEET.map((j) => blockSlices(OUTPUT_LAYOUT).pose.start + POSE_JOINT * j + 3);
+/** The joints whose steps the choice reads, the hips and both ankles, and where each role's input
+ *  holds their positions (its own pose block, its root space now); the hips' velocity follows theirs. */
+export const STEPPED: readonly number[] = [0, ...FEET];
+export const POSITION_IN: Readonly<Record<Role, readonly number[]>> = {
+  leader: STEPPED.map((j) => blockSlices(LEADER_INPUT_LAYOUT).self_pose.start + POSE_JOINT * j),
+  follower: STEPPED.map((j) => blockSlices(FOLLOWER_INPUT_LAYOUT).self_pose.start + POSE_JOINT * j),
+};
+const ROOT_UPDATE_OUT = blockSlices(OUTPUT_LAYOUT).root_update.start;
 
 function speedAt(x: ArrayLike<number>, c: number): number {
   return Math.hypot(x[c], x[c + 1], x[c + 2]);
@@ -53,11 +70,43 @@ export function footworkNow(input: ArrayLike<number>, role: Role): number {
   return sum;
 }
 
-/** The footwork the output at output[at..] would draw at the next step. */
-export function footworkNext(output: ArrayLike<number>, at = 0): number {
-  let sum = 0;
-  for (const c of ANKLE_VELOCITY_OUT) sum += speedAt(output, at + c);
-  return sum;
+/**
+ * How far the hips and each ankle move (m, in the dancer's root space now) from where the input has
+ * them to where output[at..] draws them, into steps [3 · 3]: `body` [17 · 3] is the body it draws
+ * (guard.ts uprightBody, in the next root's space), carried by the output's root update.
+ */
+export function drawnSteps(
+  output: ArrayLike<number>, at: number, body: ArrayLike<number>, input: ArrayLike<number>, role: Role, steps: Float64Array,
+): Float64Array {
+  const dx = output[at + ROOT_UPDATE_OUT];
+  const dz = output[at + ROOT_UPDATE_OUT + 1];
+  const turn = output[at + ROOT_UPDATE_OUT + 2];
+  const c = Math.cos(turn);
+  const s = Math.sin(turn);
+  for (let n = 0; n < STEPPED.length; n++) {
+    const j = 3 * STEPPED[n];
+    const now = POSITION_IN[role][n];
+    // features.ts fromRootSpaceDirections by the turn: the next root's space seen from this one.
+    steps[3 * n] = c * body[j] + s * body[j + 2] + dx - input[now];
+    steps[3 * n + 1] = body[j + 1] - input[now + 1];
+    steps[3 * n + 2] = -s * body[j] + c * body[j + 2] + dz - input[now + 2];
+  }
+  return steps;
+}
+
+/** The footwork (m/s) of the steps drawnSteps gives: the summed speed of both ankles. */
+export function drawnFootwork(steps: ArrayLike<number>): number {
+  return (Math.hypot(steps[3], steps[4], steps[5]) + Math.hypot(steps[6], steps[7], steps[8])) * FPS;
+}
+
+/** Whether the steps drawnSteps gives take the hips back the way they came: more than 90 degrees
+ *  from their step into this frame (the input's own hip velocity), both longer than STILL. */
+export function hipsTurnBack(steps: ArrayLike<number>, input: ArrayLike<number>, role: Role): boolean {
+  const v = POSITION_IN[role][0] + 3;
+  const bx = input[v] / FPS;
+  const by = input[v + 1] / FPS;
+  const bz = input[v + 2] / FPS;
+  return steps[0] * bx + steps[1] * by + steps[2] * bz < 0 && Math.hypot(steps[0], steps[1], steps[2]) > STILL && Math.hypot(bx, by, bz) > STILL;
 }
 
 /** How fast the dancer turns now (rad/s, unsigned): its facing KEY_STEP frames ago, seen from its root now. */
@@ -81,32 +130,36 @@ export class OnCount {
     readonly role: Role,
     readonly samples: number = SAMPLES,
     readonly strength: number = STRENGTH,
+    readonly hips: number = HIPS,
   ) {
     if (samples < 2) throw new Error('choosing on the count needs at least 2 samples');
   }
 
   /** The footwork the next step aims at, for this step's input (it moves the mean on); null while
-   *  the dancer turns faster than TURNING (the network's own sample is taken). */
+   *  the dancer turns faster than its TURNING (its footwork is left to the network). */
   target(input: ArrayLike<number>): number | null {
     const now = footworkNow(input, this.role);
     this.mean = this.mean === null ? now : this.mean + (now - this.mean) / (MEAN_SECONDS * FPS);
-    if (turnRate(input, this.role) > TURNING) return null;
+    if (turnRate(input, this.role) > TURNING[this.role]) return null;
     return this.mean * (1 - this.strength * Math.cos(2 * Math.PI * countNext(input)));
   }
 }
 
 /**
- * The index of the output (of `count` laid `size` apart) whose footwork is nearest the target among
- * those standing (their upright margins, guard.ts) at least `margin` inside the range; -1 when none does.
+ * The index of the candidate (of `count`) whose drawn footwork (m/s) is nearest the target, `hips`
+ * m/s added to the miss of each whose hips turn back (hipsTurnBack), among those standing (their
+ * upright margins, guard.ts) at least `margin` inside the range; -1 when none does. With no target
+ * (the dancer turns) the footwork is left alone: the first standing one whose hips go on.
  */
 export function nearestCount(
-  output: ArrayLike<number>, count: number, size: number, target: number, standing: ArrayLike<number>, margin: number,
+  footwork: ArrayLike<number>, turnBack: ArrayLike<boolean>, count: number, target: number | null, standing: ArrayLike<number>,
+  margin: number, hips = HIPS,
 ): number {
   let best = -1;
   let bestMiss = Infinity;
   for (let i = 0; i < count; i++) {
     if (!(standing[i] >= margin)) continue;
-    const miss = Math.abs(footworkNext(output, i * size) - target);
+    const miss = (target === null ? 0 : Math.abs(footwork[i] - target)) + (turnBack[i] ? hips : 0);
     if (miss < bestMiss) {
       best = i;
       bestMiss = miss;
