@@ -79,8 +79,8 @@ def reversal_frames(positions: np.ndarray) -> np.ndarray:
 
 def plot(path: str, args, seed: int, steer: bool, seconds: float = 4.0) -> None:
     """Her hips over the floor, seen from above, as the network put them and as the page draws
-    them: the `seconds` of one duet (of its --seconds) where the network's hips turn back most, a
-    dot a frame. Jitter is a path that doubles back."""
+    them: the `seconds` of one duet (of its --seconds) where the drawn hips turn back most, a dot a
+    frame. Jitter is a path that doubles back."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -91,7 +91,7 @@ def plot(path: str, args, seed: int, steer: bool, seconds: float = 4.0) -> None:
     soak_one(manifest, leader, follower, seed, int(args.seconds * FPS), temperature, record=rec,
              tempo=args.tempo, steer=steer)
     width = int(seconds * FPS)
-    counts = np.convolve(reversal_frames(rec["follower"]).astype(float), np.ones(width), "valid")
+    counts = np.convolve(reversal_frames(rec["follower_shown"]).astype(float), np.ones(width), "valid")
     start = int(np.argmax(counts))
     sl = slice(start, start + width)
     fig, axes = plt.subplots(1, 2, figsize=(10, 5), sharex=True, sharey=True)
@@ -105,7 +105,7 @@ def plot(path: str, args, seed: int, steer: bool, seconds: float = 4.0) -> None:
         ax.set_xlabel("x (m)")
     axes[0].set_ylabel("z (m)")
     fig.suptitle(f"seed {seed}, {'steered' if steer else 'nobody steering'}: {start / FPS:.1f}-{(start + width) / FPS:.1f} s, "
-                 "where her hips turn back most; a dot a frame")
+                 "where her drawn hips turn back most; a dot a frame")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
 
