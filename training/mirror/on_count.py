@@ -49,8 +49,9 @@ HIPS = 1.0            # m/s added to the footwork's miss of a candidate whose hi
 STILL = 0.002         # m a frame (6 cm/s): a shorter step of the hips stands still, and turns no way
 
 # Where each role's input holds its own ankles' velocity (pose block: position, velocity, forward,
-# up per joint), and where the output holds the next step's; the count now is the music block's key
-# at offset 0 (sin, cos of 2 pi count), the tempo (beats a second) the block's last number.
+# up per joint; the step into this frame as drawn, so the footwork now and the drawn footwork of a
+# sample agree); the count now is the music block's key at offset 0 (sin, cos of 2 pi count), the
+# tempo (beats a second) the block's last number.
 _POSE_JOINT = feat.POSE_SIZE // feat.N_JOINTS
 _NOW_KEY = int(np.nonzero(MUSIC_OFFSETS == 0)[0][0]) * 4
 ANKLE_VELOCITY_IN = {
