@@ -64,7 +64,7 @@ def test_crossval_runs_every_fold_and_resumes(tmp_path):
             if p is None and metric in figures:
                 continue
             assert np.isfinite([p["mean"], p["low"], p["high"]]).all() and p["low"] <= p["mean"] <= p["high"]
-    assert all(k in res["means"]["ours"] for k in figures)
+    assert all(k in res["means"]["ours"] for k in figures | {"pulse_ratio", "on_beat", "together_ratio"})
     # One data folder per fold; only the tempo method read its copies (it saw more samples).
     with np.load(out / "fold0" / "data" / "train_tempo.npz") as z:
         assert sorted(set(z["tempo"].tolist())) == pytest.approx(TEMPOS)

@@ -63,6 +63,11 @@ def test_schema(result):
             assert 0.0 <= m["divergence"] <= 1.0
     md = (out / "metrics.md").read_text()
     assert "| method | MPJPE cm" in md and "| ours |" in md and "## Controlled" in md
+    # Her rhythm at the count she hears, beside the recording's own (rhythm.py's measures).
+    for name in ("ours", "ccm", "motion_matching", "ground_truth"):
+        m = r["methods"][name]
+        assert -1.0 <= m["on_beat"] <= 1.0 and 0.0 <= m["together"] <= 1.0 and 0.0 <= m["pulse"] <= 1.0, name
+    assert "| method | pulse | on the beat | together |" in md
 
 
 def test_ground_truth_against_itself(result):

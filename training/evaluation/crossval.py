@@ -61,12 +61,17 @@ METHODS = {
 # implausible / worst second: the free-running follower's frames with its body low, folded or split,
 # against the fold's own training range (evaluate's plausibility; n/a for evaluations without it).
 # The figures (evaluation.figures): the follower's turns per minute and spin frames as a ratio to
-# the recorded follower's on the same test takes, and the recall and precision of her turns.
+# the recorded follower's on the same test takes, and the recall and precision of her turns; her
+# rhythm (evaluation.rhythm) beside the played-back leader, at the count she hears.
 METRICS = {"mpjpe_cm": "MPJPE cm", "fid": "FID", "codebook_error": "codebook error",
            "implausible": "implausible frames", "worst_second": "worst second",
            "turns_ratio": "turns/min ratio", "spin_ratio": "spin frames ratio", "recall": "turn recall",
-           "precision": "turn precision"}
-RATIOS = {"turns_ratio": "turns_per_min", "spin_ratio": "spin_frames"}   # over the recording's
+           "precision": "turn precision", "pulse_ratio": "pulse ratio", "on_beat": "on the beat",
+           "together_ratio": "together ratio"}
+# Over the recording's on the same test takes. Her rhythm (evaluate's RHYTHM_KEYS, at the count
+# she hears): her footwork's pulse and together as ratios; on the beat, which can be negative, as is.
+RATIOS = {"turns_ratio": "turns_per_min", "spin_ratio": "spin_frames", "pulse_ratio": "pulse",
+          "together_ratio": "together"}
 CONFIDENCE = 0.95
 
 
@@ -275,7 +280,8 @@ def _num(v, digits):
 def markdown(res: dict) -> str:
     plan = res["plan"]
     digits = {"mpjpe_cm": 2, "fid": 1, "codebook_error": 4, "implausible": 3, "worst_second": 2,
-              "turns_ratio": 2, "spin_ratio": 2, "recall": 2, "precision": 2}
+              "turns_ratio": 2, "spin_ratio": 2, "recall": 2, "precision": 2, "pulse_ratio": 2,
+              "on_beat": 2, "together_ratio": 2}
     lines = [f"Folds {len(res['complete_folds'])} of {len(plan['folds'])} complete, seeds "
              f"{','.join(map(str, plan['seeds']))}, {plan['intention_epochs']} + {plan['epochs']} epochs, "
              f"free runs at variety {plan.get('temperature', 0.5):g}"

@@ -44,7 +44,7 @@ from ..mirror import features as feat
 from . import metrics as M
 from .evaluate_inputs import EvalError, RecordingPolicy, find_models, load_eval_takes, load_onnx
 from .evaluate_report import write_markdown, write_report
-from .evaluate_rollouts import FIGURE_KEYS, latents, mean_metrics, parse_condition, recorded, rollout, run_metrics
+from .evaluate_rollouts import FIGURE_KEYS, RHYTHM_KEYS, latents, mean_metrics, parse_condition, recorded, rollout, run_metrics
 from .evaluate_teacher_forced import codebook_errors, output_encoders, pose_positions, teacher_forced
 from .motion_matching import build, load_tracks, training_takes
 
@@ -177,7 +177,8 @@ def evaluate(args) -> dict:
                           "rollout_mpjpe_cm": roll["mpjpe_cm"], "root_error_m": roll["root_error_m"],
                           "resets": roll["resets"], "implausible": roll.get("implausible"),
                           "worst_second": roll.get("worst_second"),
-                          **{k: v for k, v in roll.items() if k in FIGURE_KEYS or k[:-4] in FIGURE_KEYS}}
+                          **{k: v for k, v in roll.items()
+                             if k in FIGURE_KEYS + RHYTHM_KEYS or k[:-4] in FIGURE_KEYS + RHYTHM_KEYS}}
     if any(v is None for m, v in cb.items() if m != "ground_truth"):
         notes.append(f"codebook error is null where {eval_folder(args.models)} lacks the model's output encoder")
     notes.append("codebook error: the step model's own code at temperature 0 (the exported int8 file) against "

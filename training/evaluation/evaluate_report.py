@@ -106,7 +106,26 @@ def figures_table(res: dict) -> list[str]:
         L.append(f"| {name} | {cell(m, 'turns_per_min', 1)} | {cell(m, 'spin_frames', share=True)} | "
                  f"{cell(m, 'body_motion')} | {cell(m, 'travel')} | {cell(m, 'recall', share=True)} | "
                  f"{cell(m, 'precision', share=True)} | {cell(m, 'direction', share=True)} |")
+    if "pulse" in ref:
+        L += ["", "The follower's rhythm in the same runs, at the take's count found in its footwork (the "
+              "count she hears; training.evaluation.rhythm): her footwork's pulse, her steps on the beat "
+              "(mean cosine of the count's phase at her steps) and together (her motion beats within 0.1 s "
+              "of the played-back leader's).", "",
+              "| method | pulse | on the beat | together |", "|---|---|---|---|"]
+        for name, m in res["methods"].items():
+            L.append(f"| {name} | {cell(m, 'pulse')} | {rhythm_cell(m, 'on_beat')} | {cell(m, 'together')} |")
     return L
+
+
+def rhythm_cell(m: dict, k: str) -> str:
+    """A figure that can be negative (steps on the beat), so no ratio: the value and its seeds."""
+    v = m.get(k)
+    if v is None:
+        return "n/a"
+    text = f"{v:+.2f}"
+    if m.get(f"{k}_min") is not None and m.get(f"{k}_min") != m.get(f"{k}_max"):
+        text += f" [{m[f'{k}_min']:+.2f}..{m[f'{k}_max']:+.2f}]"
+    return text
 
 
 def clean(o):

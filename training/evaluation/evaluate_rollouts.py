@@ -12,9 +12,11 @@ from ..mirror import features as feat
 from ..mirror.features import FUTURE_OFFSETS, HISTORY, Track, follower_input, leader_input
 from ..mirror.music import music_at
 from ..mirror.rollout import NOW, Dancer, apply_output, output_is_absurd, reset_beside
+from ..mirror.skeleton import FPS
 from . import figures as Fg
 from . import metrics as M
 from . import plausibility as P
+from . import rhythm as R
 from .evaluate_inputs import EvalError, EvalTake, RecordingPolicy, window
 
 DIVERGED = 3.0          # m between the partners' roots: the pair has come apart
@@ -125,7 +127,8 @@ def rollout(take: EvalTake, follower_policy, temperature: float, seed: int, star
         record(HISTORY + 1 + i, HISTORY + 2 + i, NOW)
         if bar is not None:
             bar.update(1)
-    rec.update(t0=t0, steps=steps, resets=follower.resets, leader_resets=leader.resets)
+    rec.update(t0=t0, steps=steps, resets=follower.resets, leader_resets=leader.resets,
+               beat=take.lead.beat[t0 - HISTORY:t0 + steps + 1])
     return rec
 
 
@@ -136,7 +139,7 @@ def recorded(take: EvalTake) -> dict:
     return {"positions": take.follow.positions[sl], "rotations": take.follow.rotations[sl],
             "root": take.follow.root[sl], "heading": take.follow.heading[sl],
             "leader_positions": take.lead.positions[sl], "leader_root": take.lead.root[sl],
-            "t0": t0, "steps": steps, "resets": 0, "leader_resets": 0}
+            "beat": take.lead.beat[sl], "t0": t0, "steps": steps, "resets": 0, "leader_resets": 0}
 
 
 def as_track(r: dict) -> Track:
@@ -151,6 +154,10 @@ def latents(encoder, r: dict) -> np.ndarray:
 # The figure measures (figures.py) every run reports: pooled over the takes, then means over seeds
 # with the worst seed beside them (mean_metrics).
 FIGURE_KEYS = ["turns_per_min", "spin_frames", "body_motion", "travel", "recall", "precision", "direction"]
+# The follower's rhythm (rhythm.py) beside the played-back leader, at the take's count found in its
+# footwork (the count she hears): her footwork's pulse, her steps on the beat, and her motion beats
+# within 0.1 s of the recorded leader's (together). Frame-weighted means over the takes.
+RHYTHM_KEYS = ["pulse", "on_beat", "together"]
 
 
 def run_metrics(runs: list[dict], refs: list[dict], encoder, ref_latents: np.ndarray,
@@ -181,6 +188,10 @@ def run_metrics(runs: list[dict], refs: list[dict], encoder, ref_latents: np.nda
         weights.append(len(idx))
         lat.append(latents(encoder, r))
         figs.append({**Fg.dancer(r["positions"][idx]), **Fg.against(r["positions"][idx], g["positions"][idx])})
+        beat = r["beat"][idx]
+        bpm = float(np.median(np.diff(beat)) * FPS * 60)
+        rh = R.rhythm(r["leader_positions"][idx], r["positions"][idx], beat, bpm)
+        per[-1].update(pulse=rh["follower_pulse"], on_beat=rh["follower_on_beat"], together=rh["together"])
     w = np.asarray(weights, float) / sum(weights)
     out = {k: float(sum(wi * p[k] for wi, p in zip(w, per))) for k in per[0]}
     if ranges is not None:
@@ -200,7 +211,7 @@ def mean_metrics(items: list[dict]) -> dict:
     gets its lowest and highest seed (KEY_min, KEY_max): a mean alone hides a seed that never turns."""
     out = {k: float((np.max if k == "worst_second" else np.nanmean)([i[k] for i in items]))
            for k in items[0] if k not in ("seed", "temperature")}
-    for k in FIGURE_KEYS:
+    for k in FIGURE_KEYS + RHYTHM_KEYS:
         if k in items[0]:
             v = [i[k] for i in items]
             out[f"{k}_min"], out[f"{k}_max"] = float(np.nanmin(v)), float(np.nanmax(v))
