@@ -72,23 +72,43 @@ describe('HipGlide (the shown path over the floor)', () => {
     }
     return p;
   };
-  it('shows a jump a (1 - HIP_GLIDE) share of the way while free, keeps its offset while a foot is planted', () => {
+  it('steps by a running mean of the network\'s steps: a jump shown a HIP_GLIDE share at once and the rest later, never back', () => {
     const glide = new HipGlide();
     const first = body(3, 0);
-    glide.apply(first, [0, 0]);
+    glide.apply(first);
     expect(Array.from(first)).toEqual(Array.from(body(3, 0)));
     const jumped = body(3, 1);
-    glide.apply(jumped, [0, 0]);
+    glide.apply(jumped);
     for (let j = 0; j < 17; j++) {
-      expect(jumped[3 * j + 2] - 1).toBeCloseTo(-HIP_GLIDE, 12);
+      expect(jumped[3 * j + 2]).toBeCloseTo(HIP_GLIDE, 12);
+      expect(jumped[3 * j]).toBeCloseTo(3, 12);
       expect(jumped[3 * j + 1]).toBeCloseTo(0.1 * j, 12);
     }
-    const planted = body(3, 1.5);
-    glide.apply(planted, [1, 0]);
-    expect(planted[2] - 1.5).toBeCloseTo(-HIP_GLIDE, 12);
+    // The network stays: the shown hips go on the same way, each step (1 - HIP_GLIDE) of the last,
+    // and come to the network's place without passing it.
+    let z = HIP_GLIDE;
+    let step = HIP_GLIDE;
+    for (let n = 0; n < 60; n++) {
+      const still = body(3, 1);
+      glide.apply(still);
+      step *= 1 - HIP_GLIDE;
+      z += step;
+      expect(still[2]).toBeCloseTo(z, 12);
+      expect(still[2]).toBeLessThanOrEqual(1 + 1e-12);
+    }
+    expect(z).toBeCloseTo(1, 6);
     glide.clear();
-    const again = body(3, 1.5);
-    glide.apply(again, [0, 0]);
-    expect(Array.from(again)).toEqual(Array.from(body(3, 1.5)));
+    const again = body(5, 1.5);
+    glide.apply(again);
+    expect(Array.from(again)).toEqual(Array.from(body(5, 1.5)));
+  });
+  it('leaves a steady walk as it is, once it has caught up', () => {
+    const glide = new HipGlide();
+    let last = body(0, 0);
+    for (let n = 0; n < 80; n++) {
+      last = body(0, 0.03 * n);
+      glide.apply(last);
+    }
+    expect(last[2]).toBeCloseTo(0.03 * 79 - (0.03 * (1 - HIP_GLIDE)) / HIP_GLIDE, 6);   // trails by (1 - g) / g steps
   });
 });

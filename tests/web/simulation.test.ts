@@ -433,9 +433,11 @@ describe('foot locking (drawn pose only)', () => {
     const bone = (p: ArrayLike<number>, i: number, j: number) => Math.hypot(p[3 * i] - p[3 * j], p[3 * i + 1] - p[3 * j + 1], p[3 * i + 2] - p[3 * j + 2]);
     expect(bone(drawn, 11, 12)).toBeCloseTo(bone(modelled, 11, 12), 5);
     expect(bone(drawn, 12, 13)).toBeCloseTo(bone(modelled, 12, 13), 5);
-    // The right foot has no contact: drawn where the model put it (with a foot planted the body
-    // does not glide: contact.ts HIP_GLIDE).
-    for (let a = 0; a < 3; a++) expect(drawn[16 * 3 + a]).toBeCloseTo(modelled[16 * 3 + a], 5);
+    // The right foot has no contact: drawn where the model put it beside the hips, the whole body
+    // trailing the walk by the glide's few millimetres (contact.ts HIP_GLIDE).
+    for (const a of [0, 2]) expect(drawn[16 * 3 + a] - drawn[a]).toBeCloseTo(modelled[16 * 3 + a] - modelled[a], 5);
+    expect(drawn[16 * 3 + 1]).toBeCloseTo(modelled[16 * 3 + 1], 5);
+    expect(Math.abs(drawn[2] - modelled[2])).toBeLessThan(0.02);
     expect(drawn[13 * 3 + 1]).toBeGreaterThanOrEqual(ANKLE_FLOOR - 1e-6);
 
     // Contact ends: within a few steps the drawn foot is the model's again, beside the hips; the

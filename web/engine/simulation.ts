@@ -439,7 +439,7 @@ export class DuetSimulation implements Simulation {
         view.feet.clear();
       }
       view.resets = f.resets;
-      view.glide.apply(view.positions, f.contacts);
+      view.glide.apply(view.positions);
       view.feet.apply(view.positions, f.contacts, f.heading);
     }
   }

@@ -9,8 +9,8 @@
 //    HAND_REACH, is drawn toward a grip around its midpoint by two-bone IK of both arms, fully at
 //    HAND_FULL and closer, with a weight that rises and falls smoothly;
 // 3. planted feet stay planted: FootLock on both dancers, last, so a body moved by 1. keeps its feet.
-// First of all, each body's path over the floor glides while no foot is planted (HIP_GLIDE): the
-// whole body is moved to where its hips' smoothed path is; the feet, locked last, stay planted.
+// First of all, each body's path over the floor glides (HIP_GLIDE): the whole body is moved to
+// where its hips' smoothed path is; the feet, locked last, stay planted.
 
 import { CONTACT_THRESHOLD, FootLock, twoBoneIk } from './footik';
 import { HANDS, PARENTS, SPINE } from './skeleton';
@@ -42,11 +42,11 @@ export const MIN_ELBOW_BEND = 0.6;
 /** The follower's feet lock from a lower contact than the leader's: its network, at its own
  *  variety, is unsure of its feet, which slid while low (training/mirror/contact.py: measured). */
 export const FOLLOWER_CONTACT = 0.3;
-/** While no foot is planted, each step the shown hips keep this share of the distance between
- *  where they were shown and where the network puts them now (horizontal only); while one is, the
- *  body keeps its offset. Her hips turned back 3.8x as often as the recorded follower's, 2.0-2.3x
- *  with it (training/mirror/contact.py: measured). */
-export const HIP_GLIDE = 0.7;
+/** Each step the shown hips take this share of the way from the step they last made to the
+ *  network's new step over the floor (a running mean of its steps; horizontal only). Smoothing the
+ *  velocity, not the place, the shown hips turn back only when the network's keep going back
+ *  (training/mirror/contact.py: measured). */
+export const HIP_GLIDE = 0.3;
 
 type Positions = Float32Array | Float64Array;
 
@@ -165,37 +165,41 @@ export function moveHand(positions: Positions, hand: number, tx: number, ty: num
 
 const pair = new Float64Array(3);
 
-/** One dancer's shown path over the floor (HIP_GLIDE): where its hips were shown, and how far
- *  from the network's. */
+/** One dancer's shown path over the floor (HIP_GLIDE): where its hips were shown, the step they
+ *  made last, and where the network put them last. */
 export class HipGlide {
   /** The shown hips (x, z); NaN: not yet shown. */
   readonly shown = new Float64Array([NaN, NaN]);
-  /** Shown minus the network's (x, z). */
-  readonly offset = new Float64Array(2);
+  /** The shown hips' last step (x, z). */
+  readonly step = new Float64Array(2);
+  /** The network's hips last step (x, z). */
+  readonly network = new Float64Array(2);
 
   clear(): void {
     this.shown.fill(NaN);
   }
 
-  /** Move the body (world 17 x 3, in place) to its hips' smoothed path over the floor, as far as
-   *  no foot is planted (1 - the larger contact): while one is, the body keeps the offset it had
-   *  and moves as the network moves it, and the locked foot stays where it is. */
-  apply(positions: Positions, contacts: ArrayLike<number>): void {
-    const hx = positions[0], hz = positions[2], shown = this.shown, o = this.offset;
+  /** Move the body (world 17 x 3, in place) to its hips' smoothed path over the floor: the shown
+   *  hips step by the running mean of the network's steps. Planted feet stay where they are by the
+   *  foot locks, applied last. */
+  apply(positions: Positions): void {
+    const hx = positions[0], hz = positions[2], shown = this.shown, step = this.step, net = this.network;
     if (Number.isNaN(shown[0])) {
-      shown[0] = hx;
-      shown[1] = hz;
-      o.fill(0);
+      shown[0] = net[0] = hx;
+      shown[1] = net[1] = hz;
+      step.fill(0);
     }
-    const free = 1 - clamp01(Math.max(contacts[0], contacts[1]));
-    o[0] += free * (HIP_GLIDE * (shown[0] - hx) - o[0]);
-    o[1] += free * (HIP_GLIDE * (shown[1] - hz) - o[1]);
+    step[0] += HIP_GLIDE * (hx - net[0] - step[0]);
+    step[1] += HIP_GLIDE * (hz - net[1] - step[1]);
+    net[0] = hx;
+    net[1] = hz;
+    shown[0] += step[0];
+    shown[1] += step[1];
+    const ox = shown[0] - hx, oz = shown[1] - hz;
     for (let i = 0; i < positions.length; i += 3) {
-      positions[i] += o[0];
-      positions[i + 2] += o[1];
+      positions[i] += ox;
+      positions[i + 2] += oz;
     }
-    shown[0] = hx + o[0];
-    shown[1] = hz + o[1];
   }
 }
 
@@ -227,8 +231,8 @@ export class ContactLayer {
     leader: Positions, follower: Positions, leaderContacts: ArrayLike<number>, followerContacts: ArrayLike<number>,
     leaderHeading: number, followerHeading: number,
   ): void {
-    this.leaderGlide.apply(leader, leaderContacts);
-    this.followerGlide.apply(follower, followerContacts);
+    this.leaderGlide.apply(leader);
+    this.followerGlide.apply(follower);
     this.pushed = separate(leader, follower);
     closestHands(leader, follower, pair);
     const i = pair[0], j = pair[1], d = pair[2];
