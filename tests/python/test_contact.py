@@ -11,7 +11,7 @@ import torch
 from training.evaluation import metrics as M
 from training.learning import partner_losses as P
 from training.mirror.contact import HIP_GLIDE, SEPARATION, ContactLayer, separate, spine_gap
-from training.mirror.footik import ANKLE_FLOOR, MAX_STANCE, FootLock, cap_stance, two_bone_ik
+from training.mirror.footik import ANKLE_FLOOR, MAX_LOCK_DISTANCE, MAX_STANCE, FootLock, cap_stance, two_bone_ik
 from training.mirror.skeleton import FEET, PARENTS
 
 
@@ -104,6 +104,23 @@ def test_foot_lock_holds_a_planted_foot_and_never_sinks():
     low[FEET[1], 1] = 0.0
     FootLock().apply(low, [0, 0], 0.0)
     assert low[FEET[1], 1] >= ANKLE_FLOOR - 1e-9
+
+
+def test_a_glide_during_a_contact_never_slides_the_lock():
+    """The network's body stays; the contact layer's glide moves the drawn body 0.3 m (more than
+    MAX_LOCK_DISTANCE). Told of the glide, the lock stays where the foot was planted and the leg
+    reaches back to it; not told, it slides to MAX_LOCK_DISTANCE behind the drawn foot (as
+    web/mirror/footik.test.ts)."""
+    told, blind = FootLock(), FootLock()
+    told.apply(standing(), [1, 0], 0.0, (0.0, 0.0))
+    blind.apply(standing(), [1, 0], 0.0)
+    planted = standing()[FEET[0]].copy()
+    glided, slid = standing(-0.3, 0), standing(-0.3, 0)
+    told.apply(glided, [1, 0], 0.0, (-0.3, 0.0))
+    blind.apply(slid, [1, 0], 0.0)
+    np.testing.assert_allclose(told.target[0], [planted[0], max(planted[1], ANKLE_FLOOR), planted[2]])
+    np.testing.assert_allclose(blind.target[0], [0.1 - 0.3 + MAX_LOCK_DISTANCE, max(planted[1], ANKLE_FLOOR), 0.0])
+    assert glided[FEET[0], 0] > slid[FEET[0], 0] + 0.01
 
 
 def test_a_lock_never_holds_the_feet_wider_than_max_stance():

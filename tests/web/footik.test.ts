@@ -69,6 +69,27 @@ describe('FootLock', () => {
     });
   });
 
+  it('trails the network\'s own foot: a glide of the drawn body during a contact never slides the lock', () => {
+    // The network's body stays; the contact layer's glide moves the drawn body 0.3 m back (more
+    // than MAX_LOCK_DISTANCE). Told of the glide, the lock stays where the foot was planted and the
+    // leg reaches back to it; not told, it slides to MAX_LOCK_DISTANCE behind the drawn foot.
+    const moved = () => {
+      const p = leg();
+      for (let i = 0; i < 51; i += 3) p[i] -= 0.3;
+      return p;
+    };
+    const told = new FootLock();
+    told.apply(leg(), [1, 0], 0, [0, 0]);
+    const glided = moved();
+    told.apply(glided, [1, 0], 0, [-0.3, 0]);
+    const blind = new FootLock();
+    blind.apply(leg(), [1, 0], 0);
+    const slid = moved();
+    blind.apply(slid, [1, 0], 0);
+    expect(glided[39]).toBeGreaterThan(slid[39] + 0.01);   // nearer the planted spot (x 0.1)
+    expect(slid[39]).toBeLessThanOrEqual(0.1 - 0.3 + MAX_LOCK_DISTANCE + 1e-9);
+  });
+
   it('locks from its own threshold (the follower is unsure of its feet)', () => {
     const follower = new FootLock(0.3);
     const leader = new FootLock();

@@ -51,13 +51,13 @@ FOLLOWER_CONTACT = 0.3
 # height and turning stay the network's). The glide smooths velocity, not place, so the shown hips
 # turn back only when the network's keep going back, and stay within a few centimetres of them
 # (the running mean lags the steps by (1 - HIP_GLIDE) / HIP_GLIDE frames, 2.3 at 0.3). Her drawn
-# hips against the recorded follower's (training.evaluation.jitter, 6 seeds x 30 s, steered /
-# nobody steering): reversals a second 1.07x / 1.07x, speed change 1.11x / 1.16x; 0.2 followed the
-# recording closer (0.94x / 0.99x reversals) but trails a steered walk by 4 frames; 0.5 1.21x / 1.13x.
-# The glide before this one kept a share of the distance to where the network put the hips, and only
-# while no foot was planted: the share it passed on changed with her contacts every frame, and her
-# drawn hips turned back 1.47x / 1.16x as often (speed change 1.35x / 1.32x); holding still while a
-# foot is planted gave 1.35x with this one too.
+# hips against the recorded follower's (training.evaluation.jitter, 20 seeds x 30 s, steered /
+# nobody steering): reversals a second 1.20x / 1.00x, speed change 1.14x / 1.12x (his 1.24x /
+# 1.27x and 0.98x / 0.93x). The glide before kept a share of the distance to where the network
+# put the hips, and only while no foot was planted: the share it passed on changed with her
+# contacts every frame, and her drawn hips turned back 1.55x / 1.38x as often. Holding this one
+# while a foot is planted gave 1.35x; 0.2 trails a steered walk by 4 frames, 0.5 gave 1.21x
+# (6 seeds each); her planted feet slide no more than before (0.83 against 0.85 cm a contact frame).
 HIP_GLIDE = 0.3
 
 
@@ -122,7 +122,7 @@ class HipGlide:
     def __init__(self):
         self.shown = None               # the shown hips (x, z), None: not yet shown
         self.step = np.zeros(2)         # the shown hips' last step (x, z)
-        self.network = np.zeros(2)      # the network's hips last step (x, z)
+        self.network = np.zeros(2)      # where the network put the hips last (x, z)
 
     def clear(self) -> None:
         self.shown = None
@@ -138,6 +138,10 @@ class HipGlide:
         self.network = hips
         self.shown = self.shown + self.step
         positions[:, [0, 2]] += self.shown - hips
+
+    def glided(self) -> np.ndarray:
+        """How far (x, z) the last apply moved the body from where the network put it."""
+        return np.zeros(2) if self.shown is None else self.shown - self.network
 
 
 class ContactLayer:
@@ -179,5 +183,5 @@ class ContactLayer:
             # midpoint leaves the rest of the way to the partner's arm).
             reached = leader[HANDS[i]]
             move_hand(follower, HANDS[j], hf + (reached - u * GRIP - hf) * self.hold)
-        self.leader_feet.apply(leader, leader_contacts, leader_heading)
-        self.follower_feet.apply(follower, follower_contacts, follower_heading)
+        self.leader_feet.apply(leader, leader_contacts, leader_heading, self.leader_glide.glided())
+        self.follower_feet.apply(follower, follower_contacts, follower_heading, self.follower_glide.glided())

@@ -102,15 +102,20 @@ class FootLock:
         self.locked = [False, False]
         self.target = np.zeros((2, 3))
         self.weight = np.zeros(2)
+        self.glided = np.zeros((2, 2))   # the body's glide (x, z) when each lock began
 
     def clear(self) -> None:
         """Forget every lock (after a reset or a jump of the dancer)."""
         self.locked = [False, False]
         self.weight[:] = 0
 
-    def apply(self, positions: np.ndarray, contacts, heading: float) -> None:
+    def apply(self, positions: np.ndarray, contacts, heading: float, glide=(0.0, 0.0)) -> None:
         """Lock or release each foot from contacts (left, right) and bend the legs of positions
-        [17, 3] (world, in place). heading gives the knee's bend direction for a straight leg."""
+        [17, 3] (world, in place). heading gives the knee's bend direction for a straight leg.
+        glide (x, z) is how far the contact layer moved the body from where the network put it
+        (contact.HipGlide): a lock trails the network's own foot, so the legs, not the planted
+        foot, take up what the glide moves the body during a contact."""
+        glide = np.asarray(glide, float)
         for i, foot in enumerate(FEET):
             knee = PARENTS[foot]
             thigh = PARENTS[knee]
@@ -119,11 +124,14 @@ class FootLock:
             if contacts[i] > self.threshold:
                 if not self.locked[i]:
                     t[:] = (f[0], max(f[1], ANKLE_FLOOR), f[2])
+                    self.glided[i] = glide
                     self.locked[i] = True
                 else:
-                    behind = float(np.linalg.norm(t - f))
+                    own = f.copy()                   # the foot as the glide at the lock's start had it
+                    own[[0, 2]] -= glide - self.glided[i]
+                    behind = float(np.linalg.norm(t - own))
                     if behind > MAX_LOCK_DISTANCE:   # slide along, MAX_LOCK_DISTANCE behind the foot
-                        t[:] = f + (t - f) * (MAX_LOCK_DISTANCE / behind)
+                        t[:] = own + (t - own) * (MAX_LOCK_DISTANCE / behind)
                         t[1] = max(t[1], ANKLE_FLOOR)
                 self.weight[i] = 1.0
             else:

@@ -440,7 +440,7 @@ export class DuetSimulation implements Simulation {
       }
       view.resets = f.resets;
       view.glide.apply(view.positions);
-      view.feet.apply(view.positions, f.contacts, f.heading);
+      view.feet.apply(view.positions, f.contacts, f.heading, view.glide.glided());
     }
   }
 }

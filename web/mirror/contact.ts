@@ -172,8 +172,9 @@ export class HipGlide {
   readonly shown = new Float64Array([NaN, NaN]);
   /** The shown hips' last step (x, z). */
   readonly step = new Float64Array(2);
-  /** The network's hips last step (x, z). */
+  /** Where the network put the hips last (x, z). */
   readonly network = new Float64Array(2);
+  private readonly moved = new Float64Array(2);
 
   clear(): void {
     this.shown.fill(NaN);
@@ -200,6 +201,14 @@ export class HipGlide {
       positions[i] += ox;
       positions[i + 2] += oz;
     }
+  }
+
+  /** How far (x, z) the last apply moved the body from where the network put it. */
+  glided(): Float64Array {
+    const g = this.moved, shown = this.shown;
+    g[0] = Number.isNaN(shown[0]) ? 0 : shown[0] - this.network[0];
+    g[1] = Number.isNaN(shown[0]) ? 0 : shown[1] - this.network[1];
+    return g;
   }
 }
 
@@ -253,7 +262,7 @@ export class ContactLayer {
       const rx = leader[3 * hl] - ux * GRIP, ry = leader[3 * hl + 1] - uy * GRIP, rz = leader[3 * hl + 2] - uz * GRIP;
       moveHand(follower, hf, fx + (rx - fx) * w, fy + (ry - fy) * w, fz + (rz - fz) * w);
     }
-    this.leaderFeet.apply(leader, leaderContacts, leaderHeading);
-    this.followerFeet.apply(follower, followerContacts, followerHeading);
+    this.leaderFeet.apply(leader, leaderContacts, leaderHeading, this.leaderGlide.glided());
+    this.followerFeet.apply(follower, followerContacts, followerHeading, this.followerGlide.glided());
   }
 }

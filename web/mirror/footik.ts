@@ -109,12 +109,16 @@ export function capStance(
 }
 
 /** The lock state of one dancer's two feet, kept between steps. */
+const NO_GLIDE = [0, 0] as const;
+
 export class FootLock {
   constructor(readonly threshold: number = CONTACT_THRESHOLD) {}
 
   private readonly locked = [false, false];
   private readonly target = new Float64Array(6);
   private readonly weight = new Float64Array(2);
+  /** The body's glide (x, z) when each lock began. */
+  private readonly glided = new Float64Array(4);
 
   /** Forget every lock (after a reset or a jump of the dancer). */
   clear(): void {
@@ -125,8 +129,11 @@ export class FootLock {
   /**
    * Lock or release each foot from `contacts` (left, right) and bend the legs of `positions`
    * (17 × 3 world, modified in place). `heading` gives the knee's bend direction for a straight leg.
+   * `glide` (x, z) is how far the contact layer moved the body from where the network put it
+   * (contact.ts HipGlide): a lock trails the network's own foot, so the legs, not the planted foot,
+   * take up what the glide moves the body during a contact.
    */
-  apply(positions: Float32Array | Float64Array, contacts: ArrayLike<number>, heading: number): void {
+  apply(positions: Float32Array | Float64Array, contacts: ArrayLike<number>, heading: number, glide: ArrayLike<number> = NO_GLIDE): void {
     for (let i = 0; i < FEET.length; i++) {
       const foot = FEET[i];
       const knee = PARENTS[foot];
@@ -139,15 +146,20 @@ export class FootLock {
           t[o] = fx;
           t[o + 1] = Math.max(fy, ANKLE_FLOOR);
           t[o + 2] = fz;
+          this.glided[2 * i] = glide[0];
+          this.glided[2 * i + 1] = glide[1];
           this.locked[i] = true;
         } else {
-          const behind = Math.hypot(t[o] - fx, t[o + 1] - fy, t[o + 2] - fz);
+          // The foot as the glide at the lock's start had it.
+          const ox = fx - (glide[0] - this.glided[2 * i]);
+          const oz = fz - (glide[1] - this.glided[2 * i + 1]);
+          const behind = Math.hypot(t[o] - ox, t[o + 1] - fy, t[o + 2] - oz);
           if (behind > MAX_LOCK_DISTANCE) {
             // Slide along, MAX_LOCK_DISTANCE behind the foot.
             const k = MAX_LOCK_DISTANCE / behind;
-            t[o] = fx + (t[o] - fx) * k;
+            t[o] = ox + (t[o] - ox) * k;
             t[o + 1] = Math.max(fy + (t[o + 1] - fy) * k, ANKLE_FLOOR);
-            t[o + 2] = fz + (t[o + 2] - fz) * k;
+            t[o + 2] = oz + (t[o + 2] - oz) * k;
           }
         }
         this.weight[i] = 1;
