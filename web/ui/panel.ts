@@ -34,14 +34,14 @@ export interface PanelOptions {
   facts: HelpFacts;
 }
 
-/** What the intention adds on this data, as measured (docs/results.md, "The paper's claim,
- * cross-validated by take"; docs/plausibility.md); shown in the help's details fold. */
+/** What the intention adds on this data, as measured (docs/results.md, "Intention against no
+ * intention"; docs/plausibility.md); shown in the help's details fold. */
 export const INTENTION_NOTE =
-  'Measured on the CMU salsa takes with the earlier networks, the intention did not make the ' +
-  'follower more accurate (6-fold cross-validation: same pose error as CCM within 0.1 cm; CCM had ' +
-  'the better FID). The shipped networks decode each pose beside the current one: on the test takes ' +
-  'ours has the better FID (219 against 250, one training each), and in 100 steered minutes neither ' +
-  'partner falls or freezes. Details: docs/plausibility.md and docs/results.md.';
+  'Measured on the CMU salsa takes, both networks hearing the music, the intention makes no ' +
+  'difference twelve takes can show (6-fold cross-validation against CCM: the same pose error within ' +
+  '0.1 cm, the same turns, the same steps on the beat); run without the page\'s upright guard, ours ' +
+  'went down in 2 of the 6 folds, which costs it FID. With the guard, in 100 steered minutes neither ' +
+  'partner falls or freezes. Details: docs/results.md and docs/plausibility.md.';
 
 /** The partner menu: plain names first; the research names live in the details fold. */
 export const MODEL_LABELS: Record<FollowerChoice, string> = {
