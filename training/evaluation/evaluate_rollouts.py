@@ -12,7 +12,6 @@ from ..mirror import features as feat
 from ..mirror.features import FUTURE_OFFSETS, HISTORY, Track, follower_input, leader_input
 from ..mirror.music import music_at
 from ..mirror.rollout import NOW, Dancer, apply_output, output_is_absurd, reset_beside
-from ..mirror.skeleton import FPS
 from . import figures as Fg
 from . import metrics as M
 from . import plausibility as P
@@ -189,8 +188,7 @@ def run_metrics(runs: list[dict], refs: list[dict], encoder, ref_latents: np.nda
         lat.append(latents(encoder, r))
         figs.append({**Fg.dancer(r["positions"][idx]), **Fg.against(r["positions"][idx], g["positions"][idx])})
         beat = r["beat"][idx]
-        bpm = float(np.median(np.diff(beat)) * FPS * 60)
-        rh = R.rhythm(r["leader_positions"][idx], r["positions"][idx], beat, bpm)
+        rh = R.rhythm(r["leader_positions"][idx], r["positions"][idx], beat, R.bpm_of(beat))
         per[-1].update(pulse=rh["follower_pulse"], on_beat=rh["follower_on_beat"], together=rh["together"])
     w = np.asarray(weights, float) / sum(weights)
     out = {k: float(sum(wi * p[k] for wi, p in zip(w, per))) for k in per[0]}

@@ -107,6 +107,11 @@ def on_the_beat(positions: np.ndarray, beat: np.ndarray, fps: float = FPS) -> fl
     return float(np.mean(np.cos(2 * np.pi * beat[s])))
 
 
+def bpm_of(beat: np.ndarray, fps: float = FPS) -> float:
+    """Beats a minute of a count given per frame (beats since the start)."""
+    return float(np.median(np.diff(beat)) * fps * 60)
+
+
 def rhythm(leader_positions: np.ndarray, follower_positions: np.ndarray, beat: np.ndarray,
            bpm: float, fps: float = FPS) -> dict:
     """Every rhythm figure of one duet (or one recorded take): per dancer pulse, period, its
@@ -130,8 +135,7 @@ def recorded(data: str) -> dict:
     takes = {}
     for take in discover_takes(data):
         lead, follow = pair_tracks(*load_pair(take))
-        bpm = float(np.median(np.diff(lead.beat)) * FPS * 60)
-        takes[take.name] = rhythm(lead.positions, follow.positions, lead.beat, bpm)
+        takes[take.name] = rhythm(lead.positions, follow.positions, lead.beat, bpm_of(lead.beat))
     keys = [k for k in next(iter(takes.values())) if k != "bpm"]
     mean = {k: float(np.mean([t[k] for t in takes.values()])) for k in keys}
     for role in ("leader", "follower"):

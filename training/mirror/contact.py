@@ -57,7 +57,9 @@ FOLLOWER_CONTACT = 0.3
 # put the hips, and only while no foot was planted: the share it passed on changed with her
 # contacts every frame, and her drawn hips turned back 1.55x / 1.38x as often. Holding this one
 # while a foot is planted gave 1.35x; 0.2 trails a steered walk by 4 frames, 0.5 gave 1.21x
-# (6 seeds each); her planted feet slide no more than before (0.83 against 0.85 cm a contact frame).
+# (6 seeds each). The foot locks trail the network's own foot (footik.FootLock.apply's glide): her
+# skate in contact stays 1.48x the recording's (1.47x before; 1.88x with the locks as they were,
+# 30 steered seeds x 60 s), her joint angles out of range with the layer 2.2x (2.0x before).
 HIP_GLIDE = 0.3
 
 

@@ -108,9 +108,10 @@ export function capStance(
   t[o + 2] = fz + (t[o + 2] - fz) * share;
 }
 
-/** The lock state of one dancer's two feet, kept between steps. */
+/** A body the contact layer did not move (FootLock.apply's default glide). */
 const NO_GLIDE = [0, 0] as const;
 
+/** The lock state of one dancer's two feet, kept between steps. */
 export class FootLock {
   constructor(readonly threshold: number = CONTACT_THRESHOLD) {}
 
