@@ -5,8 +5,8 @@ recorded and with some of its blocks reflected (x -> -x, left and right swapped:
 scripts/reflected_lead_probe.py's reflection). A block that carries the way turns her the other way
 when reflected.
 
-    PYTHONPATH=. .venv/bin/python scripts/her_reading_probe.py [FRAMES]
-    PYTHONPATH=. .venv/bin/python scripts/her_reading_probe.py -20,-10,-6
+    PYTHONPATH=. .venv/bin/python scripts/her_reading_probe.py [FRAMES [FOLLOWER.onnx]]
+    PYTHONPATH=. .venv/bin/python scripts/her_reading_probe.py -45,-20,-10
 """
 import importlib.util
 import sys
@@ -33,7 +33,7 @@ DRAWS, VARIETY = 16, 0.5
 
 def main(argv: list[str]) -> int:
     offsets = [int(a) for a in argv[0].split(",")] if argv else [-20, -10, -6]
-    policy = OnnxPolicy("public/models/follower.onnx")
+    policy = OnnxPolicy(argv[1] if len(argv) > 1 else "public/models/follower.onnx")
     rng = np.random.default_rng(0)
     sl = feat.block_slices(feat.FOLLOWER_INPUT_LAYOUT)
     cols = {v: np.concatenate([np.arange(sl[n].start, sl[n].stop) for n in names]) if names else None
