@@ -103,12 +103,6 @@ class TrainConfig:
     # next step falls so well that the count adds little (a half-beat shift of it changes the step
     # by a tenth of the ankles' speed: docs/music.md); hidden, only the pose and the music do.
     past_dropout: float = 0.0
-    # Follower: share of the samples where her turn starts (turn_onsets) whose own past path and
-    # past key joints are shown at their mean. Her network takes her turn's way from her own last
-    # second, which it continues, and hardly from him (scripts/her_reading_probe.py), though he
-    # shows it half a second ahead in 79 % of her turns (evaluation/turn_direction.py); hidden
-    # where a turn starts, only he (and her pose now) can tell the way.
-    turn_past_dropout: float = 0.0
     # Train on the tempo copies too (prepare's train_tempo.npz): more varied samples, same steps.
     tempo_copies: bool = False
     # Weight of the samples where the follower's turn starts (turn_onsets) in the reconstruction
@@ -239,11 +233,6 @@ MODELS = {
     "follower": replace(steady(OURS), state_dropout=0.5, turn_weight=4.0, own_rollouts_from=10, tempo_copies=True),
     "follower_long_own": replace(steady(OURS), state_dropout=0.5, turn_weight=4.0, tempo_copies=True,
                                  epochs=6, lr=3e-4, own_rollouts_from=0, own_rollouts_horizon=30),
-    # Measured, not shipped: her own past hidden where her turn starts, fine-tuned from the shipped follower.
-    "follower_way": replace(steady(OURS), state_dropout=0.5, turn_weight=4.0, tempo_copies=True,
-                            epochs=4, lr=3e-4, turn_past_dropout=1.0),
-    "follower_way_long": replace(steady(OURS), state_dropout=0.5, turn_weight=8.0, tempo_copies=True,
-                                 epochs=16, lr=5e-4, turn_past_dropout=1.0),
     "follower_ccm": replace(steady(CCM), state_dropout=0.5, turn_weight=4.0, own_rollouts_from=10, tempo_copies=True),
     # Measured, not shipped (docs/results.md, "She reads his hand" and "He turns on his own"): only
     # the turn starts his raised hand leads weigh more (unled_turn_weight). At 8x she reads his hand
@@ -628,7 +617,6 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
                      if cfg.turn_weight != 1.0 else torch.ones(len(xr)))
     own_weight = own_onset_weights(cfg, train["input"], train["output"], role)
     weighted = cfg.turn_weight != 1.0 or cfg.own_turn_weight != 1.0
-    turn_start = torch.from_numpy(turn_onsets(train["input"], train["output"], role))
     xv, yv, jv = (normalize(val[k], stats, k) for k in ("input", "output", "intention"))
     mcfg = cfg.model
     predictor = IntentionPredictor(mcfg if cfg.intention_dropout is None
@@ -692,8 +680,6 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
     pasts = torch.cat([torch.arange(slices[k].start, slices[k].stop)
                        for k in ("partner_trajectory_past", "partner_key_joints_past",
                                  "self_trajectory_past", "self_key_joints_past")])
-    own_pasts = torch.cat([torch.arange(slices[k].start, slices[k].stop)
-                           for k in ("self_trajectory_past", "self_key_joints_past")])
 
     def inputs(idx, proximity: bool = False):
         """Normalized inputs of a batch as the networks read them (with state noise), which samples
@@ -716,7 +702,7 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
             x, lowered = lower_partner(x, cfg.partner_lowered_share, cfg.partner_lowered_depth, gen)
             altered = lowered if altered is None else altered | lowered
         clean = ((x - stats["input_mean"]) / stats["input_std"]).to(device)
-        if cfg.state_noise == 0 and cfg.past_dropout == 0 and cfg.turn_past_dropout == 0:
+        if cfg.state_noise == 0 and cfg.past_dropout == 0:
             return clean, moved, altered, clean
         noisy = clean.clone()
         if cfg.state_noise:
@@ -724,9 +710,6 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
         if cfg.past_dropout:
             hidden = (torch.rand(len(noisy), generator=gen) < cfg.past_dropout).to(device)
             noisy[hidden.nonzero()[:, 0][:, None], pasts[None].to(device)] = 0.0
-        if cfg.turn_past_dropout:
-            hidden = turn_start[idx] & (torch.rand(len(noisy), generator=gen) < cfg.turn_past_dropout)
-            noisy[hidden.nonzero()[:, 0][:, None].to(device), own_pasts[None].to(device)] = 0.0
         return noisy, moved, altered, clean
 
     def save(stage_, epoch_):
@@ -799,7 +782,6 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
             w_own = (onset_weights(cfg, rolled["input"], rolled["output"], rolled["intention"], role)
                      if cfg.turn_weight != 1.0 else torch.ones(len(rolled["input"])))
             sample_weight = torch.cat([sample_weight[:recorded_n], w_own])
-            turn_start = torch.cat([turn_start[:recorded_n], torch.from_numpy(turn_onsets(rolled["input"], rolled["output"], role))])
             own_weight = torch.cat([own_weight[:recorded_n],
                                     own_onset_weights(cfg, rolled["input"], rolled["output"], role)])
             mirrored = torch.cat([mirrored[:recorded_n], torch.from_numpy(rolled["mirror"]).long()])
