@@ -1,6 +1,6 @@
 """A probe of what tells her turn's way (docs/results.md, "Which way she turns"): her network reads
 the recorded couple with some blocks of her input reflected (x -> -x, left and right swapped:
-scripts/reflected_lead_probe.py's reflection). A block that carries the way turns her the other way
+scripts/lead_way_probe.py's reflection). A block that carries the way turns her the other way
 when reflected. Two readings:
 
 - one step: at recorded frames FRAMES before each of her turns' completion, in every take as
@@ -28,7 +28,7 @@ from training.mirror import features as feat
 from training.mirror.features import HISTORY
 from training.mirror.rollout import OnnxPolicy
 
-_spec = importlib.util.spec_from_file_location("reflected_lead_probe", Path(__file__).with_name("reflected_lead_probe.py"))
+_spec = importlib.util.spec_from_file_location("lead_way_probe", Path(__file__).with_name("lead_way_probe.py"))
 _probe = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(_probe)
 

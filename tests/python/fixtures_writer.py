@@ -490,7 +490,8 @@ def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_o
             ro.ask_turn(duet, ask[i])
         before_velocity = duet.steering.velocity.copy()
         ro.steer_plan(duet.leader, duet.steering, np.array(stick, float))
-        planned_root = duet.leader.track.root.copy()
+        ro.lead_plan(duet)   # from step 1 a request runs: the plan bent her way
+        planned_root, planned_heading = duet.leader.track.root.copy(), duet.leader.track.heading.copy()
         xl, xf = ro.step_inputs(duet)
         ol, of = plausible(lead, 30 + i % 2), plausible(follow, 30 + i % 2)
         fi = feat.intention_target(lead, follow, np.array([30]))[0].astype(np.float32).astype(np.float64)
@@ -505,6 +506,7 @@ def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_o
         steps.append({
             "stick": stick, "steeringBefore": exact(before_velocity),
             "steeringAfter": out7(duet.steering.velocity), "plannedLeaderRoot": out7(planned_root),
+            "plannedLeaderHeading": out7(planned_heading),
             "leaderInput": out7(xl), "followerInput": out7(xf),
             "leaderOutput": [None if not np.isfinite(v) else float(v) for v in lead_out],
             "followerOutput": [float(v) for v in follow_out],

@@ -196,7 +196,13 @@ def test_lead_runs_on_freshly_exported_models(exported, data3, tmp_path, capsys)
     # The lead detector read both branches of every request (fitted on the 3 takes of data3).
     assert all(isinstance(r[k], bool) for s in res["per_seed"] for r in s["requests"]
                for k in ("lead_seen", "lead_seen_unasked"))
-    assert "Does he lead?" in capsys.readouterr().out
+    text = capsys.readouterr().out
+    assert "Does he lead?" in text
+    # His own facing over each request, signed the asked way, and its median in the report.
+    his = [r["his_turn"] for s in res["per_seed"] for r in s["requests"]]
+    assert len(his) == 2 and all(np.isfinite(his))
+    assert res["summary"]["his_turn"] == pytest.approx(float(np.median(his)))
+    assert f"His own facing over a request: a median {res['summary']['his_turn']:+.0f} degrees" in text
 
 
 def test_the_film_dances_the_duet_the_table_measured(exported):
@@ -240,6 +246,11 @@ def test_recorded_leads_reads_his_hands_around_her_turns(data3, capsys):
     assert "Her turns to her left (+1)" in out and "Her turns to her right (-1)" in out
     left, right = (int(line.rsplit("negative in ", 1)[1].split(" %")[0]) for line in out.splitlines() if "winds" in line)
     assert left + right == 100                      # mirrored copies wind the other way
+    # His facing around her turns, signed her way: each turn's mirrored copy turns her other way
+    # and his with it, so the signed degrees come in the same amounts, whatever the way.
+    turned, moved = recorded_leads.facing_around_turns(str(data3))
+    assert len(turned) == len(moved) > 0 and len(turned) % 2 == 0 and np.all(moved >= 0)
+    assert f"her way by a median {np.median(turned):+.0f} degrees" in out
     # The windows: her turns split by his hand, with shares that add up to the whole.
     r = recorded_leads.windows(str(data3))
     up, she = r[:, 0], r[:, 1]

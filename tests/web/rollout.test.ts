@@ -93,12 +93,14 @@ describe('the duet loop, step by step', () => {
   const nan = (values: (number | null)[]) => Float32Array.from(values, (v) => (v === null ? NaN : v));
 
   (data.steps as Json[]).forEach((step, i) => {
-    it(`step ${i}: steerPlan, stepInputs, outputIsAbsurd, finishStep (absurd: ${step.absurd})`, () => {
+    it(`step ${i}: steerPlan, leadPlan, stepInputs, outputIsAbsurd, finishStep (absurd: ${step.absurd})`, () => {
       if (step.ask !== null) R.askTurn(duet, step.ask);
       duet.steering.velocity.set(step.steeringBefore);
       R.steerPlan(duet.leader, duet.steering, step.stick[0], step.stick[1]);
+      R.leadPlan(duet);
       expectClose(duet.steering.velocity, step.steeringAfter, 'steering velocity');
       expectClose(duet.leader.track.root, step.plannedLeaderRoot, 'steered plan');
+      expectClose(duet.leader.track.heading, step.plannedLeaderHeading, 'steered plan, its facing');
 
       const leaderIn = new Float32Array(LEADER_INPUT_SIZE);
       const followerIn = new Float32Array(INPUT_SIZE);

@@ -51,7 +51,8 @@ def branch(duet, leader, follower, temperature: float, rng: np.random.Generator,
     """Dance a copy of the duet `frames` steps on (asked for a turn in `direction` first, or not):
     the follower's world positions [frames + 1, 17, 3], the request's frame first, (with_body)
     his body at each of those frames (turn_cues.leader_body: his past, pose and plan in his own
-    root space; None without), and the highest his hands went (m above the floor)."""
+    root space; None without), the highest his hands went (m above the floor), how his higher hand
+    wound (winding) and how far his own facing turned (degrees, counterclockwise seen from above)."""
     d = copy.deepcopy(duet)
     if direction is not None:
         ask_turn(d, direction)
@@ -59,15 +60,18 @@ def branch(duet, leader, follower, temperature: float, rng: np.random.Generator,
     body = np.zeros((frames + 1, C.LEADER_BODY_SIZE)) if with_body else None
     now, hand = np.array([NOW]), 0.0
     hands = np.zeros((frames + 1, 2, 3))
+    his = np.zeros((frames + 1, 17, 3))
     for f in range(frames + 1):
         if f > 0:
             step(d, leader, follower, np.zeros(2), temperature, rng)
         out[f] = d.follower.track.positions[NOW]
+        his[f] = d.leader.track.positions[NOW]
         hand = max(hand, float(d.leader.track.positions[NOW][HANDS, 1].max()))
         hands[f] = feat.to_root_space_points(d.leader.track.positions[NOW][HANDS], d.leader.root, d.leader.heading)
         if with_body:
             body[f] = C.leader_body(d.follower.track, d.leader.track, now)[0]
-    return out, body, hand, winding(hands)
+    facing = Fg.facing(his)
+    return out, body, hand, winding(hands), float(np.degrees(facing[-1] - facing[0]))
 
 
 def winding(hands: np.ndarray) -> float:
@@ -107,10 +111,12 @@ def one_duet(manifest, leader, follower, temperature: float, seed: int, seconds:
         if f in ask_at:
             direction = int(rng.choice([-1, 1]))
             state = rng.bit_generator.state
-            asked, body_asked, hand_asked, wind_asked = branch(duet, leader, follower, temperature, np.random.default_rng(seed * 1000 + f),
-                                       direction, window, detector is not None)
-            unasked, body_unasked, hand_unasked, wind_unasked = branch(duet, leader, follower, temperature,
-                                           np.random.default_rng(seed * 1000 + f), None, window, detector is not None)
+            asked, body_asked, hand_asked, wind_asked, his_asked = branch(
+                duet, leader, follower, temperature, np.random.default_rng(seed * 1000 + f), direction, window,
+                detector is not None)
+            unasked, body_unasked, hand_unasked, wind_unasked, his_unasked = branch(
+                duet, leader, follower, temperature, np.random.default_rng(seed * 1000 + f), None, window,
+                detector is not None)
             rng.bit_generator.state = state
             turns_asked, turns_unasked = Fg.turns(Fg.facing(asked)), Fg.turns(Fg.facing(unasked))
             requests.append({"frame": f, "direction": direction,
@@ -119,6 +125,8 @@ def one_duet(manifest, leader, follower, temperature: float, seed: int, seconds:
                              "turned_unasked": bool(turns_unasked),
                              "hand_m": hand_asked, "hand_m_unasked": hand_unasked,
                              "winding": wind_asked, "winding_unasked": wind_unasked,
+                             # his own facing over the request, positive the asked way (rollout.lead_plan)
+                             "his_turn": direction * his_asked, "his_turn_unasked": direction * his_unasked,
                              "hand_raised": hand_asked > HAND_RAISED, "hand_raised_unasked": hand_unasked > HAND_RAISED,
                              "lead_seen": lead_seen(detector, body_asked, direction),
                              "lead_seen_unasked": lead_seen(detector, body_unasked, direction)})
@@ -169,7 +177,14 @@ def summary(per_seed: list[dict], ref: dict) -> dict:
            "turned_unasked": share("turned_unasked"),
            "hand_raised": share("hand_raised"), "hand_raised_unasked": share("hand_raised_unasked"),
            "median_seconds": float(np.median([r["seconds"] for r in req if r["seconds"] is not None]))
-           if any(r["turned"] for r in req) else None}
+           if any(r["turned"] for r in req) else None,
+           "his_turn": float(np.median([r["his_turn"] for r in req])) if n else None,
+           "his_turn_unasked": float(np.median([r["his_turn_unasked"] for r in req])) if n else None}
+    # The asked way of her turns, per way: a follower who turns one way whatever is asked shows here.
+    for name, way in (("left", 1), ("right", -1)):
+        turned = [r for r in req if r["direction"] == way and r["turned"]]
+        out[f"that_way_of_turns_{name}"] = (sum(r["turned_that_way"] for r in turned) / len(turned)
+                                            if turned else None)
     # Unasked, how often she turns in the windows where his hand went up and where it did not: her
     # reading of his lead (recorded_leads.windows measures the recorded follower's).
     up = [r["turned_unasked"] for r in req if r["hand_raised_unasked"]]
@@ -227,6 +242,11 @@ def recording(data: str, takes: list[str]) -> dict:
             for who, part in (("leader", "lead"), ("follower", "follow"))}
 
 
+def way_share(s: dict, name: str) -> str:
+    v = s.get(f"that_way_of_turns_{name}")
+    return "–" if v is None else f"{100 * v:.0f} %"
+
+
 def write_markdown(path: Path, res: dict) -> None:
     s, ref, cfg = res["summary"], res["recording"], res["config"]
     L = [f"# Leading a turn, and dancing unasked: {cfg['seeds']} seeds × {cfg['seconds']:g} s, nobody steering", "",
@@ -240,6 +260,11 @@ def write_markdown(path: Path, res: dict) -> None:
          f"| the same moments, unasked | {100 * s['turned_unasked']:.0f} % |",
          f"| ratio asked / unasked | {s['turned'] / s['turned_unasked']:.1f}× |" if s["turned_unasked"] else
          "| ratio asked / unasked | – (no turn unasked) |", "",
+         *([f"Her turns after a request that went the asked way: {way_share(s, 'left')} of those asked to her left, "
+            f"{way_share(s, 'right')} to her right. His own facing over a request: a median "
+            f"{s['his_turn']:+.0f} degrees the asked way ({s['his_turn_unasked']:+.0f} over the same moments unasked; "
+            f"the recorded leader around her turns: `python -m training.evaluation.recorded_leads`).", ""]
+           if s.get("his_turn") is not None else []),
          f"His hand above {HAND_RAISED:g} m within 2.5 s: {100 * s['hand_raised']:.0f} % of the requests, "
          f"{100 * s['hand_raised_unasked']:.0f} % of the same moments unasked.", "",
          *([f"Her reading of his hand, unasked: she turns in {100 * s['turned_unasked_hand_up']:.0f} % of the moments "

@@ -10,6 +10,9 @@ WINDOW[1] seconds around the turn's completion, and reports:
 - when the peak comes, which hand it is for each direction, and where it is;
 - which way the higher hand winds over the floor plan in the last second (its signed area,
   lead.winding's sign: negative for her turn to the left);
+- how far his own facing goes her way over a request's span around her turn (FACING_SPAN seconds
+  from her turn's completion: a request's 2.5 s, her turn completing where the page's requests
+  complete it), and how far his root moves: rollout.LEAD_TURN and LEAD_SIDE are read against it;
 - in windows of REQUEST_SECONDS from every EVERY-th frame (what `lead` reads after a request and at
   the same moments unasked): how often his hand goes above RAISED metres, and how often she, and
   he, complete a turn in the windows with it and without it; and the ratio `lead` reports (asked /
@@ -38,6 +41,7 @@ WINDOW = (-2.0, 0.5)   # s around the turn's completion
 PEAK = 1.5             # s before completion where the lead's peak is looked for
 WIND = 1.0             # s before completion over which the winding is read
 EVERY = 6              # frames between the windows' starts
+FACING_SPAN = (-1.7, 0.8)   # s around the turn's completion: REQUEST_SECONDS, as a request's turn
 
 
 def couples(data: str):
@@ -60,6 +64,27 @@ def hands_around_turns(data: str) -> tuple[dict[int, list[np.ndarray]], np.ndarr
             if idx[0] >= 0 and idx[-1] < lead.frames:
                 around[direction].append(hands[idx])
     return around, np.concatenate(every)
+
+
+def facing_around_turns(data: str) -> tuple[np.ndarray, np.ndarray]:
+    """[turns] degrees his facing goes her way over FACING_SPAN around each of her turns (signed:
+    positive the way she turns), and [turns] metres his root moves over it."""
+    a, b = int(round(FACING_SPAN[0] * FPS)), int(round(FACING_SPAN[1] * FPS))
+    turned, moved = [], []
+    for lead, follow in couples(data):
+        his = F.facing(lead.positions)   # unwrapped
+        for t, direction in F.turns(F.facing(follow.positions)):
+            if t + a >= 0 and t + b < lead.frames:
+                turned.append(direction * np.degrees(his[t + b] - his[t + a]))
+                moved.append(float(np.linalg.norm(lead.root[t + b] - lead.root[t + a])))
+    return np.array(turned), np.array(moved)
+
+
+def facing_report(turned: np.ndarray, moved: np.ndarray) -> str:
+    q = np.percentile(turned, [25, 50, 75])
+    return (f"His facing over the {FACING_SPAN[1] - FACING_SPAN[0]:g} s from {-FACING_SPAN[0]:g} s before her turn "
+            f"completes: her way by a median {q[1]:+.0f} degrees (quartiles {q[0]:+.0f} and {q[2]:+.0f}, {len(turned)} turns); "
+            f"his root moves a median {np.median(moved):.2f} m.")
 
 
 def windows(data: str) -> np.ndarray:
@@ -136,7 +161,8 @@ def main(argv=None) -> int:
     if not around[1] or not around[-1]:
         print(f"error: {args.data}: no recorded turn of both directions to read a lead from", file=sys.stderr)
         return 2
-    print("\n".join(report(around, every) + [windows_report(windows(args.data))]))
+    print("\n".join(report(around, every) + [facing_report(*facing_around_turns(args.data)),
+                                              windows_report(windows(args.data))]))
     return 0
 
 

@@ -15,7 +15,7 @@ import { OnCount, STEPPED, drawnFootwork, drawnSteps, hipsTurnBack, nearestCount
 import { LeaderPlayback } from './playback';
 import { StepTimer } from './timing';
 import {
-  Dancer, type Duet, NOW, applyOutput, askTurn, finishStep, musicInput, outputIsAbsurd, startDuet, steerPlan, stepInputs,
+  Dancer, type Duet, NOW, applyOutput, askTurn, finishStep, leadPlan, musicInput, outputIsAbsurd, startDuet, steerPlan, stepInputs,
 } from '../mirror/rollout';
 import type { DancerView, Simulation, SimulationOptions, StepPolicy, Steer } from './types';
 
@@ -189,6 +189,7 @@ export class DuetSimulation implements Simulation {
       const sx = steer.active ? steer.x : 0;
       const sz = steer.active ? steer.z : 0;
       steerPlan(duet.leader, duet.steering, sx, sz);
+      leadPlan(duet);
     }
     this.shownBeat = duet.beat;
     stepInputs(duet, playing ? null : this.leaderPolicy.input, this.followerInputs);

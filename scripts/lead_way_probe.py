@@ -1,22 +1,29 @@
 """A probe of the lead's way (docs/results.md, "Which way she turns"): does she turn the asked way
-when his lead for one way is his lead for the other, reflected?
+when his lead changes? Two leads, each run through `python -m training.evaluation.lead` with the
+remaining arguments, then the asked way printed for each way:
 
-Training reads every take also reflected (skeleton.mirror_motion), so the leader network's answer
-to a reflected input is as good as its answer to the input itself. While a request for WAY runs
-(+1: her left, -1: her right), the leader network reads the duet reflected (x -> -x, left and
-right swapped), asked for the other way, and its step is reflected back; the follower reads him as
-always. Then `python -m training.evaluation.lead` runs with the remaining arguments, and the asked
-way is printed for each way. The reflection is checked first against the features of a reflected
-take (take 10, as training builds its mirrored copies).
+- reflect WAY: his lead for one way is his lead for the other, reflected. Training reads every take
+  also reflected (skeleton.mirror_motion), so the leader network's answer to a reflected input is as
+  good as its answer to the input itself. While a request for WAY runs (+1: her left, -1: her
+  right) the leader network reads the duet reflected (x -> -x, left and right swapped), asked for
+  the other way, and its step is reflected back. The reflection is checked first against the
+  features of a reflected take (take 10, as training builds its mirrored copies).
+- plan DEG SIDE: while a request runs, his planned path (the control he reads, and the future path
+  she reads) turns DEG degrees her way and moves SIDE metres to his other side, eased as her planned
+  turn (rollout.lead_plan with LEAD_TURN = DEG, LEAD_SIDE = SIDE; 0 0: the plan left as it was).
 
-    PYTHONPATH=. .venv/bin/python scripts/reflected_lead_probe.py WAY [lead's arguments]
-    PYTHONPATH=. .venv/bin/python scripts/reflected_lead_probe.py 1 --seeds 20 --seconds 30 --no-legibility --out runs/lead_p1
+The follower reads him as always.
 
-Per block (features.py, docs/features.md): every 3-vector (a position, velocity, forward or up in
-root space, a hand's planned move) has its x negated and its joint swapped with its twin
-(skeleton.MIRROR); a trajectory key (x, z, forward x, forward z) has both x negated; the figure's
-planned turns change sign (the heading is atan2(x, z)); a root update (dx, dz, heading change) has
-dx and the heading change negated; the contacts (left, right) swap; the music is what it was.
+    PYTHONPATH=. .venv/bin/python scripts/lead_way_probe.py reflect WAY [lead's arguments]
+    PYTHONPATH=. .venv/bin/python scripts/lead_way_probe.py reflect 1 --seeds 20 --seconds 30 --no-legibility --out runs/lead_p1
+    PYTHONPATH=. .venv/bin/python scripts/lead_way_probe.py plan 45 0 --seeds 20 --seconds 30 --no-legibility --out runs/lead_plan
+
+Per block of the reflection (features.py, docs/features.md): every 3-vector (a position, velocity,
+forward or up in root space, a hand's planned move) has its x negated and its joint swapped with
+its twin (skeleton.MIRROR); a trajectory key (x, z, forward x, forward z) has both x negated; the
+figure's planned turns change sign (the heading is atan2(x, z)); a root update (dx, dz, heading
+change) has dx and the heading change negated; the contacts (left, right) swap; the music is what
+it was.
 """
 from __future__ import annotations
 
@@ -120,6 +127,7 @@ def check(data: str = "../shared/data/cmu-salsa") -> None:
 def step(duet, leader_policy, follower_policy, stick, temperature, rng, way: int) -> None:
     """rollout.step, the leader reflected while a request for `way` runs."""
     rollout.steer_plan(duet.leader, duet.steering, np.asarray(stick, float))
+    rollout.lead_plan(duet)
     xl, xf = rollout.step_inputs(duet)
     reflected = duet.request is not None and duet.request.direction == way
     ol = leader_policy(reflect(xl, "leader") if reflected else xl, temperature, rng)["output"][0]
@@ -130,13 +138,19 @@ def step(duet, leader_policy, follower_policy, stick, temperature, rng, way: int
 
 
 def main(argv: list[str]) -> int:
-    if not argv or argv[0] not in ("1", "-1"):
-        print(__doc__.split("\n\n")[2], file=sys.stderr)
+    if len(argv) < 2 or argv[0] not in ("reflect", "plan") or argv[0] == "reflect" and argv[1] not in ("1", "-1"):
+        print(__doc__.split("\n\n")[3], file=sys.stderr)
         return 2
-    way = int(argv[0])
-    check()
-    lead.step = lambda *a: step(*a, way=way)
-    rc = lead.main(argv[1:])
+    way = None
+    if argv[0] == "reflect":
+        way = int(argv[1])
+        check()
+        lead.step = lambda *a: step(*a, way=way)
+        argv = argv[2:]
+    else:
+        rollout.LEAD_TURN, rollout.LEAD_SIDE = float(argv[1]), float(argv[2])
+        argv = argv[3:]
+    rc = lead.main(argv)
     out = Path(argv[argv.index("--out") + 1] if "--out" in argv else "runs/lead") / "lead.json"
     res = json.loads(out.read_text())
     for asked in (1, -1):
