@@ -377,7 +377,7 @@ for (const view of VIEWS) {
         assert.ok(help.includes(`${manifest.fps} times a second`));
         const turns = await page.locator('.turn-button').evaluateAll((buttons) => buttons.map((b) => ({ text: b.textContent.trim(), title: b.title })));
         assert.deepEqual(turns.map((t) => t.text), ['R-hand turn', 'L-hand turn']);
-        for (const t of turns) assert.match(t.title, /his (right|left) hand .* she may turn either way/);
+        for (const t of turns) assert.match(t.title, /to her (right|left): he raises his \1 hand .* most of her turns go that way/);
 
         const row = page.locator('.duet-panel .lil-controller').filter({ has: page.locator('.lil-name', { hasText: /^\s*variety\s*$/ }) });
         const box = row.locator('input');

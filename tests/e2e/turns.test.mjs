@@ -201,8 +201,8 @@ describe(`leading a turn (seed ${SEED})`, () => {
 // Shift+T call), her left on odd seeds and her right on even ones as in scripts/turns_probe.mjs,
 // and her facing recorded for 2.5 s. She is still not told: her network reads his motion. The dance
 // of a seed is the same on every run. With the shipped models she turned 300 degrees or more
-// (either way) within 2.5 s in 8 of these 16 (seeds 6-9, 11, 13, 15, 16; the asked way in 6, 7,
-// 8, 11, 15 and 16); Python's lead turns after 58 % of 250 requests (docs/results.md, "Leading a
+// (either way) within 2.5 s in 7 of these 16 (seeds 2, 6, 8, 12-15; the asked way in 2, 6, 8, 12,
+// 14 and 15); Python's lead turns after 52 % of 500 requests (docs/results.md, "Leading a
 // turn"). Asserted: at least MIN_TURNED of the 16. A follower who turns after half the requests
 // fails that by chance once in a hundred models (3 or fewer of 16); one who turns after a fifth
 // fails it six times in ten. And every request is taken without an error.

@@ -73,12 +73,15 @@ describe('the help, against the manifest and the page', () => {
       const title = turnTitle(hand as 'right' | 'left', key);
       expect(title).toContain(`his ${hand} hand`);
       expect(title).toContain(`(${key})`);
-      expect(title).toContain('she may turn either way');
-      expect(title).not.toMatch(/her (right|left)/);
+      // The hand names her way: his right hand leads her turn to her right (rollout lead_plan).
+      expect(title).toContain(`lead a turn to her ${hand}`);
+      expect(title).toContain('most of her turns go that way');
     }
-    expect(keysText()).toContain('she may turn either way');
+    expect(keysText()).toContain('T: your dancer raises his right hand over her and turns to lead her turn to her right');
+    expect(keysText()).toContain('Shift+T his left, to her left');
     const brief = BRIEF.map(([term, text]) => `${term} ${text}`).join('\n');
-    expect(brief).not.toMatch(/her (right|left)|↻|↺/);
+    expect(brief).toContain('leading her turn that way');
+    expect(brief).not.toMatch(/↻|↺/);
   });
 
   it('the brief names every control of the panel', () => {

@@ -65,7 +65,8 @@ export const RAISE: readonly number[] = [0.1, 0.5, 1.8, 2.3]; // s
 // goes her way by a median 38 degrees, quartiles -103 and +205), and she reads the way from his
 // body over the second before her turn. With
 // his plan left as it was she turned the asked way after 32 % of requests; turned 90 degrees and
-// moved 0.6 m aside, 48 % (the other amounts tried: training/mirror/rollout.py).
+// moved 0.6 m aside, 48 % (the other amounts tried: training/mirror/rollout.py); he turns a median
+// 121 degrees her way over a request.
 export const LEAD_TURN = 90; // degrees
 export const LEAD_SIDE = 0.6; // m
 

@@ -64,7 +64,7 @@ export function methodText(facts: HelpFacts): string[] {
 /** Every key and gesture (in the "more" fold). */
 export function keysText(): string {
   return (
-    'Keys: arrows or WASD lead · T: your dancer raises his right hand over her to lead a turn, Shift+T his left (she may turn either way) · ' +
+    'Keys: arrows or WASD lead · T: your dancer raises his right hand over her and turns to lead her turn to her right, Shift+T his left, to her left (most of her turns go that way) · ' +
     'Space pause · R start again (the camera too) · ' +
     `“● clip” saves a ${CLIP_SECONDS} s video, the corners button goes full screen · drag to turn the camera, wheel to zoom, ` +
     'double-click to frame both dancers again. Phone: drag one finger to lead, two fingers to turn and zoom, double-tap to frame ' +

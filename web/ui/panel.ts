@@ -81,7 +81,7 @@ export const BRIEF: readonly (readonly [string, string])[] = [
   ['arrows · WASD · finger', 'Lead the blue dancer.'],
   ['drag · wheel · 2 fingers', 'Move the camera; a double tap brings both dancers back.'],
   ['pause (Space)', 'Holds the dance, or lets it go on.'],
-  ['R- · L-hand turn (T, Shift+T)', 'He raises that hand to lead her turn; she may turn either way.'],
+  ['R- · L-hand turn (T, Shift+T)', 'He raises that hand and turns, leading her turn that way; she mostly follows the way.'],
   ['● clip · corners', `Save a ${CLIP_SECONDS} s video · full screen.`],
   ['partner', 'Reads your intention, a baseline that does not, or both side by side.'],
   ['variety', 'Low: her likeliest move; high: wilder ones.'],

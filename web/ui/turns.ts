@@ -1,8 +1,9 @@
 // "Lead a turn": the two buttons beside pause (a phone has no T key). Each asks the leader model
 // to lead the partner's turn now (Simulation.askTurn): he raises his right hand over her (T) or
-// his left (Shift+T). The follower is never told: she turns only if she reads it in his motion,
-// and today she may turn either way whichever hand he raises (issue 51), so the buttons name the
-// hand, not a direction. On a phone the word "hand" folds away (one row of buttons: style.css).
+// his left (Shift+T), and turns with her that way (rollout lead_plan). The follower is never
+// told: she turns only if she reads it in his motion, and most of her turns after a request go the
+// asked way (78 %: docs/results.md, "Which way she turns"), so the buttons name the hand and her
+// way. On a phone the word "hand" folds away (one row of buttons: style.css).
 
 /** [direction for Simulation.askTurn, hand letter, hand, key]. */
 const TURNS = [
@@ -12,7 +13,7 @@ const TURNS = [
 
 /** What a turn button says it does, in its tooltip and to a screen reader. */
 export function turnTitle(hand: 'right' | 'left', key: string): string {
-  return `lead a turn: he raises his ${hand} hand over her (${key}); she may turn either way`;
+  return `lead a turn to her ${hand}: he raises his ${hand} hand over her and turns with her (${key}); most of her turns go that way`;
 }
 
 export class TurnButtons {
