@@ -63,8 +63,9 @@ def one_step(offsets: list[int], model: str) -> None:
     for take in discover_takes(DATA):
         lead, follow = load_pair(take)
         for mirror in (False, True):
-            s = samples(*pair_tracks(lead, follow, mirror=mirror))
-            for f, d in F.turns(F.facing(pair_tracks(lead, follow, mirror=mirror)[1].positions)):
+            tracks = pair_tracks(lead, follow, mirror=mirror)
+            s = samples(*tracks)
+            for f, d in F.turns(F.facing(tracks[1].positions)):
                 for o in offsets:
                     i = np.searchsorted(s["frame"], f + o)
                     if i >= len(s["frame"]) or s["frame"][i] != f + o:
