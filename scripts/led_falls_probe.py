@@ -4,7 +4,7 @@ alternating (T, then Shift+T), so that a request runs most of the time. Counts, 
 the drawn bodies (plausibility.py: a second mostly with hips low, head low or feet wide), the seeds
 with a bad second and the collapses, for him and for her, and her turns a minute.
 
-    PYTHONPATH=. .venv/bin/python scripts/led_falls_probe.py steered|nobody SEEDS SECONDS
+    PYTHONPATH=. .venv/bin/python scripts/led_falls_probe.py steered|nobody SEEDS SECONDS [--models DIR --follower NAME]
     PYTHONPATH=. .venv/bin/python scripts/led_falls_probe.py steered 30 60
 """
 import argparse
@@ -24,7 +24,7 @@ EVERY = 3.0   # s between requests (a request lasts rollout.REQUEST_SECONDS, 2.5
 
 
 def main(argv: list[str]) -> int:
-    if len(argv) != 3 or argv[0] not in ("steered", "nobody"):
+    if len(argv) < 3 or argv[0] not in ("steered", "nobody"):
         print(__doc__.split("\n\n")[-1], file=sys.stderr)
         return 2
     steer, seeds, seconds = argv[0] == "steered", int(argv[1]), int(argv[2])
@@ -33,7 +33,7 @@ def main(argv: list[str]) -> int:
     ap.add_argument("--models", default="public/models")
     ap.add_argument("--follower", default="follower")
     O.add_options(ap)
-    manifest, leader, follower, temperature = load_dancers(ap.parse_args([]))
+    manifest, leader, follower, temperature = load_dancers(ap.parse_args(argv[3:]))
     ranges = manifest["plausibility"]
 
     def asking_step(duet, *args):

@@ -5,7 +5,7 @@ beats a minute from seed 0 and prints her footwork's pulse, the share of seeds w
 music's (within 4 %), her steps on the beat (training.evaluation.rhythm) and her turns a minute
 (training.evaluation.figures), as ratios to the recorded follower's (pulse 0.33, 23.0 turns a minute).
 
-    PYTHONPATH=. .venv/bin/python scripts/turning_probe.py TURNING steered|nobody SEEDS SECONDS
+    PYTHONPATH=. .venv/bin/python scripts/turning_probe.py TURNING steered|nobody SEEDS SECONDS [--models DIR --follower NAME]
     PYTHONPATH=. .venv/bin/python scripts/turning_probe.py 7.5 steered 40 60     # 0.83x, turns 0.70x
 """
 import argparse
@@ -24,7 +24,7 @@ RECORDED_PULSE, RECORDED_TURNS, TEMPO = 0.33, 23.0, 170.0
 
 
 def main(argv: list[str]) -> int:
-    if len(argv) != 4 or argv[1] not in ("steered", "nobody"):
+    if len(argv) < 4 or argv[1] not in ("steered", "nobody"):
         print(__doc__.split("\n\n")[-1], file=sys.stderr)
         return 2
     turning, steer, seeds, seconds = float(argv[0]), argv[1] == "steered", int(argv[2]), int(argv[3])
@@ -33,7 +33,7 @@ def main(argv: list[str]) -> int:
     ap.add_argument("--models", default="public/models")
     ap.add_argument("--follower", default="follower")
     O.add_options(ap)
-    args = ap.parse_args([])
+    args = ap.parse_args(argv[4:])
     manifest, leader, follower, temperature = load_dancers(args)
     on_count.TURNING["follower"] = turning
     rows, turns = [], 0

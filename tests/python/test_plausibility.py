@@ -120,6 +120,28 @@ def test_state_columns_are_the_own_pose_positions_and_velocities():
         assert replace(ModelConfig(role=role), decoder_state=False).state_columns == []
 
 
+def test_a_decoder_that_hears_the_music_reads_the_count_and_never_has_it_hidden():
+    """decoder_music: the music block follows the pose among the decoder's columns; a step decoded
+    from one code changes with the count, and hiding the state (state_keep 0) hides the pose only."""
+    torch.manual_seed(0)
+    cfg = ModelConfig(hidden=32, intention_hidden=16, channels=3, classes=4, decoder_state=True, decoder_music=True)
+    music = feat.block_slices(feat.FOLLOWER_INPUT_LAYOUT)["music"]
+    assert cfg.music_columns == list(range(music.start, music.stop))
+    assert cfg.state_columns[-len(cfg.music_columns):] == cfg.music_columns
+    assert len(cfg.state_columns) == 17 * 6 + music.stop - music.start
+    matching = CodebookMatching(cfg).eval()
+    code = torch.nn.functional.one_hot(torch.tensor([[1, 2, 3]]), 4).float().reshape(1, -1).repeat(2, 1)
+    x = torch.randn(1, feat.INPUT_SIZE).repeat(2, 1)
+    x[1, music] += 1.0   # another count, the same pose
+    with torch.no_grad():
+        assert not torch.allclose(*matching.decode(code, x))
+        hidden = matching.decode(code, x, state_keep=torch.zeros(2, 1))
+        other_pose = x.clone()
+        other_pose[:, cfg.state_columns[0]] += 5.0
+        assert torch.allclose(hidden, matching.decode(code, other_pose, state_keep=torch.zeros(2, 1)))
+        assert not torch.allclose(*hidden)   # the count still tells the two apart
+
+
 def test_seeds_judges_every_seed_of_the_exported_models_against_the_recording(exported, data3, tmp_path):
     """training.evaluation.seeds end to end on the smoke models: one row per seed, shares and
     their ratios to the recording, alone and with the layer."""

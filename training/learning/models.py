@@ -30,6 +30,11 @@ class ModelConfig:
     # shape between code switches (stop-motion; docs/plausibility.md). With the current motion
     # beside the code, the same code carries the body on from where it is.
     decoder_state: bool = False
+    # The decoder also reads the music block (the count over the past and next second, the tempo)
+    # beside the code and the pose, never hidden. Read only by the encoders, the count reaches the
+    # pose through the code, and a half-beat shift of it moves a step by a tenth of the ankles'
+    # speed (docs/music.md): the code may not carry when the feet land.
+    decoder_music: bool = False
     input_size: int = INPUT_SIZE
     output_size: int = OUTPUT_SIZE
     intention_size: int = INTENTION_SIZE
@@ -56,7 +61,16 @@ class ModelConfig:
             return []
         layout = LEADER_INPUT_LAYOUT if self.role == "leader" else FOLLOWER_INPUT_LAYOUT
         start, per_joint = block_slices(layout)["self_pose"].start, POSE_SIZE // N_JOINTS   # features.pose_block
-        return [start + per_joint * j + k for j in range(N_JOINTS) for k in range(6)]
+        return [start + per_joint * j + k for j in range(N_JOINTS) for k in range(6)] + self.music_columns
+
+    @property
+    def music_columns(self) -> list[int]:
+        """Columns of the input's music block the decoder reads after the pose (decoder_music)."""
+        if not self.decoder_music:
+            return []
+        layout = LEADER_INPUT_LAYOUT if self.role == "leader" else FOLLOWER_INPUT_LAYOUT
+        music = block_slices(layout)["music"]
+        return list(range(music.start, music.stop))
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -125,8 +139,11 @@ class CodebookMatching(nn.Module):
         """One-hot code [B, C*D] (and the normalized input x, read when the decoder reads the state) -> O.
         state_keep [B, 1] (training only): 0 hides a sample's state from the decoder (the mean pose)."""
         state = x[:, self.state_columns]
-        if state_keep is not None:
-            state = state * state_keep
+        if state_keep is not None:   # hides the pose, never the music
+            music = len(self.cfg.music_columns)
+            keep = torch.cat([state_keep.expand(-1, state.shape[1] - music),
+                              torch.ones(len(state), music, device=state.device)], 1)
+            state = state * keep
         return self.decoder(torch.cat([code, state], -1))
 
     def _cond(self, x, intention):
