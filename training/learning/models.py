@@ -56,7 +56,8 @@ class ModelConfig:
     @property
     def state_columns(self) -> list[int]:
         """Columns of the input the decoder reads: the self pose's position and velocity of each
-        joint (6 of its 12 numbers); none without decoder_state."""
+        joint (6 of its 12 numbers), then the music block with decoder_music; none without
+        decoder_state."""
         if not self.decoder_state:
             return []
         layout = LEADER_INPUT_LAYOUT if self.role == "leader" else FOLLOWER_INPUT_LAYOUT
