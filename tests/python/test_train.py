@@ -370,3 +370,26 @@ def test_state_dropout_hides_the_state_from_the_decoder_only():
     assert torch.allclose(out[[0, 2]], m.decode(code, zeroed)[[0, 2]])
     assert torch.allclose(out[1], m.decode(code, x)[1])
     assert not torch.allclose(m.decode(code, x)[0], m.decode(code, zeroed)[0])
+
+
+def test_a_run_saved_before_a_model_field_existed_is_fine_tuned_and_resumed(smoke_runs, prepared3, tmp_path, capsys):
+    """A checkpoint whose model config lacks a field added later (decoder_music) reads as that
+    field's default: it can be fine-tuned from (--init-from) and resumed, and another size cannot."""
+    run = tmp_path / "old" / "follower"
+    shutil.copytree(smoke_runs / "follower", run)
+    ck = torch.load(run / "checkpoint.pt", map_location="cpu", weights_only=False)
+    del ck["config"]["model"]["decoder_music"]
+    torch.save(ck, run / "checkpoint.pt")
+    rc, out, err = run_main(capsys, "--model", "follower", "--smoke", "--prepared", prepared3,
+                            "--runs", tmp_path / "new", "--init-from", run)
+    assert rc == 0, err
+    assert "fine-tuning" in out
+    shutil.copytree(run, tmp_path / "resumed" / "follower")
+    rc, out, err = run_main(capsys, "--model", "follower", "--smoke", "--prepared", prepared3,
+                            "--runs", tmp_path / "resumed", "--resume")
+    assert rc == 0 and "resumed at done" in out, err
+    ck["config"]["model"]["hidden"] = 7
+    torch.save(ck, run / "checkpoint.pt")
+    rc, _, err = run_main(capsys, "--model", "follower", "--smoke", "--prepared", prepared3,
+                          "--runs", tmp_path / "other", "--init-from", run)
+    assert rc == 2 and "not a finished run of the same model sizes" in err

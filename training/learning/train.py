@@ -612,6 +612,14 @@ def cosine(step: int, total: int, lr: float) -> float:
     return lr * 0.5 * (1 + math.cos(math.pi * min(step, total) / max(total, 1)))
 
 
+def saved_config(config: dict | None) -> dict | None:
+    """A checkpoint's recipe as asdict(TrainConfig) gives it today: model fields added since it was
+    saved (ModelConfig.decoder_music) take their defaults, which are what it was trained with."""
+    if not config or "model" not in config:
+        return config
+    return {**config, "model": asdict(ModelConfig(**config["model"]))}
+
+
 def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = "cpu",
                 resume: bool = False, quiet: bool = False, rank: int = 0, world: int = 1,
                 init_from: str | None = None) -> dict:
@@ -656,7 +664,7 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
     stage, epoch, seconds = "intention", 0, 0.0
     if resume and ckpt_path.exists():
         ck = load_checkpoint(ckpt_path)
-        if ck.get("config") != asdict(cfg):
+        if saved_config(ck.get("config")) != asdict(cfg):
             raise TrainError(f"{ckpt_path}: saved with another configuration; use a new --out or delete it")
         predictor.load_state_dict(ck["predictor"]); matching.load_state_dict(ck["matching"])
         disc.load_state_dict(ck["disc"]); opt_p.load_state_dict(ck["opt_p"])
@@ -668,7 +676,7 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
         # A fine-tune: the weights of another run (same sizes), its intention predictor kept as
         # it is; this recipe's matching epochs train on with fresh optimizers.
         ck = load_checkpoint(Path(init_from) / "checkpoint.pt")
-        if ck.get("stage") not in ("matching", "done") or ck["config"]["model"] != asdict(cfg.model):
+        if ck.get("stage") not in ("matching", "done") or saved_config(ck["config"])["model"] != asdict(cfg.model):
             raise TrainError(f"{init_from}: not a finished run of the same model sizes; cannot fine-tune from it")
         predictor.load_state_dict(ck["predictor"]); matching.load_state_dict(ck["matching"])
         disc.load_state_dict(ck["disc"])
