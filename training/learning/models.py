@@ -142,9 +142,10 @@ class CodebookMatching(nn.Module):
         state = x[:, self.state_columns]
         if state_keep is not None:   # hides the pose, never the music
             music = len(self.cfg.music_columns)
-            keep = torch.cat([state_keep.expand(-1, state.shape[1] - music),
-                              torch.ones(len(state), music, device=state.device)], 1)
-            state = state * keep
+            if music:
+                state_keep = torch.cat([state_keep.expand(-1, state.shape[1] - music),
+                                        torch.ones(len(state), music, device=state.device)], 1)
+            state = state * state_keep
         return self.decoder(torch.cat([code, state], -1))
 
     def _cond(self, x, intention):
