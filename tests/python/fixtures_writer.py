@@ -419,6 +419,8 @@ def on_count_cases(rng: np.random.Generator, outputs: np.ndarray, ranges: dict, 
     otherwise), three steps of each dancer's chooser, and the choice among the upright fixture's
     outputs at margins where all, some and none of them stand."""
     cases = {}
+    spinner = OC.OnCount("follower", 4, 0.8, spin_keep=0.7)   # her chooser that keeps spins
+    spins = []
     for role, size in (("leader", feat.LEADER_INPUT_SIZE), ("follower", feat.INPUT_SIZE)):
         chooser = OC.OnCount(role, 4, 0.8)
         steps = []
@@ -430,7 +432,11 @@ def on_count_cases(rng: np.random.Generator, outputs: np.ndarray, ranges: dict, 
             target = chooser.target(x)
             steps.append({"input": exact(x), "footwork": out7(OC.footwork_now(x, role)),
                           "count": out7(OC.count_next(x)), "turnRate": out7(OC.turn_rate(x, role)),
+                          "turnNow": out7(OC.turn_now(x, role)),
                           "target": None if target is None else out7(target), "mean": out7(chooser.mean)})
+            if role == "follower":
+                aimed = spinner.target(x)
+                spins.append({"target": out7(aimed), "spin": None if spinner.spin is None else out7(spinner.spin)})
         cases[role] = steps
     # The choice among the upright fixture's bodies, from a follower's input whose own hips and
     # ankles stand where the first body draws them, her hips having come in against the first's
@@ -445,10 +451,21 @@ def on_count_cases(rng: np.random.Generator, outputs: np.ndarray, ranges: dict, 
     footwork, back = OC.drawn_footwork(steps), OC.hips_turn_back(steps, x, "follower")
     standing = G.upright_margin(outputs, ranges, offsets)
     target = float(0.55 * footwork[0] + 0.45 * footwork[1])   # nearer the first, unless its hips count
-    return {"roles": cases, "outputs": exact(outputs), "input": exact(x), "steps": out7(steps.reshape(len(outputs), -1)),
+    # Her spin at 3.2 rad/s clockwise, the same bodies turning on it (the first), slowing to half
+    # (the second), turning back (the third) and on at 0.9 of it (the fourth): at spinKeep 0.7 the
+    # first and fourth keep it, at 0 all but the third, at 1.5 none.
+    spun = outputs.copy()
+    spun[:, feat.block_slices(feat.OUTPUT_LAYOUT)["root_update"].start + 2] = np.array([-3.2, -1.6, 3.2, -2.9]) / FPS
+    spin = -3.2
+    keeps = {f"{k}": OC.keeps_spin(spun, spin, k).tolist() for k in (0.0, 0.7, 1.5)}
+    return {"roles": cases, "spinner": spins, "outputs": exact(outputs), "input": exact(x), "spun": exact(spun),
+            "steps": out7(steps.reshape(len(outputs), -1)),
             "footwork": out7(footwork), "turnBack": back.tolist(), "standing": out7(standing), "target": out7(target),
             "best": {f"{m}/{h}": OC.nearest_count(footwork, back, target, standing, m, h)
-                     for m in (-9.0, 0.0, 0.05, 9.0) for h in (0.0, 1.0)}}
+                     for m in (-9.0, 0.0, 0.05, 9.0) for h in (0.0, 1.0)},
+            "spin": out7(spin), "keeps": keeps,
+            "bestKept": {f"{m}/{k}": OC.nearest_count(footwork, back, target, standing, m, 1.0, np.array(keeps[f"{k}"]))
+                         for m in (-9.0, 0.0, 0.05, 9.0) for k in (0.0, 0.7, 1.5)}}
 
 
 def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_offsets, follow_offsets) -> dict:

@@ -212,3 +212,58 @@ def test_a_turn_leaves_the_footwork_to_the_network_and_keeps_the_hips_going():
     calls.clear()
     plain = UprightGuard(policy, RANGES, samples=4, margin=0.05, offsets=OFFSETS, on_count=OC.OnCount("follower", 3, hips=0.0))
     assert plain(x, 1.0, np.random.default_rng(0))["code"][0, 0] == 0 and calls == [1]
+
+
+def test_her_spin_steps_on_the_count_among_the_samples_that_keep_it():
+    """With spin_keep, her spin (facing 1.2 rad round in 5 frames: 7.2 rad/s clockwise) still aims
+    at the count's footwork, but only among the standing samples whose root turns on the same way at
+    spin_keep x 7.2 rad/s or faster: not the one that slows down, nor the one turning back, though
+    their feet are nearest. When no standing sample keeps the spin, the footwork is left alone as
+    without spin_keep (the first standing one whose hips go on)."""
+    x = input_at("follower", 0.5 - 2.9 / FPS, 0.5)   # between the beats: her target is 2x her mean of 1 m/s
+    c = OC.LAST_FACING["follower"]
+    x[c:c + 2] = np.sin(1.2), np.cos(1.2)
+    spin = -1.2 * FPS / feat.KEY_STEP
+    assert OC.turn_now(x, "follower") == pytest.approx(spin) and OC.turn_rate(x, "follower") == pytest.approx(-spin)
+    chooser = OC.OnCount("follower", samples=4, spin_keep=0.7)
+    assert chooser.target(x) == pytest.approx(2.0) and chooser.spin == pytest.approx(spin)
+    # footwork, turn (rad/s) and hips of each sample: keeps far off, slows, turns back, keeps near
+    samples = [(0.2, spin, 1.0), (2.0, -2.0, 1.0), (2.0, -spin, 1.0), (1.5, 0.85 * spin, 1.0)]
+
+    def spun(fw, turn, hip):
+        out = output(fw, hip)
+        out[ROOT_UPDATE.start + 2] = turn / FPS
+        return out
+
+    assert OC.keeps_spin(np.stack([spun(*s) for s in samples]), spin, 0.7).tolist() == [True, False, False, True]
+
+    def policy(xx, temperature, rng):
+        n = len(np.atleast_2d(xx))
+        return {"output": np.stack([spun(*samples[i % 4]) for i in range(n)]), "code": np.arange(n)[:, None]}
+
+    guard = UprightGuard(policy, RANGES, samples=4, margin=0.05, offsets=OFFSETS, on_count=chooser)
+    assert guard(x, 1.0, np.random.default_rng(0))["code"][0, 0] == 3 and guard.guarded == 0
+    # the two that keep the spin are low: none standing keeps it, the first standing one is taken
+    samples[0], samples[3] = (0.2, spin, 0.4), (1.5, 0.85 * spin, 0.4)
+    assert guard(x, 1.0, np.random.default_rng(0))["code"][0, 0] == 1
+    # without spin_keep her spin is the network's, as before
+    assert OC.OnCount("follower", samples=4).target(x) is None
+    with pytest.raises(ValueError, match="spin_keep"):
+        OC.OnCount("follower", spin_keep=-0.5)
+
+
+def test_options_give_her_the_manifests_spin_keep_and_him_none():
+    m = {"defaultTemperature": 1.0, "leaderTemperature": 0.5, "plausibility": RANGES,
+         "skeleton": {"offsets": {"follower": OFFSETS.tolist(), "leader": OFFSETS.tolist()}},
+         "guard": {"samples": 32, "margin": 0.05}, "leaderGuard": {"samples": 8, "margin": 0.07},
+         "onCount": {"samples": 8, "strength": 1.0, "hips": 1.0, "spinKeep": 0.7}}
+    args = parse()
+    assert O.resolve(args, m) is None and args.on_count_spin_keep == 0.7
+    assert O.follower_policy(policy_stub, m, args, 0.5).on_count.spin_keep == 0.7
+    assert O.leader_policy(policy_stub, m, args).on_count.spin_keep is None
+    args = parse("--on-count-spin-keep", "-1")
+    assert O.resolve(args, m) is None and O.follower_policy(policy_stub, m, args, 0.5).on_count.spin_keep is None
+    args = parse()   # a manifest without spinKeep: her spins left to the network, as the page does
+    assert O.resolve(args, {**m, "onCount": {"samples": 8, "strength": 1.0}}) is None
+    assert O.follower_policy(policy_stub, m | {"onCount": {"samples": 8, "strength": 1.0}}, args, 0.5).on_count.spin_keep is None
+    assert "--on-count-spin-keep" in O.resolve(parse("--on-count-spin-keep", "-0.5"), m)

@@ -6,7 +6,7 @@
 import { describe, expect, it } from 'vitest';
 import { OUTPUT_SIZE } from '../../web/mirror/features';
 import { uprightBody } from '../../web/mirror/guard';
-import { OnCount, TURNING, countNext, drawnFootwork, drawnSteps, footworkNow, hipsTurnBack, nearestCount, turnRate } from '../../web/mirror/on_count';
+import { OnCount, TURNING, countNext, drawnFootwork, drawnSteps, footworkNow, hipsTurnBack, keepsSpin, nearestCount, turnNow, turnRate } from '../../web/mirror/on_count';
 import { expectClose, fixture } from './fixture';
 
 const data = fixture('rollout').onCount;
@@ -20,6 +20,7 @@ describe('the footwork each dancer aims at on the count', () => {
         expectClose([footworkNow(x, role)], step.footwork, `${role} footwork now`);
         expectClose([countNext(x)], step.count, `${role} count at the next step`);
         expectClose([turnRate(x, role)], step.turnRate, `${role} turn rate`);
+        expectClose([turnNow(x, role)], step.turnNow, `${role} turn now`);
         const target = chooser.target(x);
         if (step.target === null) expect(target, `${role} turning: no target`).toBeNull();
         else expectClose([target as number], step.target, `${role} target`);
@@ -35,8 +36,22 @@ describe('the footwork each dancer aims at on the count', () => {
     }
   });
 
-  it('refuses a chooser with fewer than two samples', () => {
+  it('aims her spins at the count too when she keeps them, as Python does', () => {
+    const spinner = new OnCount('follower', 4, 0.8, 1.0, 0.7);
+    data.roles.follower.forEach((step: { input: number[] }, i: number) => {
+      const target = spinner.target(Float32Array.from(step.input));
+      expectClose([target as number], data.spinner[i].target, `target ${i}`);
+      if (data.spinner[i].spin === null) expect(spinner.spin, `no spin at ${i}`).toBeNull();
+      else expectClose([spinner.spin as number], data.spinner[i].spin, `spin ${i}`);
+    });
+    // the last step spins: without spinKeep it had no target
+    expect(data.spinner[2].spin).not.toBeNull();
+    expect(data.roles.follower[2].target).toBeNull();
+  });
+
+  it('refuses a chooser with fewer than two samples, or a spin kept at a negative share', () => {
     expect(() => new OnCount('leader', 1)).toThrow(/at least 2 samples/);
+    expect(() => new OnCount('follower', 8, 1, 1, -0.5)).toThrow(/spinKeep/);
   });
 });
 
@@ -70,5 +85,29 @@ describe('nearestCount', () => {
     expect(new Set(Object.values(data.best))).toEqual(new Set([0, 1, -1]));
     expect(data.best['0.0/0.0']).toBe(0);
     expect(data.best['0.0/1.0']).toBe(1);
+  });
+
+  it('while she spins, takes only the standing samples that keep the spin, as Python does', () => {
+    const spun = Float64Array.from(data.spun);
+    const chooser = new OnCount('follower', 4, 1, 1, 0);
+    const keeps = new Array<boolean>(k).fill(false);
+    expect(chooser.keeps(spun, k, OUTPUT_SIZE, keeps), 'not spinning: no choice of the spin').toBe(false);
+    for (const [share, expected] of Object.entries(data.keeps)) {
+      const kept = Array.from({ length: k }, (_, i) => keepsSpin(spun, i * OUTPUT_SIZE, data.spin[0], Number(share)));
+      expect(kept, `keeps at ${share}`).toEqual(expected);
+      const spinner = new OnCount('follower', 4, 1, 1, Number(share));
+      spinner.spin = data.spin[0];
+      expect(spinner.keeps(spun, k, OUTPUT_SIZE, keeps)).toBe(true);
+      expect(keeps, `OnCount.keeps at ${share}`).toEqual(expected);
+    }
+    for (const [key, best] of Object.entries(data.bestKept)) {
+      const [margin, share] = key.split('/');
+      expect(nearestCount(data.footwork, data.turnBack, k, data.target[0], data.standing, Number(margin), 1, data.keeps[share]), key).toBe(best);
+    }
+    // where keeping the spin matters: the nearest going on (1) does not keep it, the first does;
+    // none keeps it (1.5): the footwork is left alone, the first standing one whose hips go on
+    expect(data.best['-9.0/1.0']).toBe(1);
+    expect(data.bestKept['-9.0/0.7']).toBe(0);
+    expect(data.bestKept['-9.0/1.5']).toBe(1);
   });
 });

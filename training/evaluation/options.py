@@ -53,6 +53,10 @@ def add_options(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--on-count-hips", type=float, default=None, metavar="W",
                     help="m/s added to the footwork's miss of a candidate whose hips turn back; 0: the hips left alone, "
                          "and a turn's step the network's own (default: the manifest's onCount.hips)")
+    ap.add_argument("--on-count-spin-keep", type=float, default=None, metavar="F",
+                    help="her spins on the count too, among the samples that keep the spin at F times her turn "
+                         "rate or faster; -1: her spins left to the network (default: the manifest's "
+                         "onCount.spinKeep, else -1)")
     ap.add_argument("--leader-guard", type=int, default=None, metavar="K",
                     help="the leader's upright guard with K samples (0: off; default: the manifest's "
                          "leaderGuard, acting at its margin)")
@@ -106,12 +110,16 @@ def resolve(args, manifest: dict) -> str | None:
         args.on_count_strength = float(on_count.get("strength", ON_COUNT_STRENGTH))
     if getattr(args, "on_count_hips", None) is None:
         args.on_count_hips = float(on_count.get("hips", ON_COUNT_HIPS))
+    if getattr(args, "on_count_spin_keep", None) is None:
+        args.on_count_spin_keep = float(on_count.get("spinKeep", -1.0))
     if args.on_count < 0 or args.on_count == 1:
         return f"--on-count {args.on_count}: 0 (off) or at least 2 samples to choose from"
     if not 0 <= args.on_count_strength <= 1:
         return f"--on-count-strength {args.on_count_strength:g}: 0 to 1"
     if not args.on_count_hips >= 0:
         return f"--on-count-hips {args.on_count_hips:g}: 0 (the hips left alone) or more m/s"
+    if not (args.on_count_spin_keep >= 0 or args.on_count_spin_keep == -1):
+        return f"--on-count-spin-keep {args.on_count_spin_keep:g}: -1 (her spins left to the network) or 0 or more"
     if args.on_count and not (args.guard or args.leader_guard):
         return "--on-count chooses inside the upright guards: it needs --guard or --leader-guard"
     if args.guard and not manifest.get("plausibility"):
@@ -158,8 +166,10 @@ def on_count_for(role: str, args) -> OnCount | None:
     samples = getattr(args, "on_count", 0) or 0
     if not samples:
         return None
+    keep = getattr(args, "on_count_spin_keep", -1.0)
     return OnCount(role, samples, getattr(args, "on_count_strength", ON_COUNT_STRENGTH),
-                   getattr(args, "on_count_hips", ON_COUNT_HIPS))
+                   getattr(args, "on_count_hips", ON_COUNT_HIPS),
+                   spin_keep=keep if role == "follower" and keep is not None and keep >= 0 else None)
 
 
 def restart_count(policy) -> None:

@@ -88,6 +88,8 @@ export class DuetSimulation implements Simulation {
   private standing = new Float64Array(0);
   private footwork = new Float64Array(0);
   private turnBack: boolean[] = [];
+  /** Which of the chooser's samples keep her spin (on_count.ts OnCount.keeps), while she spins. */
+  private keeps: boolean[] = [];
   private readonly body = new Float64Array(3 * N_JOINTS);
   private readonly steps = new Float64Array(3 * STEPPED.length);
   /** The leader model's own variety (the manifest's); the slider sets the followers'. */
@@ -119,7 +121,7 @@ export class DuetSimulation implements Simulation {
     this.leaderGuard = lg && lg.samples >= 2 && manifest.plausibility ? { settings: lg, ranges: manifest.plausibility } : null;
     const oc = manifest.onCount && manifest.onCount.samples >= 2 ? manifest.onCount : null;
     this.leaderOnCount = oc && this.leaderGuard ? new OnCount('leader', oc.samples, oc.strength, oc.hips) : null;
-    this.followerOnCount = followers.map(() => (oc && this.uprightGuard ? new OnCount('follower', oc.samples, oc.strength, oc.hips) : null));
+    this.followerOnCount = followers.map(() => (oc && this.uprightGuard ? new OnCount('follower', oc.samples, oc.strength, oc.hips, oc.spinKeep ?? null) : null));
     this.duet = startDuet(manifest, followers.length);
     this.shownBeat = this.duet.beat;
     this.leaderView = new View(false);
@@ -274,6 +276,7 @@ export class DuetSimulation implements Simulation {
       this.standing = new Float64Array(k);
       this.footwork = new Float64Array(k);
       this.turnBack = new Array<boolean>(k).fill(false);
+      this.keeps = new Array<boolean>(k).fill(false);
     }
     for (let n = 0; n < k; n++) {
       this.standing[n] = uprightBody(output, n * OUTPUT_SIZE, ranges, offsets, slack, hipSlack, this.body);
@@ -281,7 +284,8 @@ export class DuetSimulation implements Simulation {
       this.footwork[n] = drawnFootwork(this.steps);
       this.turnBack[n] = hipsTurnBack(this.steps, input, onCount.role);
     }
-    return nearestCount(this.footwork, this.turnBack, k, target, this.standing, margin, onCount.hips);
+    const spinning = onCount.keeps(output, k, OUTPUT_SIZE, this.keeps);
+    return nearestCount(this.footwork, this.turnBack, k, target, this.standing, margin, onCount.hips, spinning ? this.keeps : null);
   }
 
   /** The leader's output of this step, under the same guard (mirror/guard.py's UprightGuard wraps

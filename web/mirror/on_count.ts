@@ -11,8 +11,11 @@
 // velocities the network writes beside them, which follow the drawn ankles only loosely. A sample
 // whose hips turn back the way they came has `hips` m/s added to its miss: the networks' own hips
 // turn back far more often than the recorded dancers'. While a dancer turns faster than TURNING (a
-// fast spin), its footwork is left to the network and only its hips are weighed. Every candidate is
-// the network's own reaction from the same state: nothing jumps, and nobody's input changes.
+// fast spin), its footwork is left to the network and only its hips are weighed, unless the dancer
+// keeps spins (her spinKeep): then her footwork is still aimed at the count, among the candidates
+// whose root turns on the same way at spinKeep times her turn rate or faster (keepsSpin), so the
+// pull cannot take the spin out of her. Every candidate is the network's own reaction from the same
+// state: nothing jumps, and nobody's input changes.
 
 import { FOLLOWER_INPUT_LAYOUT, KEY_STEP, KEYS, LEADER_INPUT_LAYOUT, OUTPUT_LAYOUT, POSE_SIZE, blockSlices } from './features';
 import { MUSIC_OFFSETS, MUSIC_SIZE } from './music';
@@ -28,13 +31,17 @@ export const TURNING: Readonly<Record<Role, number>> = { leader: 1.5, follower: 
 export const HIPS = 1.0;
 /** m a frame (6 cm/s): a shorter step of the hips stands still, and turns no way. */
 export const STILL = 0.002;
+/** Her spins on the count: a candidate keeps the spin at this share of her turn rate now. */
+export const SPIN_KEEP = 0.7;
 
-/** The manifest's "onCount": samples each step, how far the footwork aimed at swings (0-1), and
- *  what a candidate whose hips turn back adds to its miss (m/s; HIPS when absent). */
+/** The manifest's "onCount": samples each step, how far the footwork aimed at swings (0-1), what a
+ *  candidate whose hips turn back adds to its miss (m/s; HIPS when absent), and the share of her turn
+ *  rate a candidate keeps while she spins on the count (the follower's; absent: spins left alone). */
 export interface OnCountSettings {
   samples: number;
   strength: number;
   hips?: number;
+  spinKeep?: number;
 }
 
 export type Role = 'leader' | 'follower';
@@ -109,10 +116,22 @@ export function hipsTurnBack(steps: ArrayLike<number>, input: ArrayLike<number>,
   return steps[0] * bx + steps[1] * by + steps[2] * bz < 0 && Math.hypot(steps[0], steps[1], steps[2]) > STILL && Math.hypot(bx, by, bz) > STILL;
 }
 
-/** How fast the dancer turns now (rad/s, unsigned): its facing KEY_STEP frames ago, seen from its root now. */
-export function turnRate(input: ArrayLike<number>, role: Role): number {
+/** How fast and which way the dancer turns now (rad/s, signed as the output's root update turns): its
+ *  facing KEY_STEP frames ago, seen from its root now, lies the other way. */
+export function turnNow(input: ArrayLike<number>, role: Role): number {
   const c = LAST_FACING[role];
-  return (Math.abs(Math.atan2(input[c], input[c + 1])) * FPS) / KEY_STEP;
+  return (-Math.atan2(input[c], input[c + 1]) * FPS) / KEY_STEP;
+}
+
+/** How fast the dancer turns now (rad/s, unsigned): turnNow's size. */
+export function turnRate(input: ArrayLike<number>, role: Role): number {
+  return Math.abs(turnNow(input, role));
+}
+
+/** Whether output[at..] keeps a spin of `spin` rad/s (turnNow) going: its root update turns the same
+ *  way at `keep` times that rate or faster. */
+export function keepsSpin(output: ArrayLike<number>, at: number, spin: number, keep: number): boolean {
+  return output[at + ROOT_UPDATE_OUT + 2] * FPS * Math.sign(spin) >= keep * Math.abs(spin);
 }
 
 /** The count at the next step (beats, its fraction only) from the music block ending the input. */
@@ -122,26 +141,46 @@ export function countNext(input: ArrayLike<number>): number {
   return now + input[input.length - 1] / FPS;
 }
 
-/** One dancer's footwork mean, kept across steps, and the footwork its next step aims at. */
+/** One dancer's footwork mean, kept across steps, and the footwork its next step aims at.
+ *  `spinKeep` (null: spins left to the network): while the dancer turns faster than its TURNING, the
+ *  footwork is still aimed at, among the candidates that keep the spin. */
 export class OnCount {
   mean: number | null = null;
+  /** rad/s (turnNow) while this step's target is a spin's; null otherwise. */
+  spin: number | null = null;
 
   constructor(
     readonly role: Role,
     readonly samples: number = SAMPLES,
     readonly strength: number = STRENGTH,
     readonly hips: number = HIPS,
+    readonly spinKeep: number | null = null,
   ) {
     if (samples < 2) throw new Error('choosing on the count needs at least 2 samples');
+    if (spinKeep !== null && !(spinKeep >= 0)) throw new Error(`spinKeep must be 0 or more (a share of the turn rate), got ${spinKeep}`);
   }
 
   /** The footwork the next step aims at, for this step's input (it moves the mean on); null while
-   *  the dancer turns faster than its TURNING (its footwork is left to the network). */
+   *  the dancer turns faster than its TURNING (its footwork is left to the network), unless it keeps
+   *  spins (spinKeep): then `spin` holds the turn the candidates are to keep. */
   target(input: ArrayLike<number>): number | null {
     const now = footworkNow(input, this.role);
     this.mean = this.mean === null ? now : this.mean + (now - this.mean) / (MEAN_SECONDS * FPS);
-    if (turnRate(input, this.role) > TURNING[this.role]) return null;
+    const turn = turnNow(input, this.role);
+    this.spin = null;
+    if (Math.abs(turn) > TURNING[this.role]) {
+      if (this.spinKeep === null) return null;
+      this.spin = turn;
+    }
     return this.mean * (1 - this.strength * Math.cos(2 * Math.PI * countNext(input)));
+  }
+
+  /** While this step's target is a spin's, which of `count` candidates laid one after another in
+   *  `output` keep it (keepsSpin), written into `keeps`; false (every candidate may be taken) otherwise. */
+  keeps(output: ArrayLike<number>, count: number, size: number, keeps: boolean[]): boolean {
+    if (this.spin === null || this.spinKeep === null) return false;
+    for (let i = 0; i < count; i++) keeps[i] = keepsSpin(output, i * size, this.spin, this.spinKeep);
+    return true;
   }
 }
 
@@ -149,16 +188,23 @@ export class OnCount {
  * The index of the candidate (of `count`) whose drawn footwork (m/s) is nearest the target, `hips`
  * m/s added to the miss of each whose hips turn back (hipsTurnBack), among those standing (their
  * upright margins, guard.ts) at least `margin` inside the range; -1 when none does. With no target
- * (the dancer turns) the footwork is left alone: the first standing one whose hips go on.
+ * (the dancer turns) the footwork is left alone: the first standing one whose hips go on. With
+ * `keeps` (OnCount.keeps: the dancer spins), only the standing ones that keep the spin are aimed;
+ * when none of them does, the footwork is left alone as without a target.
  */
 export function nearestCount(
   footwork: ArrayLike<number>, turnBack: ArrayLike<boolean>, count: number, target: number | null, standing: ArrayLike<number>,
-  margin: number, hips = HIPS,
+  margin: number, hips = HIPS, keeps: ArrayLike<boolean> | null = null,
 ): number {
+  let only = false;
+  if (keeps !== null) {
+    for (let i = 0; i < count; i++) if (standing[i] >= margin && keeps[i]) only = true;
+    if (!only) target = null;
+  }
   let best = -1;
   let bestMiss = Infinity;
   for (let i = 0; i < count; i++) {
-    if (!(standing[i] >= margin)) continue;
+    if (!(standing[i] >= margin) || (only && !keeps![i])) continue;
     const miss = (target === null ? 0 : Math.abs(footwork[i] - target)) + (turnBack[i] ? hips : 0);
     if (miss < bestMiss) {
       best = i;
