@@ -44,6 +44,22 @@ def test_short_soak_of_the_shipped_models_passes(tmp_path, capsys):
     assert "summary: 0 of 2 rollouts failed" in capsys.readouterr().out
 
 
+@pytest.mark.skipif(not (MODELS / "manifest.json").exists(), reason="no shipped models")
+def test_each_rollout_dances_as_its_seed_alone_does(tmp_path, capsys):
+    """Rollout 1 of a soak from seed 0 is the rollout of a soak from seed 1: nothing of the rollout
+    before carries over (the leader's chooser on the count forgot its footwork too), so a soak's
+    fall can be danced again from its seed."""
+    both, alone = tmp_path / "both.json", tmp_path / "alone.json"
+    args = ["--models", str(MODELS), "--minutes", "0.3"]
+    soak.main([*args, "--rollouts", "2", "--seed", "0", "--out", str(both)])
+    soak.main([*args, "--rollouts", "1", "--seed", "1", "--out", str(alone)])
+    capsys.readouterr()
+    second, first = (json.loads(p.read_text())["rollouts"] for p in (both, alone))
+    assert second[1]["seed"] == first[0]["seed"] == 1
+    for key in ("max_distance", "guarded", "rhythm"):
+        assert second[1][key] == first[0][key], key
+
+
 def test_soak_out_may_name_a_folder_and_a_missing_one_is_refused_first(tmp_path, capsys):
     """--out DIR writes DIR/soak.json; --out in a folder that does not exist is refused before
     any dancing, not after an hour of it."""
