@@ -267,3 +267,18 @@ def test_options_give_her_the_manifests_spin_keep_and_him_none():
     assert O.resolve(args, {**m, "onCount": {"samples": 8, "strength": 1.0}}) is None
     assert O.follower_policy(policy_stub, m | {"onCount": {"samples": 8, "strength": 1.0}}, args, 0.5).on_count.spin_keep is None
     assert "--on-count-spin-keep" in O.resolve(parse("--on-count-spin-keep", "-0.5"), m)
+
+
+def test_every_option_reaches_the_seeds_workers():
+    """seeds builds its dancers in worker processes from a dict of the resolved options: it takes
+    every option add_options adds, so a new one (as --on-count-spin-keep was) cannot be left out."""
+    names = O.option_names()
+    assert {"on_count_spin_keep", "on_count_hips", "guard_hip_drop", "leader_guard", "tempo"} <= set(names)
+    args = parse("--on-count-spin-keep", "0.5")
+    m = {"defaultTemperature": 1.0, "leaderTemperature": 0.5, "plausibility": RANGES,
+         "skeleton": {"offsets": {"follower": OFFSETS.tolist(), "leader": OFFSETS.tolist()}},
+         "guard": {"samples": 32, "margin": 0.05}, "leaderGuard": {"samples": 8, "margin": 0.07},
+         "onCount": {"samples": 8, "strength": 1.0}}
+    assert O.resolve(args, m) is None
+    again = argparse.Namespace(**{k: getattr(args, k) for k in names})   # what a worker gets
+    assert O.follower_policy(policy_stub, m, again, 0.5).on_count.spin_keep == 0.5

@@ -161,6 +161,14 @@ def leader_policy(policy, manifest: dict, args):
     return policy
 
 
+def option_names() -> list[str]:
+    """The attribute names of every option add_options adds (what a worker process needs of args to
+    build the dancers as the parent does)."""
+    ap = argparse.ArgumentParser()
+    add_options(ap)
+    return [a.dest for a in ap._actions if a.dest != "help"]
+
+
 def on_count_for(role: str, args) -> OnCount | None:
     """A dancer's chooser on the count as the options ask (None: off)."""
     samples = getattr(args, "on_count", 0) or 0

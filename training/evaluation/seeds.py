@@ -114,9 +114,7 @@ def _one(job: tuple[int, int, float, float]) -> dict:
 def run_method(args, method: str, r: dict, test: list[str], bar, r_rhythm: dict) -> dict:
     frames = int(args.seconds * FPS)
     jobs = [(seed, frames, args.temperature, args.tempo) for seed in range(args.first_seed, args.first_seed + args.seeds)]
-    options = {k: getattr(args, k) for k in ("temperature", "follower_temperature", "guard", "guard_margin",
-                                             "guard_hip_margin", "guard_partner_low", "guard_partner_low_hip_margin",
-                                             "leader_guard", "on_count", "on_count_strength", "on_count_hips")}
+    options = {k: getattr(args, k) for k in O.option_names()}   # every option, as resolved here
     init = (args.models, method, args.data, test, r, options)
 
     def counted(results):
@@ -188,7 +186,8 @@ def run(args) -> dict:
                      "guard_partner_low": args.guard_partner_low,
                      "guard_partner_low_hip_margin": args.guard_partner_low_hip_margin,
                      "on_count": args.on_count, "on_count_strength": args.on_count_strength,
-                     "on_count_hips": args.on_count_hips, "wall_seconds": time.time() - t0}
+                     "on_count_hips": args.on_count_hips, "on_count_spin_keep": args.on_count_spin_keep,
+                     "wall_seconds": time.time() - t0}
     return res
 
 
