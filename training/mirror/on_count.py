@@ -36,11 +36,13 @@ Her spins are danced on the count all the same, as the recorded follower's are: 
 spinning dancer's footwork is chosen on the count among the samples that keep the spin going (their
 root turns the same way at SPIN_KEEP times her turn rate now or faster; keeps_spin), so the pull
 can no longer take the spin out of her. Only when none of the standing samples keeps it is the
-footwork left alone as above. Her pulse went from 0.74x / 0.77x the recording's (steered / nobody
-steering) to 0.87x / 0.85x, her turns stayed 0.72x (shipped 0.73x) and the requests she follows
-went from 55 % to 55 % asked, 43 % to 38 % unasked (`rhythm --seeds 20 --seconds 20 --tempos 170`,
-`lead --seeds 20`; SPIN_KEEP 0.5: pulse 0.89x / 0.94x but her spins slower, spin frames 0.53x, and
-48 % of requests; 0.8: 0.84x / 0.79x; 0.95: 0.72x / 0.79x). His walks round stay his network's.
+footwork left alone as above. Over 100 steered seeds x 60 s (`seeds --methods ours`) her pulse is
+0.83x the recording's, 0.71x with her spins left alone (SPIN_KEEP None); her turns 0.71x steered
+and 0.75x nobody steering, and she turns after 58 % of requests, 44 % of the same moments unasked
+(`lead --seeds 100 --seconds 30`). Over 20 seeds x 20 s (`rhythm --tempos 170`) other shares gave:
+0.5, pulse 0.89x / 0.94x (steered / nobody steering) but her spins slower (spin frames 0.53x) and
+48 % of requests; 0.7, 0.86x / 0.85x; 0.8, 0.84x / 0.79x; 0.95, 0.72x / 0.79x (none: 0.74x /
+0.77x). His walks round stay his network's.
 """
 from __future__ import annotations
 
