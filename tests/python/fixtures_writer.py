@@ -458,7 +458,21 @@ def on_count_cases(rng: np.random.Generator, outputs: np.ndarray, ranges: dict, 
     spun[:, feat.block_slices(feat.OUTPUT_LAYOUT)["root_update"].start + 2] = np.array([-3.2, -1.6, 3.2, -2.9]) / FPS
     spin = -3.2
     keeps = {f"{k}": OC.keeps_spin(spun, spin, k).tolist() for k in (0.0, 0.7, 1.5)}
+    # Her turn starts: the same bodies, their planned paths turning 300 degrees to her left (the
+    # first), 90 (the second), 200 to her right (the third) and not at all (the fourth): from 180
+    # degrees the first and third start a turn, from 60 all but the fourth, from 400 none.
+    turned = outputs.copy()
+    future = feat.block_slices(feat.OUTPUT_LAYOUT)["trajectory_future"]
+    for i, degrees in enumerate((300.0, 90.0, -200.0, 0.0)):
+        keys = turned[i, future].reshape(feat.KEYS, 4)
+        h = np.radians(degrees) * np.arange(1, feat.KEYS + 1) / feat.KEYS
+        keys[:, 2], keys[:, 3] = 0.8 * np.sin(h), 0.8 * np.cos(h)
+        turned[i, future] = keys.ravel()
+    starts = {f"{d}": OC.starts_turn(turned, d).tolist() for d in (60.0, 180.0, 400.0)}
     return {"roles": cases, "spinner": spins, "outputs": exact(outputs), "input": exact(x), "spun": exact(spun),
+            "turned": exact(turned), "plannedTurn": out7(OC.planned_turn(turned)), "starts": starts,
+            "bestPreferred": {f"{m}/{d}": OC.nearest_count(footwork, back, target, standing, m, 1.0, None, np.array(starts[f"{d}"]))
+                              for m in (-9.0, 0.0, 0.05, 9.0) for d in (60.0, 180.0, 400.0)},
             "steps": out7(steps.reshape(len(outputs), -1)),
             "footwork": out7(footwork), "turnBack": back.tolist(), "standing": out7(standing), "target": out7(target),
             "best": {f"{m}/{h}": OC.nearest_count(footwork, back, target, standing, m, h)

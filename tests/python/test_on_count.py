@@ -252,21 +252,29 @@ def test_her_spin_steps_on_the_count_among_the_samples_that_keep_it():
         OC.OnCount("follower", spin_keep=-0.5)
 
 
-def test_options_give_her_the_manifests_spin_keep_and_him_none():
+@pytest.mark.parametrize("key, option, attr, value, off, bad", [
+    ("spinKeep", "--on-count-spin-keep", "spin_keep", 0.7, "-1", "-0.5"),
+    ("turnStart", "--on-count-turn-start", "turn_start", 180.0, "-1", "0"),
+])
+def test_options_give_her_the_manifests_choices_and_him_none(key, option, attr, value, off, bad):
+    """The manifest's onCount.spinKeep and .turnStart reach her chooser, never his; -1 turns each
+    off; a manifest without the key leaves it off, as the page does."""
     m = {"defaultTemperature": 1.0, "leaderTemperature": 0.5, "plausibility": RANGES,
          "skeleton": {"offsets": {"follower": OFFSETS.tolist(), "leader": OFFSETS.tolist()}},
          "guard": {"samples": 32, "margin": 0.05}, "leaderGuard": {"samples": 8, "margin": 0.07},
-         "onCount": {"samples": 8, "strength": 1.0, "hips": 1.0, "spinKeep": 0.7}}
+         "onCount": {"samples": 8, "strength": 1.0, "hips": 1.0, key: value}}
+    dest = "on_count_" + attr
     args = parse()
-    assert O.resolve(args, m) is None and args.on_count_spin_keep == 0.7
-    assert O.follower_policy(policy_stub, m, args, 0.5).on_count.spin_keep == 0.7
-    assert O.leader_policy(policy_stub, m, args).on_count.spin_keep is None
-    args = parse("--on-count-spin-keep", "-1")
-    assert O.resolve(args, m) is None and O.follower_policy(policy_stub, m, args, 0.5).on_count.spin_keep is None
-    args = parse()   # a manifest without spinKeep: her spins left to the network, as the page does
-    assert O.resolve(args, {**m, "onCount": {"samples": 8, "strength": 1.0}}) is None
-    assert O.follower_policy(policy_stub, m | {"onCount": {"samples": 8, "strength": 1.0}}, args, 0.5).on_count.spin_keep is None
-    assert "--on-count-spin-keep" in O.resolve(parse("--on-count-spin-keep", "-0.5"), m)
+    assert O.resolve(args, m) is None and getattr(args, dest) == value
+    assert getattr(O.follower_policy(policy_stub, m, args, 0.5).on_count, attr) == value
+    assert getattr(O.leader_policy(policy_stub, m, args).on_count, attr) is None
+    args = parse(option, off)
+    assert O.resolve(args, m) is None and getattr(O.follower_policy(policy_stub, m, args, 0.5).on_count, attr) is None
+    without = m | {"onCount": {"samples": 8, "strength": 1.0}}
+    args = parse()
+    assert O.resolve(args, without) is None and getattr(args, dest) == -1
+    assert getattr(O.follower_policy(policy_stub, without, args, 0.5).on_count, attr) is None
+    assert option in O.resolve(parse(option, bad), m)
 
 
 def test_every_option_reaches_the_seeds_workers():
@@ -282,3 +290,50 @@ def test_every_option_reaches_the_seeds_workers():
     assert O.resolve(args, m) is None
     again = argparse.Namespace(**{k: getattr(args, k) for k in names})   # what a worker gets
     assert O.follower_policy(policy_stub, m, again, 0.5).on_count.spin_keep == 0.5
+
+
+def turning_output(footwork: float, degrees: float, hip: float = 1.0) -> np.ndarray:
+    """output(footwork), its planned path turning `degrees` evenly over the next second."""
+    out = output(footwork, hip)
+    h = np.radians(degrees) * np.arange(1, feat.KEYS + 1) / feat.KEYS
+    keys = out[FUTURE].reshape(feat.KEYS, 4)
+    keys[:, 2], keys[:, 3] = np.sin(h), np.cos(h)
+    out[FUTURE] = keys.ravel()
+    return out
+
+
+FUTURE = feat.block_slices(feat.OUTPUT_LAYOUT)["trajectory_future"]
+
+
+def test_outside_a_spin_she_takes_the_turn_start_her_samples_offer():
+    """With turn_start, outside a spin the standing samples whose planned path turns turn_start
+    degrees or more (either way, a whole turn counted whole) are aimed at the count before the
+    others; none standing that starts one: the choice is the one without it. In a spin the spin's
+    own choice holds; without turn_start nothing is preferred."""
+    outs = np.stack([turning_output(2.0, 0.0), turning_output(0.3, 300.0), turning_output(1.9, -200.0),
+                     turning_output(2.0, 90.0)])
+    assert OC.planned_turn(outs) == pytest.approx([0.0, 300.0, -200.0, 90.0])
+    assert OC.starts_turn(outs, 180.0).tolist() == [False, True, True, False]
+    x = input_at("follower", 0.5 - 2.9 / FPS, 0.5)   # between the beats: her target is 2x her mean of 1 m/s
+    chooser = OC.OnCount("follower", samples=4, turn_start=180.0)
+    assert chooser.target(x) == pytest.approx(2.0) and not chooser.turning
+    assert chooser.prefers(outs).tolist() == [False, True, True, False]
+
+    def policy(xx, temperature, rng):
+        n = len(np.atleast_2d(xx))
+        return {"output": np.stack([outs[i % 4] for i in range(n)]), "code": np.arange(n)[:, None]}
+
+    guard = UprightGuard(policy, RANGES, samples=4, margin=0.05, offsets=OFFSETS, on_count=chooser)
+    assert guard(x, 1.0, np.random.default_rng(0))["code"][0, 0] == 2      # the turn start nearest the count
+    plain = UprightGuard(policy, RANGES, samples=4, margin=0.05, offsets=OFFSETS, on_count=OC.OnCount("follower", 4))
+    assert plain(x, 1.0, np.random.default_rng(0))["code"][0, 0] == 0      # without it: the nearest
+    outs[1] = turning_output(0.3, 300.0, hip=0.4)
+    outs[2] = turning_output(1.9, -200.0, hip=0.4)                          # the turn starts fall: none preferred
+    assert guard(x, 1.0, np.random.default_rng(0))["code"][0, 0] == 0
+    c = OC.LAST_FACING["follower"]
+    x[c:c + 2] = np.sin(1.2), np.cos(1.2)                                     # spinning
+    chooser.target(x)
+    assert chooser.turning and chooser.prefers(outs) is None
+    assert OC.OnCount("follower", 4).prefers(outs) is None
+    with pytest.raises(ValueError, match="turn_start"):
+        OC.OnCount("follower", turn_start=0.0)

@@ -6,7 +6,7 @@
 import { describe, expect, it } from 'vitest';
 import { OUTPUT_SIZE } from '../../web/mirror/features';
 import { uprightBody } from '../../web/mirror/guard';
-import { OnCount, TURNING, countNext, drawnFootwork, drawnSteps, footworkNow, hipsTurnBack, keepsSpin, nearestCount, turnNow, turnRate } from '../../web/mirror/on_count';
+import { OnCount, TURNING, countNext, drawnFootwork, drawnSteps, footworkNow, hipsTurnBack, keepsSpin, nearestCount, plannedTurn, startsTurn, turnNow, turnRate } from '../../web/mirror/on_count';
 import { expectClose, fixture } from './fixture';
 
 const data = fixture('rollout').onCount;
@@ -109,5 +109,30 @@ describe('nearestCount', () => {
     expect(data.best['-9.0/1.0']).toBe(1);
     expect(data.bestKept['-9.0/0.7']).toBe(0);
     expect(data.bestKept['-9.0/1.5']).toBe(1);
+  });
+
+  it('outside a spin, prefers the standing samples that start a turn, as Python does', () => {
+    const turned = Float64Array.from(data.turned);
+    for (let i = 0; i < k; i++) expect(plannedTurn(turned, i * OUTPUT_SIZE)).toBeCloseTo(data.plannedTurn[i], 4);
+    const prefers = new Array<boolean>(k).fill(false);
+    expect(new OnCount('follower', 4).prefers(turned, k, OUTPUT_SIZE, prefers), 'without turnStart: none preferred').toBe(false);
+    for (const [degrees, expected] of Object.entries(data.starts)) {
+      const started = Array.from({ length: k }, (_, i) => startsTurn(turned, i * OUTPUT_SIZE, Number(degrees)));
+      expect(started, `starts from ${degrees}`).toEqual(expected);
+      const starter = new OnCount('follower', 4, 1, 1, 0.7, Number(degrees));
+      expect(starter.prefers(turned, k, OUTPUT_SIZE, prefers)).toBe(true);
+      expect(prefers, `OnCount.prefers from ${degrees}`).toEqual(expected);
+      starter.turning = true;   // in a spin the spin's own choice holds (keeps)
+      expect(starter.prefers(turned, k, OUTPUT_SIZE, prefers)).toBe(false);
+    }
+    for (const [key, best] of Object.entries(data.bestPreferred)) {
+      const [margin, degrees] = key.split('/');
+      expect(nearestCount(data.footwork, data.turnBack, k, data.target[0], data.standing, Number(margin), 1, null, data.starts[degrees]), key).toBe(best);
+    }
+    // where it matters: the nearest going on (1) starts no turn at 180, the first does; from 400
+    // none does, and the choice is the one without a preference
+    expect(data.bestPreferred['-9.0/180.0']).toBe(0);
+    expect(data.bestPreferred['-9.0/400.0']).toBe(data.best['-9.0/1.0']);
+    expect(() => new OnCount('follower', 8, 1, 1, null, 0)).toThrow(/turnStart/);
   });
 });

@@ -219,6 +219,12 @@ describe('createSimulation', () => {
     expect(choosers.followerOnCount[0].spinKeep).toBe(0.7);
     expect(choosers.leaderOnCount.spinKeep).toBeNull();
     expect((sim as unknown as typeof choosers).followerOnCount[0].spinKeep).toBeNull(); // absent: left to her network
+    // Her turn starts are preferred outside a spin with the manifest's turnStart; his never.
+    const starting = simulation([{ role: 'follower' }], { role: 'leader' }, { ...counted, onCount: { samples: 3, strength: 1, turnStart: 120 } });
+    const starters = starting.sim as unknown as { followerOnCount: { turnStart: number | null }[]; leaderOnCount: { turnStart: number | null } };
+    expect(starters.followerOnCount[0].turnStart).toBe(120);
+    expect(starters.leaderOnCount.turnStart).toBeNull();
+    expect((sim as unknown as typeof starters).followerOnCount[0].turnStart).toBeNull(); // absent: none preferred
     // Without onCount each takes its one sample, as before.
     const plain = simulation([{ role: 'follower' }], { role: 'leader' }, { ...counted, onCount: undefined });
     await plain.sim.step(steer, 1);

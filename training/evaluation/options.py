@@ -57,6 +57,10 @@ def add_options(ap: argparse.ArgumentParser) -> None:
                     help="her spins on the count too, among the samples that keep the spin at F times her turn "
                          "rate or faster; -1: her spins left to the network (default: the manifest's "
                          "onCount.spinKeep, else -1)")
+    ap.add_argument("--on-count-turn-start", type=float, default=None, metavar="DEG",
+                    help="outside a spin, her choice on the count prefers the samples whose planned path turns "
+                         "DEG degrees or more over the next second, when any stands; -1: none preferred "
+                         "(default: the manifest's onCount.turnStart, else -1)")
     ap.add_argument("--leader-guard", type=int, default=None, metavar="K",
                     help="the leader's upright guard with K samples (0: off; default: the manifest's "
                          "leaderGuard, acting at its margin)")
@@ -112,6 +116,10 @@ def resolve(args, manifest: dict) -> str | None:
         args.on_count_hips = float(on_count.get("hips", ON_COUNT_HIPS))
     if getattr(args, "on_count_spin_keep", None) is None:
         args.on_count_spin_keep = float(on_count.get("spinKeep", -1.0))
+    if getattr(args, "on_count_turn_start", None) is None:
+        args.on_count_turn_start = float(on_count.get("turnStart", -1.0))
+    if not (args.on_count_turn_start > 0 or args.on_count_turn_start == -1):
+        return f"--on-count-turn-start {args.on_count_turn_start:g}: -1 (none preferred) or more than 0 degrees"
     if args.on_count < 0 or args.on_count == 1:
         return f"--on-count {args.on_count}: 0 (off) or at least 2 samples to choose from"
     if not 0 <= args.on_count_strength <= 1:
@@ -175,9 +183,12 @@ def on_count_for(role: str, args) -> OnCount | None:
     if not samples:
         return None
     keep = getattr(args, "on_count_spin_keep", -1.0)
+    start = getattr(args, "on_count_turn_start", -1.0)
+    her = role == "follower"
     return OnCount(role, samples, getattr(args, "on_count_strength", ON_COUNT_STRENGTH),
                    getattr(args, "on_count_hips", ON_COUNT_HIPS),
-                   spin_keep=keep if role == "follower" and keep is not None and keep >= 0 else None)
+                   spin_keep=keep if her and keep is not None and keep >= 0 else None,
+                   turn_start=start if her and start is not None and start > 0 else None)
 
 
 def restart_count(policy) -> None:

@@ -187,6 +187,7 @@ def run(args) -> dict:
                      "guard_partner_low_hip_margin": args.guard_partner_low_hip_margin,
                      "on_count": args.on_count, "on_count_strength": args.on_count_strength,
                      "on_count_hips": args.on_count_hips, "on_count_spin_keep": args.on_count_spin_keep,
+                     "on_count_turn_start": args.on_count_turn_start,
                      "wall_seconds": time.time() - t0}
     return res
 

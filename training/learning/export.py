@@ -193,10 +193,13 @@ def write_manifest(out: Path, models: dict[str, StepModel], data: str, prepared:
                         **({} if LEADER_HEAD_MARGIN is None else {"headMargin": LEADER_HEAD_MARGIN}),
                         **({} if LEADER_HIP_MARGIN is None else {"hipMargin": LEADER_HIP_MARGIN}),
                         **({"keepPlan": True} if LEADER_KEEP_PLAN else {})},
-        # Both guards choose, every step, the sample whose footwork follows the count, her spins
-        # among the samples that keep them (training/mirror/on_count.py, web/mirror/on_count.ts).
+        # Both guards choose, every step, the sample whose footwork follows the count
+        # (training/mirror/on_count.py, web/mirror/on_count.ts); with SPIN_KEEP her spins among the
+        # samples that keep them, with TURN_START_DEGREES her steps outside a spin among the
+        # samples that start a turn when any does (both measured, not shipped: None).
         "onCount": {"samples": on_count.SAMPLES, "strength": on_count.STRENGTH, "hips": on_count.HIPS,
-                    "spinKeep": on_count.SPIN_KEEP},
+                    **({} if on_count.SPIN_KEEP is None else {"spinKeep": on_count.SPIN_KEEP}),
+                    **({} if on_count.TURN_START_DEGREES is None else {"turnStart": on_count.TURN_START_DEGREES})},
         # The training dancers' range (evaluation.plausibility): soak counts a collapse against it
         # and training.evaluation.seeds judges every steered frame against it.
         "plausibility": plausibility_ranges(prepared),

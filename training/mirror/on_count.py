@@ -32,17 +32,24 @@ count, and the pull on it broke her turns off (15.0 turns a minute, 0.65x the re
 against 16.5 with her spins left alone; 10 seeds of `seeds`); his walks round went from 9.6 to 4.6
 a minute, nobody steering, with his feet pulled from 3 rad/s (50 seeds of `lead`).
 
-Her spins are danced on the count all the same, as the recorded follower's are: with a SPIN_KEEP, a
-spinning dancer's footwork is chosen on the count among the samples that keep the spin going (their
-root turns the same way at SPIN_KEEP times her turn rate now or faster; keeps_spin), so the pull
-can no longer take the spin out of her. Only when none of the standing samples keeps it is the
-footwork left alone as above. Over 100 steered seeds x 60 s (`seeds --methods ours`) her pulse is
-0.83x the recording's, 0.71x with her spins left alone (SPIN_KEEP None); her turns 0.71x steered
-and 0.75x nobody steering, and she turns after 58 % of requests, 44 % of the same moments unasked
-(`lead --seeds 100 --seconds 30`). Over 20 seeds x 20 s (`rhythm --tempos 170`) other shares gave:
-0.5, pulse 0.89x / 0.94x (steered / nobody steering) but her spins slower (spin frames 0.53x) and
-48 % of requests; 0.7, 0.86x / 0.85x; 0.8, 0.84x / 0.79x; 0.95, 0.72x / 0.79x (none: 0.74x /
-0.77x). His walks round stay his network's.
+Two more choices, measured and not shipped (the manifest carries neither; docs/music.md):
+
+- With a SPIN_KEEP, a spinning dancer's footwork is chosen on the count among the samples that keep
+  the spin going (their root turns the same way at SPIN_KEEP times her turn rate now or faster;
+  keeps_spin), so the pull cannot take the spin out of her; only when none of the standing samples
+  keeps it is the footwork left alone as above. At 0.7, over 100 steered seeds x 60 s (`seeds
+  --methods ours --on-count-spin-keep 0.7`) her pulse is 0.83x the recording's, 0.71x with her
+  spins left alone, her turns and requests as they are; but the full soak lost 1 of 100 rollouts
+  with it (rollout 20, a fall beside his lunge outside any spin) and none without. Over 20 seeds x
+  20 s (`rhythm --tempos 170`) other shares gave: 0.5, pulse 0.89x / 0.94x (steered / nobody
+  steering) but her spins slower (spin frames 0.53x) and 48 % of requests; 0.8, 0.84x / 0.79x;
+  0.95, 0.72x / 0.79x.
+- With a TURN_START_DEGREES, outside a spin the standing samples whose planned path turns that much
+  or more over the next second (starts_turn, either way) are aimed at the count before the others,
+  when any stands (OnCount.prefers). She takes the turns her samples offer: at 120 she turned after
+  63 % of 250 requests and 49 % of the same moments unasked (`lead --seeds 20` and `--seeds 30
+  --first-seed 20`, beside SPIN_KEEP 0.7 as then shipped; 53 % / 42 % without), but her pulse over 100 steered seeds x 60 s fell to
+  0.70x (0.83x with SPIN_KEEP alone). 60, 90 and 180 degrees did no better on the requests.
 """
 from __future__ import annotations
 
@@ -59,8 +66,14 @@ MEAN_SECONDS = 1.0    # how long the dancer's own footwork is averaged over (abo
 # round (1.5-3 rad/s), hers spins (6-9).
 TURNING = {"leader": 1.5, "follower": 6.0}
 HIPS = 1.0            # m/s added to the footwork's miss of a candidate whose hips turn back
-SPIN_KEEP = 0.7       # her spins on the count: a candidate keeps the spin at this share of her turn rate now
+# Her spins on the count: a candidate keeps the spin at this share of her turn rate now. None: her
+# spins left to her network, as shipped; measured at 0.7 (`--on-count-spin-keep 0.7`, the docstring).
+SPIN_KEEP = None
 STILL = 0.002         # m a frame (6 cm/s): a shorter step of the hips stands still, and turns no way
+# Her turn starts taken when offered: outside a spin, a candidate whose planned path turns at least
+# this much (degrees) over the next second is preferred to the others (starts_turn). None: none
+# preferred, as shipped; measured at 120 (`--on-count-turn-start 120`, the module's docstring).
+TURN_START_DEGREES = None
 
 # Where each role's input holds its own ankles' velocity (pose block: position, velocity, forward,
 # up per joint; the step into this frame as drawn, so the footwork now and the drawn footwork of a
@@ -135,6 +148,24 @@ def keeps_spin(outputs: np.ndarray, spin: float, keep: float) -> np.ndarray:
     return turn * np.sign(spin) >= keep * abs(spin)
 
 
+_FUTURE_OUT = feat.block_slices(feat.OUTPUT_LAYOUT)["trajectory_future"]
+
+
+def planned_turn(outputs: np.ndarray) -> np.ndarray:
+    """How far each output's [B, 323] planned path turns over the next second (degrees, signed as
+    the root update turns): its facing at each future key (sin, cos), from 0 now, summed key to key
+    so that a whole turn counts whole."""
+    keys = np.atleast_2d(outputs)[:, _FUTURE_OUT].reshape(-1, feat.KEYS, 4)
+    h = np.concatenate([np.zeros((len(keys), 1)), np.arctan2(keys[..., 2], keys[..., 3])], 1)
+    return np.degrees(np.angle(np.exp(1j * np.diff(h, axis=1))).sum(1))
+
+
+def starts_turn(outputs: np.ndarray, degrees: float) -> np.ndarray:
+    """Whether each output [B, 323] starts a turn: its planned path turns `degrees` or more over
+    the next second, either way [B]."""
+    return np.abs(planned_turn(outputs)) >= degrees
+
+
 def count_next(x: np.ndarray) -> float:
     """The count at the next step (beats, its fraction only) from the music block ending input x."""
     music = x[len(x) - MUSIC_SIZE:]
@@ -148,7 +179,7 @@ class OnCount:
     than its TURNING, the footwork is still aimed at, among the candidates that keep the spin."""
 
     def __init__(self, role: str, samples: int = SAMPLES, strength: float = STRENGTH, hips: float = HIPS,
-                 spin_keep: float | None = None):
+                 spin_keep: float | None = None, turn_start: float | None = None):
         if role not in ANKLE_VELOCITY_IN:
             raise ValueError(f"role must be 'leader' or 'follower', got {role!r}")
         if samples < 2:
@@ -156,9 +187,12 @@ class OnCount:
         if spin_keep is not None and not spin_keep >= 0:
             raise ValueError(f"spin_keep must be 0 or more (a share of the turn rate), got {spin_keep}")
         self.role, self.samples, self.strength, self.hips = role, samples, strength, hips
-        self.spin_keep = spin_keep
+        if turn_start is not None and not turn_start > 0:
+            raise ValueError(f"turn_start must be more than 0 degrees, got {turn_start}")
+        self.spin_keep, self.turn_start = spin_keep, turn_start
         self.mean: float | None = None
         self.spin: float | None = None   # rad/s (turn_now) while this step's target is a spin's
+        self.turning = False             # this step the dancer turns faster than its TURNING
 
     def target(self, x: np.ndarray) -> float | None:
         """The footwork the next step aims at, for input x [I] (this step's: it moves the mean on);
@@ -169,7 +203,8 @@ class OnCount:
         self.mean = now if self.mean is None else self.mean + (now - self.mean) / (MEAN_SECONDS * FPS)
         turn = turn_now(x, self.role)
         self.spin = None
-        if abs(turn) > TURNING[self.role]:
+        self.turning = abs(turn) > TURNING[self.role]
+        if self.turning:
             if self.spin_keep is None:
                 return None
             self.spin = turn
@@ -180,15 +215,23 @@ class OnCount:
         None otherwise (every candidate may be taken)."""
         return None if self.spin is None else keeps_spin(outputs, self.spin, self.spin_keep)
 
+    def prefers(self, outputs: np.ndarray) -> np.ndarray | None:
+        """With turn_start, outside a turn: which candidates [B, 323] start one (starts_turn); None
+        otherwise (no candidate preferred)."""
+        return None if self.turn_start is None or self.turning else starts_turn(outputs, self.turn_start)
+
 
 def nearest_count(footwork: np.ndarray, turn_back: np.ndarray, target: float | None, standing: np.ndarray,
-                  margin: float, hips: float = HIPS, keeps: np.ndarray | None = None) -> int:
+                  margin: float, hips: float = HIPS, keeps: np.ndarray | None = None,
+                  prefers: np.ndarray | None = None) -> int:
     """The index of the candidate whose drawn footwork [B] (m/s) is nearest the target, `hips` m/s
     added to the miss of each whose hips turn back [B] (hips_turn_back), among those standing [B]
     (their upright margins, guard.py) at least `margin` inside the range; -1 when none does. With
     no target (the dancer turns) the footwork is left alone: the first standing one whose hips go on.
     With `keeps` [B] (OnCount.keeps: the dancer spins), only the standing ones that keep the spin
-    are aimed; when none of them does, the footwork is left alone as without a target."""
+    are aimed; when none of them does, the footwork is left alone as without a target. With
+    `prefers` [B] (OnCount.prefers: the candidates that start a turn), only the standing ones among
+    them are aimed when there are any; otherwise all the standing ones, as without it."""
     ok = np.asarray(standing) >= margin
     if not ok.any():
         return -1
@@ -197,5 +240,7 @@ def nearest_count(footwork: np.ndarray, turn_back: np.ndarray, target: float | N
             ok = ok & keeps
         else:
             target = None
+    if prefers is not None and (ok & prefers).any():
+        ok = ok & prefers
     miss = np.zeros(len(ok)) if target is None else np.abs(np.asarray(footwork) - target)
     return int(np.argmin(np.where(ok, miss + hips * np.asarray(turn_back), np.inf)))

@@ -90,6 +90,8 @@ export class DuetSimulation implements Simulation {
   private turnBack: boolean[] = [];
   /** Which of the chooser's samples keep her spin (on_count.ts OnCount.keeps), while she spins. */
   private keeps: boolean[] = [];
+  /** Which of them start a turn (OnCount.prefers), outside her spins. */
+  private prefers: boolean[] = [];
   private readonly body = new Float64Array(3 * N_JOINTS);
   private readonly steps = new Float64Array(3 * STEPPED.length);
   /** The leader model's own variety (the manifest's); the slider sets the followers'. */
@@ -121,7 +123,7 @@ export class DuetSimulation implements Simulation {
     this.leaderGuard = lg && lg.samples >= 2 && manifest.plausibility ? { settings: lg, ranges: manifest.plausibility } : null;
     const oc = manifest.onCount && manifest.onCount.samples >= 2 ? manifest.onCount : null;
     this.leaderOnCount = oc && this.leaderGuard ? new OnCount('leader', oc.samples, oc.strength, oc.hips) : null;
-    this.followerOnCount = followers.map(() => (oc && this.uprightGuard ? new OnCount('follower', oc.samples, oc.strength, oc.hips, oc.spinKeep ?? null) : null));
+    this.followerOnCount = followers.map(() => (oc && this.uprightGuard ? new OnCount('follower', oc.samples, oc.strength, oc.hips, oc.spinKeep ?? null, oc.turnStart ?? null) : null));
     this.duet = startDuet(manifest, followers.length);
     this.shownBeat = this.duet.beat;
     this.leaderView = new View(false);
@@ -277,6 +279,7 @@ export class DuetSimulation implements Simulation {
       this.footwork = new Float64Array(k);
       this.turnBack = new Array<boolean>(k).fill(false);
       this.keeps = new Array<boolean>(k).fill(false);
+      this.prefers = new Array<boolean>(k).fill(false);
     }
     for (let n = 0; n < k; n++) {
       this.standing[n] = uprightBody(output, n * OUTPUT_SIZE, ranges, offsets, slack, hipSlack, this.body);
@@ -285,7 +288,9 @@ export class DuetSimulation implements Simulation {
       this.turnBack[n] = hipsTurnBack(this.steps, input, onCount.role);
     }
     const spinning = onCount.keeps(output, k, OUTPUT_SIZE, this.keeps);
-    return nearestCount(this.footwork, this.turnBack, k, target, this.standing, margin, onCount.hips, spinning ? this.keeps : null);
+    const starting = onCount.prefers(output, k, OUTPUT_SIZE, this.prefers);
+    return nearestCount(this.footwork, this.turnBack, k, target, this.standing, margin, onCount.hips,
+      spinning ? this.keeps : null, starting ? this.prefers : null);
   }
 
   /** The leader's output of this step, under the same guard (mirror/guard.py's UprightGuard wraps

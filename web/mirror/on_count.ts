@@ -14,8 +14,10 @@
 // fast spin), its footwork is left to the network and only its hips are weighed, unless the dancer
 // keeps spins (her spinKeep): then her footwork is still aimed at the count, among the candidates
 // whose root turns on the same way at spinKeep times her turn rate or faster (keepsSpin), so the
-// pull cannot take the spin out of her. Every candidate is the network's own reaction from the same
-// state: nothing jumps, and nobody's input changes.
+// pull cannot take the spin out of her. With her turnStart, outside a spin the candidates that start
+// a turn (startsTurn) are aimed before the others when any stands. Both are measured and not shipped
+// (the manifest carries neither; on_count.py says why). Every candidate is the network's own
+// reaction from the same state: nothing jumps, and nobody's input changes.
 
 import { FOLLOWER_INPUT_LAYOUT, KEY_STEP, KEYS, LEADER_INPUT_LAYOUT, OUTPUT_LAYOUT, POSE_SIZE, blockSlices } from './features';
 import { MUSIC_OFFSETS, MUSIC_SIZE } from './music';
@@ -31,17 +33,25 @@ export const TURNING: Readonly<Record<Role, number>> = { leader: 1.5, follower: 
 export const HIPS = 1.0;
 /** m a frame (6 cm/s): a shorter step of the hips stands still, and turns no way. */
 export const STILL = 0.002;
-/** Her spins on the count: a candidate keeps the spin at this share of her turn rate now. */
-export const SPIN_KEEP = 0.7;
+/** Her spins on the count: a candidate keeps the spin at this share of her turn rate now. null: her
+ *  spins left to her network, as shipped (the manifest's onCount.spinKeep, when present, sets it). */
+export const SPIN_KEEP: number | null = null;
+/** Her turn starts taken when offered: outside a spin, a candidate whose planned path turns at least
+ *  this much (degrees) over the next second is preferred to the others (startsTurn). null: none
+ *  preferred, as shipped (the manifest's onCount.turnStart, when present, sets it). */
+export const TURN_START_DEGREES: number | null = null;
 
 /** The manifest's "onCount": samples each step, how far the footwork aimed at swings (0-1), what a
  *  candidate whose hips turn back adds to its miss (m/s; HIPS when absent), and the share of her turn
- *  rate a candidate keeps while she spins on the count (the follower's; absent: spins left alone). */
+ *  rate a candidate keeps while she spins on the count (the follower's; absent: spins left alone),
+ *  and how far (degrees) a candidate's planned path turns over the next second to be preferred as
+ *  a turn start outside a spin (the follower's; absent: none preferred). */
 export interface OnCountSettings {
   samples: number;
   strength: number;
   hips?: number;
   spinKeep?: number;
+  turnStart?: number;
 }
 
 export type Role = 'leader' | 'follower';
@@ -134,6 +144,29 @@ export function keepsSpin(output: ArrayLike<number>, at: number, spin: number, k
   return output[at + ROOT_UPDATE_OUT + 2] * FPS * Math.sign(spin) >= keep * Math.abs(spin);
 }
 
+const FUTURE_OUT = blockSlices(OUTPUT_LAYOUT).trajectory_future.start;
+
+/** How far output[at..]'s planned path turns over the next second (degrees, signed as the root update
+ *  turns): its facing at each future key (sin, cos), from 0 now, summed key to key so that a whole
+ *  turn counts whole. */
+export function plannedTurn(output: ArrayLike<number>, at: number): number {
+  let before = 0;
+  let sum = 0;
+  for (let k = 0; k < KEYS; k++) {
+    const c = at + FUTURE_OUT + 4 * k;
+    const h = Math.atan2(output[c + 2], output[c + 3]);
+    sum += Math.atan2(Math.sin(h - before), Math.cos(h - before));
+    before = h;
+  }
+  return (sum * 180) / Math.PI;
+}
+
+/** Whether output[at..] starts a turn: its planned path turns `degrees` or more over the next second,
+ *  either way. */
+export function startsTurn(output: ArrayLike<number>, at: number, degrees: number): boolean {
+  return Math.abs(plannedTurn(output, at)) >= degrees;
+}
+
 /** The count at the next step (beats, its fraction only) from the music block ending the input. */
 export function countNext(input: ArrayLike<number>): number {
   const music = input.length - MUSIC_SIZE;
@@ -148,6 +181,8 @@ export class OnCount {
   mean: number | null = null;
   /** rad/s (turnNow) while this step's target is a spin's; null otherwise. */
   spin: number | null = null;
+  /** This step the dancer turns faster than its TURNING. */
+  turning = false;
 
   constructor(
     readonly role: Role,
@@ -155,9 +190,11 @@ export class OnCount {
     readonly strength: number = STRENGTH,
     readonly hips: number = HIPS,
     readonly spinKeep: number | null = null,
+    readonly turnStart: number | null = null,
   ) {
     if (samples < 2) throw new Error('choosing on the count needs at least 2 samples');
     if (spinKeep !== null && !(spinKeep >= 0)) throw new Error(`spinKeep must be 0 or more (a share of the turn rate), got ${spinKeep}`);
+    if (turnStart !== null && !(turnStart > 0)) throw new Error(`turnStart must be more than 0 degrees, got ${turnStart}`);
   }
 
   /** The footwork the next step aims at, for this step's input (it moves the mean on); null while
@@ -168,7 +205,8 @@ export class OnCount {
     this.mean = this.mean === null ? now : this.mean + (now - this.mean) / (MEAN_SECONDS * FPS);
     const turn = turnNow(input, this.role);
     this.spin = null;
-    if (Math.abs(turn) > TURNING[this.role]) {
+    this.turning = Math.abs(turn) > TURNING[this.role];
+    if (this.turning) {
       if (this.spinKeep === null) return null;
       this.spin = turn;
     }
@@ -182,6 +220,14 @@ export class OnCount {
     for (let i = 0; i < count; i++) keeps[i] = keepsSpin(output, i * size, this.spin, this.spinKeep);
     return true;
   }
+
+  /** With turnStart, outside a turn: which of `count` candidates laid one after another in `output`
+   *  start one (startsTurn), written into `prefers`; false (no candidate preferred) otherwise. */
+  prefers(output: ArrayLike<number>, count: number, size: number, prefers: boolean[]): boolean {
+    if (this.turnStart === null || this.turning) return false;
+    for (let i = 0; i < count; i++) prefers[i] = startsTurn(output, i * size, this.turnStart);
+    return true;
+  }
 }
 
 /**
@@ -190,21 +236,27 @@ export class OnCount {
  * upright margins, guard.ts) at least `margin` inside the range; -1 when none does. With no target
  * (the dancer turns) the footwork is left alone: the first standing one whose hips go on. With
  * `keeps` (OnCount.keeps: the dancer spins), only the standing ones that keep the spin are aimed;
- * when none of them does, the footwork is left alone as without a target.
+ * when none of them does, the footwork is left alone as without a target. With `prefers`
+ * (OnCount.prefers: the candidates that start a turn), only the standing ones among them are aimed
+ * when there are any; otherwise all the standing ones, as without it.
  */
 export function nearestCount(
   footwork: ArrayLike<number>, turnBack: ArrayLike<boolean>, count: number, target: number | null, standing: ArrayLike<number>,
-  margin: number, hips = HIPS, keeps: ArrayLike<boolean> | null = null,
+  margin: number, hips = HIPS, keeps: ArrayLike<boolean> | null = null, prefers: ArrayLike<boolean> | null = null,
 ): number {
   let only = false;
   if (keeps !== null) {
     for (let i = 0; i < count; i++) if (standing[i] >= margin && keeps[i]) only = true;
     if (!only) target = null;
   }
+  let preferred = false;
+  if (prefers !== null) {
+    for (let i = 0; i < count; i++) if (standing[i] >= margin && (!only || keeps![i]) && prefers[i]) preferred = true;
+  }
   let best = -1;
   let bestMiss = Infinity;
   for (let i = 0; i < count; i++) {
-    if (!(standing[i] >= margin) || (only && !keeps![i])) continue;
+    if (!(standing[i] >= margin) || (only && !keeps![i]) || (preferred && !prefers![i])) continue;
     const miss = (target === null ? 0 : Math.abs(footwork[i] - target)) + (turnBack[i] ? hips : 0);
     if (miss < bestMiss) {
       best = i;
