@@ -48,8 +48,9 @@ Two more choices, measured and not shipped (the manifest carries neither; docs/m
   or more over the next second (starts_turn, either way) are aimed at the count before the others,
   when any stands (OnCount.prefers). She takes the turns her samples offer: at 120 she turned after
   63 % of 250 requests and 49 % of the same moments unasked (`lead --seeds 20` and `--seeds 30
-  --first-seed 20`, beside SPIN_KEEP 0.7 as then shipped; 53 % / 42 % without), but her pulse over 100 steered seeds x 60 s fell to
-  0.70x (0.83x with SPIN_KEEP alone). 60, 90 and 180 degrees did no better on the requests.
+  --first-seed 20`, beside SPIN_KEEP 0.7 as then shipped; 53 % / 42 % without), but her pulse
+  over 100 steered seeds x 60 s fell to 0.70x (0.83x with SPIN_KEEP alone). 60, 90 and 180
+  degrees did no better on the requests.
 """
 from __future__ import annotations
 
