@@ -24,6 +24,7 @@ import numpy as np
 from sklearn.linear_model import LogisticRegression
 
 from ..mirror import features as feat
+from ..mirror.on_count import planned_turn
 
 LEADER_COLUMNS = slice(0, feat.block_slices(feat.FOLLOWER_INPUT_LAYOUT)["partner_pose"].stop)
 SHARE = 0.5       # of the recorded turn starts, the ones most clearly led count as led
@@ -39,9 +40,8 @@ FIT_SAMPLES = 40_000   # the reader is fitted on at most this many samples (an e
 def start_direction(x_raw: np.ndarray, y_raw: np.ndarray) -> np.ndarray:
     """[N] int: 0 where no turn of hers starts (train.own_turn_onsets), 1 a start to her left
     (her heading grows), 2 to her right."""
-    from .train import key_heading_change, own_turn_onsets
-    so = feat.block_slices(feat.OUTPUT_LAYOUT)
-    future = key_heading_change(y_raw[:, so["trajectory_future"]].reshape(len(y_raw), feat.KEYS, 4), False)
+    from .train import own_turn_onsets   # train reads this module: imported when called
+    future = planned_turn(y_raw)
     onset = own_turn_onsets(x_raw, y_raw, "follower")
     return np.where(onset, np.where(future > 0, 1, 2), 0)
 

@@ -34,6 +34,7 @@ from ..evaluation.loss_plot import plot_history
 from .models import CodebookMatching, Discriminator, IntentionPredictor, ModelConfig, StepModel, code_logits, sample_codes
 from .own_rollouts import load_couples, own_rollout_samples
 from .lead_reader import LeadReader
+from ..mirror.on_count import planned_turn
 from ..data.prepared import (TrainError, load_mirror_flags, load_offsets, load_split, load_stats, normalize,
                              pose_error_cm, with_led_turn)
 from .runs import load_checkpoint, save_checkpoint
@@ -589,9 +590,9 @@ def own_turn_onsets(x_raw: np.ndarray, y_raw: np.ndarray, role: str) -> np.ndarr
     """Samples (raw input and output) -> bool [N]: the dancer's own turn starts here, read from
     the dancer's own path (the same thresholds as turn_onsets)."""
     layout = feat.LEADER_INPUT_LAYOUT if role == "leader" else feat.FOLLOWER_INPUT_LAYOUT
-    si, so = feat.block_slices(layout), feat.block_slices(feat.OUTPUT_LAYOUT)
+    si = feat.block_slices(layout)
     past = key_heading_change(x_raw[:, si["self_trajectory_past"]].reshape(len(x_raw), feat.KEYS, 4), True)
-    future = key_heading_change(y_raw[:, so["trajectory_future"]].reshape(len(y_raw), feat.KEYS, 4), False)
+    future = planned_turn(y_raw)
     return (np.abs(future) >= ONSET_FUTURE_DEGREES) & (np.abs(past) < ONSET_PAST_DEGREES)
 
 
