@@ -149,6 +149,19 @@ def test_fall_continuations_swap_in_another_network(capsys):
         fc.main(["3", "--models", str(MODELS), "--variants", "leader=missing.onnx"])
 
 
+def test_fall_continuations_set_the_choice_on_the_count():
+    """The choice on the count's options are variants too (her spins kept on the count, her turn
+    starts, its samples), each reaching only the dancer it belongs to; a bad value is refused."""
+    fc = _fall_continuations()
+    manifest = json.loads((MODELS / "manifest.json").read_text())
+    lead, follow, _ = fc.policies(manifest, None, None, "on_count_spin_keep=0.7+on_count_turn_start=120+on_count=4")
+    assert (follow.on_count.spin_keep, follow.on_count.turn_start, follow.on_count.samples) == (0.7, 120.0, 4)
+    assert (lead.on_count.spin_keep, lead.on_count.turn_start, lead.on_count.samples) == (None, None, 4)
+    assert "spinKeep" not in manifest.get("onCount", {})           # the manifest itself is untouched
+    with pytest.raises(SystemExit, match="on-count-turn-start 0"):
+        fc.policies(manifest, None, None, "on_count_turn_start=0")
+
+
 def test_fall_continuations_refuse_an_unknown_setting():
     fc = _fall_continuations()
     with pytest.raises(SystemExit, match="unknown setting 'guard_size'"):
