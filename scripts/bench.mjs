@@ -1,7 +1,7 @@
 // Browser benchmark of the shipped page: builds dist/, serves it with `vite preview` (COOP/COEP
 // on, so two WASM threads are possible) and loads it cold in headless Chromium, once per thread
 // count. Prints, per run: simulation step time (median/p95 over the last 300 steps: features +
-// both models + pose), cold load to the first dancing frame on screen, and the page weight (raw and
+// both models + pose) and the networks' part of it (onnxruntime's runs), cold load to the first dancing frame on screen, and the page weight (raw and
 // gzip) of everything the page downloaded to get there.
 //
 //   npm run bench                 # threads 1 and 2
@@ -9,6 +9,8 @@
 //   npm run bench -- --leading    # the same, T pressed every 2 s: every step leads her turn
 //   npm run bench -- --count-cost # each thread count also without the manifest's onCount, alternating:
 //                                 # what choosing on the count costs a step, as a ratio in one run
+//   npm run bench -- --viewport 320x240   # a smaller window: less software drawing beside the networks
+//   node scripts/bench_networks.mjs       # the networks alone, in Node, for the same runs
 //   npm run bench -- --phone      # a phone on a mobile network: see scripts/bench_phone.mjs
 //   npm run bench -- --phone --boot-only --query threads=1   # only the two visits, extra URL settings
 //
@@ -31,6 +33,15 @@ const leading = args.includes('--leading');
 // Both dancers choose each step among onCount.samples at once (web/mirror/on_count.ts): --count-cost
 // also runs the page with the manifest's onCount taken out, so the two step times share one machine state.
 const countCost = args.includes('--count-cost');
+// The page's window, WIDTHxHEIGHT (default: the harness's). On this machine WebGL is software
+// (SwiftShader), so the drawing shares the CPU with the networks: a small window draws less and
+// shows how much of the step the drawing costs them.
+const viewportOption = option('viewport', null);
+const viewport = viewportOption ? viewportOption.split('x').map(Number) : null;
+if (viewport && !(viewport.length === 2 && viewport.every((n) => Number.isInteger(n) && n >= 100))) {
+  console.error(`--viewport ${viewportOption}: WIDTHxHEIGHT in pixels, each at least 100`);
+  process.exit(2);
+}
 
 /** Waits `ms`, pressing T every 2 s when --leading. */
 async function dance(page, ms) {
@@ -44,7 +55,8 @@ async function dance(page, ms) {
 const mb = (bytes) => `${(bytes / 1e6).toFixed(2)} MB`;
 
 async function run(url, threads, withoutCount = false) {
-  const browser = await launch(); // fresh profile: a cold load, nothing cached
+  // A fresh profile: a cold load, nothing cached.
+  const browser = await launch(viewport ? { viewport: { width: viewport[0], height: viewport[1] } } : {});
   const { page } = browser;
   if (withoutCount) {
     // The manifest as shipped, less onCount: each dancer takes its one sample (the worker's fetch too).
@@ -103,6 +115,7 @@ async function run(url, threads, withoutCount = false) {
       counted: state.counted ?? 0,
       crossOriginIsolated: await page.evaluate(() => crossOriginIsolated),
       stepMs: state.stepMs,
+      networkMs: state.networkMs,
       stepsPerSecond: state.frame / seconds,
       fps,
       coldLoadMs: ready.firstFrameMs,
@@ -143,10 +156,11 @@ if (json) {
     const count = countCost ? (r.onCount ? `, on the count (${r.counted} dancer-steps chosen)` : ', without onCount') : '';
     console.log(`\nthreads ${r.threads} (asked ${r.requestedThreads}, cross-origin isolated: ${r.crossOriginIsolated})${leading ? ', T every 2 s' : ''}${count}`);
     console.log(`  step            median ${r.stepMs.median.toFixed(2)} ms   p95 ${r.stepMs.p95.toFixed(2)} ms`);
+    console.log(`  ... networks    median ${r.networkMs.median.toFixed(2)} ms   p95 ${r.networkMs.p95.toFixed(2)} ms (onnxruntime's runs in each step; the rest is the page's own work)`);
     console.log(`  cold load       ${(r.coldLoadMs / 1000).toFixed(2)} s to the first dancing frame on screen`);
     console.log(`  models          ${mb(r.modelBytes)}`);
     console.log(`  page weight     ${mb(r.pageBytes)} raw, ${mb(r.pageGzipBytes)} gzip (${mb(r.transferredBytes)} sent by vite preview)`);
-    console.log(`  display         ${r.fps.toFixed(1)} fps (software WebGL in headless Chromium)`);
+    console.log(`  display         ${r.fps.toFixed(1)} fps (software WebGL in headless Chromium${viewport ? `, a ${viewport.join('x')} window` : ''})`);
     if (r.consoleErrors.length) console.log(`  console errors: ${r.consoleErrors.join(' | ')}`);
   }
   if (countCost) {

@@ -64,6 +64,9 @@ describe('desktop', () => {
     assert.equal(state.error, null);
     assert.equal(state.model, 'ours');
     assert.ok(state.stepMs.median > 0, 'step time is measured');
+    // Its networks' part: every step runs both networks, and a step holds its runs (so, step by
+    // step, its median cannot pass the step's).
+    assert.ok(state.networkMs.median > 0 && state.networkMs.median <= state.stepMs.median, `networks ${state.networkMs.median} ms of a ${state.stepMs.median} ms step`);
     for (const key of ['leader', 'follower']) {
       assert.equal(state[key].root.length, 2);
       assert.ok(state[key].root.every(Number.isFinite) && Number.isFinite(state[key].heading), `${key} is finite`);

@@ -39,6 +39,8 @@ interface FakeOptions {
   /** Samples (0: run(); i: the i-th of a batch) whose body is tipped over: every joint's rotation
    *  turned 90 degrees about x, its decoded positions standing. */
   tipped?: number[];
+  /** Milliseconds each run or batch counts as the network's (networkMs: set, not timed). */
+  cost?: number;
 }
 
 /** A stand-in for Policy: "keep the current pose, move `step` forward", built from its own input. */
@@ -47,6 +49,8 @@ class FakePolicy implements StepPolicy {
   readonly result = { output: new Float32Array(OUTPUT_SIZE), intention: null as Float32Array | null };
   readonly entry = { intention: false };
   runs = 0;
+  /** What the page's Policy keeps: ms in the network's runs (here options.cost per run). */
+  networkMs = 0;
   private readonly size: number;
   /** The batch sizes asked for, in order. */
   readonly batchSizes: number[] = [];
@@ -67,6 +71,7 @@ class FakePolicy implements StepPolicy {
 
   async run(temperature: number) {
     this.runs++;
+    this.networkMs += this.options.cost ?? 0;
     this.temperatures.push(temperature);
     this.fill(this.input, 0, this.result.output, 0, 0);
     return this.result;
@@ -78,6 +83,7 @@ class FakePolicy implements StepPolicy {
   }
 
   async runBatch(k: number, temperature: number) {
+    this.networkMs += this.options.cost ?? 0;
     this.temperatures.push(temperature);
     this.batchSizes.push(k);
     const b = this.batches.get(k)!;
@@ -281,6 +287,24 @@ describe('createSimulation', () => {
     const ms = sim.stepMs();
     expect(ms.median).toBeGreaterThanOrEqual(0);
     expect(ms.p95).toBeGreaterThanOrEqual(ms.median);
+  });
+
+  it("parts each step's time out to the networks: every run of the step, not the ghosts' between steps", async () => {
+    const guarded = {
+      guard: { samples: 4, margin: 0.05 },
+      plausibility: { hip_low: 0.7, head_above_hip_low: 0.4, feet_wide: 1.07, angle_high: [2.5, 0.59] },
+    };
+    const { sim } = simulation([{ role: 'follower', cost: 0.5 }], { role: 'leader', cost: 0.25 });
+    expect(sim.networkMs().median).toBe(0);
+    for (let i = 0; i < 5; i++) {
+      await sim.step(steer, 0.5);
+      await sim.ghosts(2); // a batch of her network outside the step
+    }
+    expect(sim.networkMs()).toEqual({ median: 0.75, p95: 0.75 }); // his run and hers
+    // A tipping follower under the guard: her run, then the guard's batch, in the same step.
+    const tipping = simulation([{ role: 'follower', cost: 0.5, tipped: [0, 1] }], { role: 'leader', cost: 0.25 }, guarded);
+    await tipping.sim.step(steer, 1);
+    expect(tipping.sim.networkMs().median).toBe(1.25);
   });
 
   it('moves the drawn future and root with the model output', async () => {

@@ -33,6 +33,8 @@ export class Policy implements StepPolicy {
   readonly input: Float32Array;
   /** Filled by run(); the same object and arrays every call. */
   readonly result: PolicyResult;
+  /** Milliseconds spent in session runs since this policy was made (the step's network part). */
+  networkMs = 0;
 
   private readonly temperature = new Float32Array(1);
   private readonly temperatureTensor: Tensor;
@@ -90,7 +92,9 @@ export class Policy implements StepPolicy {
   private async runWith(batch: Batch, temperature: number): Promise<PolicyResult> {
     this.temperature[0] = temperature;
     fillUniform(batch.noise, this.uniform);
+    const started = performance.now();
     const outputs = await this.session.run(batch.feeds, this.fetches);
+    this.networkMs += performance.now() - started;
     copyOut(outputs.output, batch.result.output);
     if (batch.result.intention) copyOut(outputs.intention, batch.result.intention);
     return batch.result;

@@ -99,6 +99,8 @@ export class DuetSimulation implements Simulation {
   private readonly followerOutputs: Float32Array[];
   private readonly followerIntentions: (Float32Array | null)[];
   private readonly timer = new StepTimer(300);
+  /** The networks' part of each step (their policies' networkMs over the step). */
+  private readonly networkTimer = new StepTimer(300);
   private readonly layer = new ContactLayer();
   private playback: LeaderPlayback | null = null;
   private temperature: number;
@@ -186,6 +188,7 @@ export class DuetSimulation implements Simulation {
 
   async step(steer: Steer, temperature: number): Promise<void> {
     const started = performance.now();
+    const inNetworks = this.networkTotal();
     this.temperature = temperature;
     const duet = this.duet;
     const playing = this.playback !== null;
@@ -209,6 +212,14 @@ export class DuetSimulation implements Simulation {
     finishStep(duet, playing ? null : this.leaderOutput, this.followerOutputs, this.followerIntentions);
     this.updateViews(false);
     this.timer.add(performance.now() - started);
+    this.networkTimer.add(this.networkTotal() - inNetworks);
+  }
+
+  /** Milliseconds all of this duet's policies have spent in their networks' runs. */
+  private networkTotal(): number {
+    let sum = this.leaderPolicy.networkMs ?? 0;
+    for (const policy of this.followerPolicies) sum += policy.networkMs ?? 0;
+    return sum;
   }
 
   /**
@@ -387,6 +398,10 @@ export class DuetSimulation implements Simulation {
 
   stepMs(): { median: number; p95: number } {
     return this.timer.summary();
+  }
+
+  networkMs(): { median: number; p95: number } {
+    return this.networkTimer.summary();
   }
 
   /**

@@ -66,6 +66,9 @@ export interface Simulation {
   ghosts(k: number): Promise<Float32Array[]>;
   /** Wall time of step() over the last 300 steps, milliseconds. */
   stepMs(): { median: number; p95: number };
+  /** The part of each of those steps spent in the networks' runs (onnxruntime), milliseconds: the
+   *  rest of a step is the page's own work (features, choices, pose). */
+  networkMs(): { median: number; p95: number };
   /** Guard counts since the start: dancers reset after absurd model output, frames the leash
    *  drew a follower toward the leader (see rollout.ts), and steps the upright guard took another
    *  of a follower's samples (web/mirror/guard.ts), and dancers' steps whose sample was chosen on
@@ -103,6 +106,9 @@ export interface StepPolicy {
   /** k samples of `input` at once, each with its own noise (the encoders run once): output
    *  [k × 323], intention [90] (one: it does not depend on the noise). */
   runDraws(k: number, temperature: number): Promise<PolicyResult>;
+  /** Milliseconds spent in the network's runs since the policy was made (onnxruntime's part of a
+   *  step: the page's Policy keeps it; a policy without it counts as 0). */
+  readonly networkMs?: number;
 }
 
 /** What the shell hands to the simulation factory. */
@@ -199,6 +205,8 @@ export interface DuetHook {
   afterDraw?: () => void;
   /** step() wall time over the last 300 steps: features + both models + pose. */
   stepMs: { median: number; p95: number };
+  /** The part of those steps spent in the networks' runs (onnxruntime). */
+  networkMs: { median: number; p95: number };
   /** Follower model in use: 'ours', 'ccm' or 'compare'. */
   model: string;
   /** Ask the leader to lead the partner's turn, as T does (-1 her right, +1 her left); false

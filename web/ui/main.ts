@@ -72,6 +72,7 @@ const hook: DuetHook = {
   leader: { root: [0, 0], heading: 0 },
   follower: { root: [0, 0], heading: 0 },
   stepMs: { median: 0, p95: 0 },
+  networkMs: { median: 0, p95: 0 },
   model: 'ours',
   paused: false,
   threads: 1,
@@ -343,6 +344,9 @@ class Page {
     const stats = simulation.stepMs();
     hook.stepMs.median = stats.median;
     hook.stepMs.p95 = stats.p95;
+    const networks = simulation.networkMs();
+    hook.networkMs.median = networks.median;
+    hook.networkMs.p95 = networks.p95;
     hook.turnAsked = simulation.turnAsked;
     // Copied into the hook's own pair: no array made per frame.
     const anchor = simulation.anchor;
