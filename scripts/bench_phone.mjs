@@ -204,6 +204,7 @@ export async function benchPhone({ json = false, seconds = 14, breakdown = true,
       await page.keyboard.up('ArrowUp');
       await sleep((seconds * 1000) / 2);
       result.stepMs = await page.evaluate(() => window.duet.stepMs);
+      result.networkMs = await page.evaluate(() => window.duet.networkMs);
 
       result.fps = {
         skinned: await framesPerSecond(page, url),
@@ -248,6 +249,7 @@ function printResult(result, { json, breakdown }) {
     return result;
   }
   console.log(`model step at 4× CPU       median ${result.stepMs.median.toFixed(2)} ms, p95 ${result.stepMs.p95.toFixed(2)} ms  target ≤ ${TARGETS.stepMs} ms  ${mark(result.stepMs.median, TARGETS.stepMs)}`);
+  console.log(`  ... networks             median ${result.networkMs.median.toFixed(2)} ms, p95 ${result.networkMs.p95.toFixed(2)} ms (onnxruntime's runs in each step)`);
   const { skinned, sticks } = result.fps;
   if (!skinned.bodies) {
     console.log('drawing both dancers       skipped: this page has no window.duet.bodies (no skinned bodies / ?bodies=sticks switch yet)');
