@@ -153,8 +153,18 @@ function copyOut(tensor: Tensor | undefined, into: Float32Array): void {
   tensor.dispose();
 }
 
-/** How every model's session is made (tests/e2e/runtime.test.mjs makes its sessions the same way). */
-export const SESSION_OPTIONS = { executionProviders: ['wasm'], graphOptimizationLevel: 'all' as const };
+/**
+ * How every model's session is made (tests/e2e/runtime.test.mjs makes its sessions the same way).
+ * With two threads, onnxruntime's second thread would spin for work after each run by default,
+ * holding a core that the page's drawing and the next step need (and a phone's battery): told not
+ * to, it waits asleep. The outputs are the same; on the 2-core machine the 2-thread step took
+ * 1.58 ms against 1.67 ms (mean of 4 alternating `npm run bench -- --threads 2` runs each).
+ */
+export const SESSION_OPTIONS = {
+  executionProviders: ['wasm'],
+  graphOptimizationLevel: 'all' as const,
+  extra: { session: { intra_op: { allow_spinning: '0' } } },
+};
 
 /** Create the session for one model from its bytes (see fetchModelBytes in manifest.ts). */
 export async function createPolicy(manifest: Manifest, name: string, bytes: Uint8Array, seed: number): Promise<Policy> {
