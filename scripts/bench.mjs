@@ -1,8 +1,9 @@
 // Browser benchmark of the shipped page: builds dist/, serves it with `vite preview` (COOP/COEP
 // on, so two WASM threads are possible) and loads it cold in headless Chromium, once per thread
 // count. Prints, per run: simulation step time (median/p95 over the last 300 steps: features +
-// both models + pose) and the networks' part of it (onnxruntime's runs), cold load to the first dancing frame on screen, and the page weight (raw and
-// gzip) of everything the page downloaded to get there.
+// both models + pose) and the networks' part of it (onnxruntime's runs), cold load to the first
+// dancing frame on screen, and the page weight (raw and gzip) of everything the page downloaded
+// to get there.
 //
 //   npm run bench                 # threads 1 and 2
 //   node scripts/bench.mjs --seconds 20 --json
@@ -34,8 +35,8 @@ const leading = args.includes('--leading');
 // also runs the page with the manifest's onCount taken out, so the two step times share one machine state.
 const countCost = args.includes('--count-cost');
 // The page's window, WIDTHxHEIGHT (default: the harness's). On this machine WebGL is software
-// (SwiftShader), so the drawing shares the CPU with the networks: a small window draws less and
-// shows how much of the step the drawing costs them.
+// (SwiftShader) and shares the CPU with the networks: a small window draws less a frame (and more
+// frames), which tells whether the drawing is what slows the step (docs/measurements.md: it is not).
 const viewportOption = option('viewport', null);
 const viewport = viewportOption ? viewportOption.split('x').map(Number) : null;
 if (viewport && !(viewport.length === 2 && viewport.every((n) => Number.isInteger(n) && n >= 100))) {

@@ -1,8 +1,8 @@
 // The shipped networks alone, in Node's onnxruntime-web (the page's WebAssembly build, one thread):
 // the median time of one run of each model, and of a step's two runs (his, then hers), for each
-// number of samples drawn at once, with nothing else running in the process. Beside `npm run bench` (whose "networks" line is the same runs inside
-// the dancing page) it tells how much of a step the networks need and how much the page around
-// them costs them.
+// number of samples drawn at once, with nothing else running in the process. Beside `npm run bench`
+// (whose "networks" line is the same runs inside the dancing page) it tells how much of a step the
+// networks need and how much the page around them costs them.
 //
 //   node scripts/bench_networks.mjs                 # samples 1 and 8 (a plain step, the choice on the count)
 //   node scripts/bench_networks.mjs --samples 1,4,8,16 --runs 400 --models public/models

@@ -7,6 +7,8 @@ export class StepTimer {
   private count = 0;
   private next = 0;
   private readonly stats = { median: 0, p95: 0 };
+  /** stats holds the window as it is (nothing added since it was computed). */
+  private current = false;
 
   constructor(readonly window = 300) {
     this.samples = new Float64Array(window);
@@ -17,10 +19,14 @@ export class StepTimer {
     this.samples[this.next] = milliseconds;
     this.next = (this.next + 1) % this.window;
     this.count = Math.min(this.count + 1, this.window);
+    this.current = false;
   }
 
-  /** Median and 95th percentile of the window (the same object each call). */
+  /** Median and 95th percentile of the window (the same object each call), sorted again only
+   *  after a new sample: the HUD and the page's test hook read it every frame. */
   summary(): { median: number; p95: number } {
+    if (this.current) return this.stats;
+    this.current = true;
     const n = this.count;
     if (n === 0) {
       this.stats.median = 0;
@@ -38,5 +44,6 @@ export class StepTimer {
   clear(): void {
     this.count = 0;
     this.next = 0;
+    this.current = false;
   }
 }

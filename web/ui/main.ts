@@ -65,14 +65,23 @@ const CAMERA_STILL_CHECKS = 10;
 /** Each model gets its own noise stream, all derived from the one seed in the URL. */
 const MODEL_NAMES = ['leader', 'follower', 'follower_ccm'];
 
+/** The duet whose step times the hook reports (the page's simulation, once it has one). */
+let timed: Pick<Simulation, 'stepMs' | 'networkMs'> | null = null;
+const NO_TIMES = Object.freeze({ median: 0, p95: 0 });
+
 const hook: DuetHook = {
   ready: false,
   error: null,
   frame: 0,
   leader: { root: [0, 0], heading: 0 },
   follower: { root: [0, 0], heading: 0 },
-  stepMs: { median: 0, p95: 0 },
-  networkMs: { median: 0, p95: 0 },
+  // Read when asked (the HUD each frame, the bench and the tests), not summarized every step.
+  get stepMs() {
+    return timed ? timed.stepMs() : NO_TIMES;
+  },
+  get networkMs() {
+    return timed ? timed.networkMs() : NO_TIMES;
+  },
   model: 'ours',
   paused: false,
   threads: 1,
@@ -341,12 +350,7 @@ class Page {
     publish(hook.follower, simulation.followers[0]);
     const hands = simulation.leader.hands;
     hook.hold = hands ? Math.max(hands[0], hands[1]) : 0;
-    const stats = simulation.stepMs();
-    hook.stepMs.median = stats.median;
-    hook.stepMs.p95 = stats.p95;
-    const networks = simulation.networkMs();
-    hook.networkMs.median = networks.median;
-    hook.networkMs.p95 = networks.p95;
+    timed = simulation;
     hook.turnAsked = simulation.turnAsked;
     // Copied into the hook's own pair: no array made per frame.
     const anchor = simulation.anchor;
