@@ -34,6 +34,7 @@ from training.mirror import music  # noqa: E402
 from training.mirror import on_count as OC  # noqa: E402
 from training.mirror import rollout as ro  # noqa: E402
 from training.mirror.contact import ContactLayer  # noqa: E402
+from training.mirror.policy import open_session  # noqa: E402
 from training.mirror.bvh import BvhError, forward_kinematics, local_transforms, parse_bvh  # noqa: E402
 from training.mirror.features import Track  # noqa: E402
 from training.data.synthetic import OFFSETS, procedural_dancer  # noqa: E402
@@ -666,7 +667,6 @@ def runtime_fixture(rng) -> dict:
     every layer works in its usual range), Gumbel noise and a temperature, and the outputs that
     onnxruntime computes from them, with the manifest's fingerprint of the files they came from."""
     import onnx
-    import onnxruntime as ort
     from onnx import numpy_helper
 
     manifest = json.loads((PAGE_MODELS / "manifest.json").read_text())
@@ -678,7 +678,7 @@ def runtime_fixture(rng) -> dict:
         x = np.round(mean + 0.7 * std * rng.standard_normal((RUNTIME_BATCH, mean.size)), 5).astype(np.float32)
         width = entry["channels"] * entry["classes"]
         noise = np.round(rng.uniform(0.001, 0.999, (RUNTIME_BATCH, width)), 6).astype(np.float32)
-        session = ort.InferenceSession(str(path), providers=["CPUExecutionProvider"])
+        session = open_session(path)
         names = [o.name for o in session.get_outputs()]
         results = session.run(None, {"input": x, "temperature": np.array([out["temperature"]], np.float32), "noise": noise})
         out["models"][name] = {

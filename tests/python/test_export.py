@@ -7,7 +7,6 @@ import shutil
 
 import numpy as np
 import onnx
-import onnxruntime as ort
 import pytest
 import torch
 
@@ -15,6 +14,7 @@ from training.learning import export as E
 from training.mirror import features as feat
 from training.data.dataset import discover_takes, load_pair
 from training.learning.runs import load_run
+from training.mirror.policy import open_session
 from training.mirror.skeleton import FPS, JOINT_NAMES, KEY_JOINTS, PARENTS
 from training.learning.train import SHIPPED
 
@@ -32,9 +32,7 @@ INT8_MAX_INTENTION_RELATIVE_L2 = 0.02
 
 
 def session(path):
-    so = ort.SessionOptions()
-    so.intra_op_num_threads = 1
-    return ort.InferenceSession(str(path), so, providers=["CPUExecutionProvider"])
+    return open_session(path)
 
 
 def run_onnx(sess, x, temperature, noise):

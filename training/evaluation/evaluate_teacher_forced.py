@@ -49,12 +49,9 @@ class OutputEncoder:
     one training gives a recorded or generated output, beside the input it answers."""
 
     def __init__(self, path: Path, stamp: dict):
-        import onnxruntime as ort
-        so = ort.SessionOptions()
-        so.intra_op_num_threads = 1
-        so.inter_op_num_threads = 1
+        from ..mirror.policy import open_session
         try:
-            self.session = ort.InferenceSession(str(path), so, providers=["CPUExecutionProvider"])
+            self.session = open_session(path)
         except Exception as e:   # onnxruntime raises its own types for a damaged file
             raise EvalError(f"{path}: cannot be loaded by onnxruntime ({e.__class__.__name__})") from None
         self.channels, self.classes = stamp["channels"], stamp["classes"]

@@ -421,11 +421,8 @@ class OnnxPolicy:
     """One exported step model in onnxruntime (what the page runs, minus the browser)."""
 
     def __init__(self, path, threads: int = 1):
-        import onnxruntime as ort
-        so = ort.SessionOptions()
-        so.intra_op_num_threads = threads
-        so.inter_op_num_threads = 1
-        self.session = ort.InferenceSession(str(path), so, providers=["CPUExecutionProvider"])
+        from .policy import open_session
+        self.session = open_session(path, threads)
         self.outputs = [o.name for o in self.session.get_outputs()]
         self.latent = self.session.get_inputs()[2].shape[1]
 
