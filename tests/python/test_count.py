@@ -7,6 +7,7 @@ import pytest
 
 from conftest import REAL_DATA, needs_real_data
 from training.data import count as C
+from training.data.count_report import report
 from training.mirror import music as Mu
 from training.mirror.skeleton import FEET, FPS
 
@@ -77,7 +78,7 @@ def test_music_at_reads_the_tempo_from_the_count():
 
 @needs_real_data
 def test_the_recorded_takes_carry_a_steady_count():
-    rows = C.report(str(REAL_DATA))
+    rows = report(str(REAL_DATA))
     assert len(rows) == 12
     assert all(162 <= r["bpm"] <= 188 for r in rows)
     assert sum(max(abs(r["beat_leader"]), abs(r["beat_follower"])) <= 0.15 for r in rows) >= 11

@@ -43,7 +43,8 @@ from ..mirror.features import HISTORY, follower_input, foot_contacts
 from ..data.folders import add_folder
 from .motion_matching import build, load_tracks, training_takes
 from ..mirror.rollout import NOW, Dancer, OnnxPolicy, apply_output
-from .soak import soak_one, steering_trials
+from .duet import soak_one
+from .soak import steering_trials
 
 KEYS = ["interpenetration", "hand_hold", "closest_hand_m", "skate_leader_cm", "skate_follower_cm",
         "contact_skate_leader_cm", "contact_skate_follower_cm", "contact_share_leader", "contact_share_follower",

@@ -56,7 +56,7 @@ def recorded(data: str) -> dict:
 def rollouts(args, steer: bool) -> list[dict]:
     """Per seed: each dancer's figures, raw and shown."""
     from .rhythm import load_dancers
-    from .soak import soak_one
+    from .duet import soak_one
     manifest, leader, follower, temperature = load_dancers(args)
     out = []
     for seed in tqdm(range(args.first_seed, args.first_seed + args.seeds), desc="steered" if steer else "nobody steering",
@@ -85,7 +85,7 @@ def plot(path: str, args, seed: int, steer: bool, seconds: float = 4.0) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     from .rhythm import load_dancers
-    from .soak import soak_one
+    from .duet import soak_one
     manifest, leader, follower, temperature = load_dancers(args)
     rec = {}
     soak_one(manifest, leader, follower, seed, int(args.seconds * FPS), temperature, record=rec,

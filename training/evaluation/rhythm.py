@@ -180,7 +180,7 @@ FIGURES = ["pulse", "period_off", "on_beat"]
 def duet_rhythm(manifest, leader, follower, seed: int, frames: int, temperature: float,
                 tempo: float, steered: bool) -> dict:
     """One of the soak's duets (steered by its stick, or by nobody), at a tempo: its rhythm."""
-    from .soak import soak_one
+    from .duet import soak_one
     from .options import restart_count
     record: dict = {}
     for policy in (leader, follower):   # each duet starts from its own footwork (on_count.OnCount)
@@ -239,7 +239,7 @@ def plot(path: str, data: str, manifest, leader, follower, temperature: float, t
     from ..data.dataset import discover_takes, load_pair, pair_tracks, select_takes
     (t,) = select_takes(discover_takes(data), [take])
     lead, follow = pair_tracks(*load_pair(t))
-    from .soak import soak_one
+    from .duet import soak_one
     rec: dict = {}
     frames = int((start + seconds) * FPS) + FPS
     soak_one(manifest, leader, follower, seed, frames, temperature, record=rec, tempo=tempo, steer=False)

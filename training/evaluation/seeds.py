@@ -33,7 +33,7 @@ from .evaluate_inputs import EvalError, find_models, load_eval_takes, load_onnx
 from .interaction import contact_labels, measure, weighted as interaction_weighted
 from .motion_matching import build, load_tracks, training_takes
 from . import rhythm as R
-from .soak import soak_one
+from .duet import soak_one
 
 INTERACTION = ["interpenetration", "hand_hold", "skate_leader_cm", "skate_follower_cm",
                "contact_skate_leader_cm", "contact_skate_follower_cm"]
@@ -186,8 +186,7 @@ def run(args) -> dict:
                      "guard_partner_low": args.guard_partner_low,
                      "guard_partner_low_hip_margin": args.guard_partner_low_hip_margin,
                      "on_count": args.on_count, "on_count_strength": args.on_count_strength,
-                     "on_count_hips": args.on_count_hips, "on_count_spin_keep": args.on_count_spin_keep,
-                     "on_count_turn_start": args.on_count_turn_start,
+                     "on_count_hips": args.on_count_hips,
                      "wall_seconds": time.time() - t0}
     return res
 

@@ -7,7 +7,7 @@ import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import type { Avatar } from './avatar';
 import { type Bodies, ContactMarks, type DancerBody, DancerMeshes, OUTLINE, SkinnedDancer } from './body';
-import { LIMITS } from '../ui/share';
+import { type CameraOrbit, ORBIT_LIMITS } from './orbit';
 import { type Basis, type FrameWindow, type Rect, cylinderPoints, distanceToFit, frameWindow, viewShift } from './framing';
 
 export { DancerMeshes } from './body';
@@ -118,15 +118,6 @@ export class PathOverlay {
   }
 }
 
-export interface CameraOrbit {
-  /** Degrees around the vertical axis; 0 looks along +z (from behind the leader at start). */
-  azimuth: number;
-  /** Degrees down from straight above. */
-  polar: number;
-  /** Metres from the pair's midpoint. */
-  distance: number;
-}
-
 /** A three-quarter view from behind the leader's right shoulder: both dancers visible. */
 export const DEFAULT_ORBIT: CameraOrbit = { azimuth: 35, polar: 70, distance: 5.2 };
 
@@ -165,10 +156,10 @@ export class Stage {
   /** The free part's size as framing.ts reads it (applyFrame). */
   private window: FrameWindow = frameWindow({ left: 0, top: 0, right: 1, bottom: 1 }, 1, 45);
   /** The nearest a wheel or a pinch may bring the camera at its angle now (updateClosest). */
-  private closest: number = LIMITS.distance[0];
+  private closest: number = ORBIT_LIMITS.distance[0];
   /** Points around the cylinder the closest distance keeps in the picture (framing.ts). */
   private cylinder = cylinderPoints(PAIR_HALF_WIDTH, TARGET_HEIGHT);
-  /** The distance the visitor chose (a wheel, a pinch, a link, reset view), within LIMITS. */
+  /** The distance the visitor chose (a wheel, a pinch, a link, reset view), within ORBIT_LIMITS. */
   private chosen = DEFAULT_ORBIT.distance;
   /** The distance the camera was put at after the last update: a change since is the visitor's. */
   private placed = DEFAULT_ORBIT.distance;
@@ -199,8 +190,8 @@ export class Stage {
     // fits in the free part of the screen, and farther while a dancer needs it.
     this.controls.minDistance = 0;
     this.controls.maxDistance = Infinity;
-    this.controls.minPolarAngle = THREE.MathUtils.degToRad(LIMITS.polar[0]);
-    this.controls.maxPolarAngle = THREE.MathUtils.degToRad(LIMITS.polar[1]);
+    this.controls.minPolarAngle = THREE.MathUtils.degToRad(ORBIT_LIMITS.polar[0]);
+    this.controls.maxPolarAngle = THREE.MathUtils.degToRad(ORBIT_LIMITS.polar[1]);
     // One finger steers (the joystick in controls.ts); two fingers orbit and zoom.
     this.controls.touches = { ONE: -1 as THREE.TOUCH, TWO: THREE.TOUCH.DOLLY_ROTATE };
     this.controls.target.copy(this.followTarget);
@@ -330,7 +321,7 @@ export class Stage {
   private updateClosest(): void {
     this.camera.updateMatrixWorld();
     cameraBasis(this.camera, _basis);
-    this.closest = Math.max(LIMITS.distance[0], distanceToFit(this.cylinder, this.cylinder.length / 3, _basis, this.window));
+    this.closest = Math.max(ORBIT_LIMITS.distance[0], distanceToFit(this.cylinder, this.cylinder.length / 3, _basis, this.window));
   }
 
   /**
@@ -347,7 +338,7 @@ export class Stage {
 
   /**
    * After each update of the controls: the camera at the distance the visitor chose, within the
-   * limits (LIMITS.distance, and no closer than the pair fits: keepInView), or farther while a
+   * limits (ORBIT_LIMITS.distance, and no closer than the pair fits: keepInView), or farther while a
    * dancer's head or feet need it (a step out of the cylinder, a turn at arm's length). The
    * camera backs off at once (the frame on screen holds them whole) and comes back slowly.
    */
@@ -358,7 +349,7 @@ export class Stage {
     this.updateClosest();
     // Within the limits of this layout (kept apart from the choice itself: when the sheet folds
     // again the camera comes back to where the visitor had it).
-    const within = (d: number) => Math.min(Math.max(LIMITS.distance[1], this.closest), Math.max(this.closest, d));
+    const within = (d: number) => Math.min(Math.max(ORBIT_LIMITS.distance[1], this.closest), Math.max(this.closest, d));
     // A change since the last frame is the visitor's zoom (a wheel turn, a pinch), by a factor of
     // the distance they chose; within this layout's limits, so that no turn of the wheel is lost
     // beyond them.
@@ -548,9 +539,9 @@ export class Stage {
   }
 }
 
-/** A distance within the limits a link and the visitor's zoom keep to (LIMITS.distance). */
+/** A distance within the limits a link and the visitor's zoom keep to (ORBIT_LIMITS.distance). */
 function clampDistance(distance: number): number {
-  return Math.min(LIMITS.distance[1], Math.max(LIMITS.distance[0], distance));
+  return Math.min(ORBIT_LIMITS.distance[1], Math.max(ORBIT_LIMITS.distance[0], distance));
 }
 
 /** The camera's right, up and forward axes (world) from its matrix (after updateMatrixWorld). */

@@ -246,7 +246,7 @@ export interface DuetHook {
   /** How the dancers are drawn: skinned characters, or capsule figures (?bodies=sticks). */
   bodies?: 'skinned' | 'sticks';
   /** Where the camera is (read when asked): degrees around, degrees down from above, metres from
-   *  the pair's midpoint (web/draw/scene.ts CameraOrbit). */
+   *  the pair's midpoint (web/draw/orbit.ts CameraOrbit). */
   camera?: { azimuth: number; polar: number; distance: number };
   /** Frames drawn so far (animation frames that drew nothing are not counted). */
   drawn?: number;

@@ -8,11 +8,9 @@
 // path allocates nothing. Module-level scratch arrays hold gathered inputs (JS is single-threaded
 // and none of these functions re-enters another while its scratch is live).
 
-import { FEET, FPS, HANDS, KEY_JOINTS, type Motion, N_JOINTS, POSITIONS_SIZE, ROTATIONS_SIZE, rootFromMotion } from './skeleton';
+import { FEET, FPS, HANDS, KEY_JOINTS, type Motion, N_JOINTS, type Out, POSITIONS_SIZE, ROTATIONS_SIZE, rootFromMotion } from './skeleton';
 import { MUSIC_SIZE, musicAt } from './music';
 
-/** Any float array a feature can be written into (policy inputs are float32, tests use float64). */
-export type Out = Float32Array | Float64Array;
 
 export const KEYS = 6; // trajectory keys per second (the paper's k)
 export const KEY_STEP = FPS / KEYS; // 5 frames between keys at 30 fps

@@ -6,8 +6,7 @@
 // ones start a two-beat group (the recording carries the beat and the two-beat group, not the
 // measure: training/data/count.py). In the page it is read from the audio clock (web/music/).
 
-import { FPS } from './skeleton';
-import type { Out } from './features';
+import { FPS, type Out } from './skeleton';
 
 /** Frames of the keys the count is read at: t-30, t-25, ..., t, ..., t+30 (13 keys). */
 export const MUSIC_OFFSETS: readonly number[] = Array.from({ length: 13 }, (_, i) => (i - 6) * 5);

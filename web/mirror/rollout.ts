@@ -15,10 +15,10 @@
 // The page's Simulation (policies in, views out) is simulation.ts.
 
 import {
-  FUTURE_OFFSETS, HISTORY, INTENTION_SIZE, KEYS, N_JOINTS, OUTPUT_LAYOUT, OUTPUT_SIZE, type Out, Track,
+  FUTURE_OFFSETS, HISTORY, INTENTION_SIZE, KEYS, N_JOINTS, OUTPUT_LAYOUT, OUTPUT_SIZE, Track,
   blockSlices, followerInput, fromRootSpaceDirections, fromRootSpacePoints, leaderInput, toRootSpacePoints, wrapAngle,
 } from './features';
-import { FEET, FPS, HANDS, KEY_JOINTS, PARENTS, POSITIONS_SIZE, ROTATIONS_SIZE, forwardKinematicsReduced } from './skeleton';
+import { FEET, FPS, HANDS, KEY_JOINTS, type Out, PARENTS, POSITIONS_SIZE, ROTATIONS_SIZE, forwardKinematicsReduced } from './skeleton';
 import { DEFAULT_TEMPO, MUSIC_SIZE, beatsPerStep, musicBlock } from './music';
 
 export const NOW = HISTORY;

@@ -36,6 +36,9 @@ export const MIRROR: number[] = JOINT_NAMES.map((n) => {
   return (JOINT_NAMES as readonly string[]).indexOf(twin);
 });
 
+/** Any float array a feature can be written into (policy inputs are float32, tests use float64). */
+export type Out = Float32Array | Float64Array;
+
 export interface Motion {
   /** [F × 17 × 3] world, metres. */
   positions: Float64Array;

@@ -4,7 +4,7 @@
 // its own address as they change (addressQuery), so the address bar is always such a link.
 
 import type { FollowerChoice } from '../engine/types';
-import type { CameraOrbit } from '../draw/scene';
+import { type CameraOrbit, ORBIT_LIMITS } from '../draw/orbit';
 import { DEFAULT_TEMPO, TEMPO_RANGE } from '../mirror/music';
 
 export interface Settings {
@@ -34,10 +34,9 @@ export const LIMITS = {
   speed: [0.25, 4],
   /** The tempo control: within what the networks trained on (139-218, web/mirror/music.ts). */
   tempo: TEMPO_RANGE,
-  /** The camera (web/draw/scene.ts): degrees down from straight above; metres from the pair, at
-   *  most 12, short of the fog (from 14 m). */
-  polar: [5, 88],
-  distance: [1.5, 12],
+  /** The camera (web/draw/orbit.ts). */
+  polar: ORBIT_LIMITS.polar,
+  distance: ORBIT_LIMITS.distance,
   threads: [1, 2],
 } as const;
 
