@@ -1,7 +1,7 @@
 """python -m training.evaluation.crossval: ours against CCM, cross-validated by take, with paired intervals.
 
     python -m training.evaluation.crossval                       # 6 folds x seeds 1,2, ours and CCM
-    python -m training.evaluation.crossval --methods ours,ccm,ours_tempo --folds 6 --seeds 1,2 --jobs 2
+    python -m training.evaluation.crossval --folds 6 --seeds 1,2 --jobs 2
     python -m training.evaluation.crossval --report-only         # the table from what is on disk
 
 The takes are split into --folds groups (in name order); in fold k the k-th group is the test set,
@@ -41,22 +41,11 @@ from ..data.dataset import DataError, discover_takes
 from ..data.folders import add_folder
 from ..data.prepare import TEMPOS
 
-# Method name -> (run name = ONNX stem, recipe in train.MODELS, trained on the tempo copies). The
-# recipes are the shipped pair before proximity augmentation: intention or not, all else alike.
+# Method name -> (run name = ONNX stem, recipe in train.MODELS, trained on the tempo copies): the
+# shipped pair's recipes, intention or not, all else alike.
 METHODS = {
-    "ours": ("follower", "follower_no_proximity", False),
-    "ccm": ("follower_ccm", "follower_ccm_no_proximity", False),
-    "ours_tempo": ("follower_tempo", "follower_no_proximity", True),
-    "ccm_tempo": ("follower_ccm_tempo", "follower_ccm_no_proximity", True),
-    # The shipped recipes (decoders that read the pose, proximity, state noise, state dropout, the
-    # tempo copies the music needs), and
-    # the same with the turn onsets weighed 4x (measured, not shipped).
-    "ours_steady": ("follower_steady", "follower", True),
-    "ccm_steady": ("follower_ccm_steady", "follower_ccm", True),
-    "ours_turns": ("follower_turns", "follower_turns", False),
-    "ccm_turns": ("follower_ccm_turns", "follower_ccm_turns", False),
-    # The shipped recipe whose intention also forecasts the turn the leader leads (turn_keys).
-    "ours_led_turn": ("follower_led_turn", "follower_led_turn", False),
+    "ours": ("follower", "follower", True),
+    "ccm": ("follower_ccm", "follower_ccm", True),
 }
 # implausible / worst second: the free-running follower's frames with its body low, folded or split,
 # against the fold's own training range (evaluate's plausibility; n/a for evaluations without it).
@@ -251,11 +240,7 @@ def report(out: Path, plan: dict, seconds: float, name: str = "crossval") -> dic
                     values[m][(f["fold"], s)] = {k: row.get(k) for k in METRICS}
     fold_ids = [f["fold"] for f in plan["folds"] if all((f["fold"], s) in values[m] for m in methods for s in seeds)]
     comparisons = {}
-    pairs = [(a, b) for a, b in (("ours", "ccm"), ("ours_tempo", "ours"), ("ccm_tempo", "ccm"), ("ours_tempo", "ccm_tempo"),
-                                 ("ours_steady", "ccm_steady"), ("ours_steady", "ours"), ("ccm_steady", "ccm"),
-                                 ("ours_turns", "ccm_turns"), ("ours_turns", "ours_steady"), ("ccm_turns", "ccm_steady"),
-                                 ("ours_led_turn", "ccm_steady"), ("ours_led_turn", "ours_steady"))
-             if a in methods and b in methods]
+    pairs = [("ours", "ccm")] if "ours" in methods and "ccm" in methods else []
     for a, b in pairs:
         comparisons[f"{a} - {b}"] = {k: paired(values[a], values[b], fold_ids, seeds, k) for k in METRICS}
     res = {"plan": plan, "complete_folds": fold_ids, "seconds": seconds,

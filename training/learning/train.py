@@ -33,7 +33,6 @@ from ..evaluation.figures import HAND_RAISED
 from ..evaluation.loss_plot import plot_history
 from .models import CodebookMatching, Discriminator, IntentionPredictor, ModelConfig, StepModel, code_logits, sample_codes
 from .own_rollouts import load_couples, own_rollout_samples
-from .lead_reader import LeadReader
 from ..mirror.on_count import planned_turn
 from ..data.prepared import (TrainError, load_mirror_flags, load_offsets, load_split, load_stats, normalize,
                              pose_error_cm, with_led_turn)
@@ -119,12 +118,6 @@ class TrainConfig:
     # hand goes up and in 24 % of the others (recorded_leads): weighing only the led starts asks her
     # to read his hand.
     unled_turn_weight: float | None = None
-    # Follower, with unled_turn_weight: what tells a led turn start from an unled one. "hand": his
-    # higher hand goes above HAND_RAISED over the next second (led_onsets); "body": a linear reader
-    # of his body as she sees it finds the start's direction among the likelier half
-    # (lead_reader.py). In the page his hand rarely reaches the hand rule's height when asked
-    # (docs/results.md, "She reads his hand"), while his body leads the asked way in most requests.
-    led_by: str = "hand"
     # Leader: weight of the samples where his own turn starts (own_turn_onsets), figure shown or
     # not. The recorded leader turns 6-7 times a minute, in 10 of 12 takes; turn_weight only weighs
     # the moments he leads hers, and a leader who turns only beside a spinning partner turns in few seeds.
@@ -160,12 +153,12 @@ class TrainConfig:
 # channels cost 0.3-0.5 cm, the part the intention can reduce (it does on the validation take
 # for three seeds; on the test takes ours and CCM tie: docs/results.md, "Latent size").
 FOLLOWER = ModelConfig(channels=24)
-# Weights of the terms on the decoded body (partner_losses.py); the ablation rows below switch
-# one off or change it (docs/results.md, "Partner terms", measured on steered duets):
-# - penetration 3000: at 100 the follower came closer than before the terms (the interaction term
+# Weights of the terms on the decoded body (partner_losses.py; docs/results.md, "Partner terms",
+# measured on steered duets):
+# - penetration 3000: at 100 the follower came closer than without the terms (the interaction term
 #   draws it in) and its torso passed through the leader's in 10.5 % of steered frames;
 # - foot contact 100, weighted by the recorded contacts: weighted by the decoded contacts, 30 made
-#   the feet stick and the motion stiff (free-running FID 193 against 97 before the terms), 10
+#   the feet stick and the motion stiff (free-running FID 193 against 97 without the terms), 10
 #   kept FID (111) but hardly reduced foot skate; the recorded contacts are what the decoded ones
 #   learn anyway, and at 100 they cut the follower's steered slide by a third (skate in contact
 #   3.45 against 4.94 cm without the term) while FID stays 101.
@@ -176,23 +169,19 @@ PARTNER = dict(lambda_penetration=3000.0, lambda_foot_contact=100.0, lambda_inte
 # room for a steered leader (its torso passed through the leader's in 10.3 % of steered frames,
 # 5.3 % with a quarter of the samples moved closer at weight 100; docs/results.md).
 PROXIMITY = dict(proximity_share=0.25, lambda_proximity=100.0)
-# The leader was trained with the first weights tried (penetration 100, foot contact 30 on its
-# decoded contacts); a leader with penetration 3000 did not change the steered duet's numbers.
-LEADER_PARTNER = dict(lambda_penetration=100.0, lambda_foot_contact=30.0, lambda_interaction=10.0)
 
-
-# The follower pair with the partner terms and without proximity (shipped until proximity came;
-# training.evaluation.crossval compares them), and the shipped pair.
-OURS_NO_PROXIMITY = TrainConfig(model=FOLLOWER, intention_noise=0.3, **PARTNER)
-CCM_NO_PROXIMITY = TrainConfig(model=replace(FOLLOWER, intention=False), **PARTNER)
-OURS = replace(OURS_NO_PROXIMITY, **PROXIMITY)
-CCM = replace(CCM_NO_PROXIMITY, **PROXIMITY)
-LEADER_STOP_MOTION = TrainConfig(model=ModelConfig(role="leader", input_size=feat.LEADER_INPUT_SIZE), **LEADER_PARTNER)
+# Ours and its baseline, CCM (the same network without the intention step, all else alike), from
+# which the shipped pair is made (steady, then the settings in MODELS).
+OURS = TrainConfig(model=FOLLOWER, intention_noise=0.3, **PARTNER, **PROXIMITY)
+CCM = TrainConfig(model=replace(FOLLOWER, intention=False), **PARTNER, **PROXIMITY)
+# The leader's network reads his control, the figure and the hands plan beside her (features.py).
+# His penetration term at 100: at 3000 the steered duet's numbers did not change.
+LEADER = TrainConfig(model=ModelConfig(role="leader", input_size=feat.LEADER_INPUT_SIZE),
+                     lambda_penetration=100.0, lambda_interaction=10.0)
 
 STATE_NOISE = 0.2   # normalized units: about 1 cm on the hip height, 3-4 cm on a hand, 0.1 m/s on a velocity
-# Half the matching epochs of the recipes before: with the pose beside the code the validation
-# MPJPE is 2.4 cm (follower) and 1.9 cm (leader) after 20, against 5.2 cm after 40 before, and a
-# training costs 16-35 min on the 2-core machine beside other jobs (docs/plausibility.md).
+# With the pose beside the code the validation MPJPE is 2.4 cm (follower) and 1.9 cm (leader) after
+# 20 matching epochs, against 5.2 cm after 40 decoded from the code alone (docs/plausibility.md).
 STEADY_EPOCHS = 20
 
 
@@ -200,274 +189,62 @@ def steady(cfg: TrainConfig) -> TrainConfig:
     """A recipe whose decoder reads the current pose beside the code, trained with noise on the
     dancer's own state (docs/plausibility.md). Decoded from its code alone, the leader held one
     body shape in 52.7 % of steered frames and the follower lay on the floor for a second or more
-    in 14 of 100 steered minutes; with it, no frozen body and no fall in 100. The price, measured:
-    the follower's free-running motion against the recorded leader is less varied (Diversity 13
-    against 20; FID 219 against 108)."""
+    in 14 of 100 steered minutes; with it, no frozen body and no fall in 100."""
     return replace(cfg, model=replace(cfg.model, decoder_state=True), state_noise=STATE_NOISE,
                    epochs=STEADY_EPOCHS)
 
 
-def partner_variant(**changes) -> TrainConfig:
-    """The follower's partner-term recipe (before proximity) with some settings changed (ablation rows)."""
-    return replace(OURS_NO_PROXIMITY, **changes)
-
-
-# The leader shipped until the evening of 2026-11-27 (foot contact 30 on his decoded contacts): the
-# shipped leader and its variants change only his foot-contact term (MODELS below).
-LEADER_BEFORE_CONTACT = replace(steady(LEADER_STOP_MOTION), figure_dropout=0.5, state_dropout=0.5, own_rollouts_from=10,
-                                hands_plan_dropout=0.5, seed=2)
-
-
-# The models `--all` trains (shipped), and the ones evaluation adds (ablations, larger CCM).
+# The shipped models (`--all`), then the paper's ablations that docs/results.md ("The paper's
+# tables on this data") compares them with: bash scripts/evaluate_all.sh trains those and measures
+# all. What was tried and not shipped is a row of docs/results.md's tried table, whose commit
+# holds its recipe.
 MODELS = {
-    # The predictor fits training frames better than new ones (MSE 0.14 vs 0.23): noise of the
-    # size of that gap keeps the encoders from trusting its training-set accuracy, which buys
-    # FID and Diversity on the test takes (docs/results.md, w/o intention noise).
-    # The decoder kept reading its code: the state hidden from it in half the samples
-    # (TrainConfig.state_dropout). As varied as the recording against the recorded leader (the
-    # shipped 64-level file: FID 111.9 at variety 1, seeds 108.5-115.9), and the page's upright
-    # guard (training/mirror/guard.py) catches its rare falls: 0 of 100 steered seeds with a bad
-    # second, no fall in the 100 x 10 min soak (docs/plausibility.md). CCM by the same recipe, so
-    # the comparison stays fair.
-    #
-    # Since 2026-11-25 also trained on their own rollouts (own_rollouts.py: 8 frames from every 4th
-    # frame, made anew every 2 epochs from epoch 10) with the samples where her turn starts weighed
-    # 4x. Beside the played-back recorded leader (test takes 02, 13, 5 seeds, variety 0.5) she turns
-    # 25.9 times a minute (the recording: 25.9; before 11.5) with FID 82 (before 118); and where the
-    # followers before sank at low variety beside our steered leader (5 of 20 seeds at 0.5), none of
-    # 20 does down to 0.35, so the page runs her at 0.5 (docs/results.md, "Salsa turns").
-    # Both hear the music (features "music" block) and train on the tempo copies too, so that they
-    # dance on the count from 150 to 200 beats a minute (docs/music.md).
+    # Her intention predictor fits training frames better than new ones (MSE 0.14 vs 0.23): noise
+    # of the size of that gap keeps the encoders from trusting its training-set accuracy, which
+    # buys FID and Diversity on the test takes (docs/results.md, w/o intention noise).
+    # Her decoder keeps reading its code with the state hidden from it in half the samples
+    # (TrainConfig.state_dropout): as varied as the recording against the recorded leader, and the
+    # page's upright guard (training/mirror/guard.py) catches her rare falls (docs/plausibility.md).
+    # Her own rollouts (own_rollouts.py: 8 frames from every 4th frame, made anew every 2 epochs
+    # from epoch 10) and her turn starts weighed 4x: beside the played-back recorded leader she
+    # turns 25.9 times a minute (the recording: 25.9; 11.5 without) with FID 82 (118), and beside our
+    # steered leader none of 20 seeds sinks at variety 0.35-0.5 (5 of 20 at 0.5 without), so the
+    # page runs her at 0.5 (docs/results.md, "Salsa turns").
+    # The tempo copies: she hears the music (features' "music" block) and dances on the count from
+    # 150 to 200 beats a minute (docs/music.md).
     "follower": replace(steady(OURS), state_dropout=0.5, turn_weight=4.0, own_rollouts_from=10, tempo_copies=True),
-    # Measured, not shipped (docs/results.md, "Her decoder hears the music"): her decoder also reads
-    # the music block beside the code and her pose (ModelConfig.decoder_music), her turn starts
-    # weighed 4x, 5x or 6x. With the choice on the count her footwork repeats more strongly (5x:
-    # 0.82x / 0.84x the recorded follower's steered / nobody steering, 20 seeds x 20 s at 170 bpm;
-    # shipped 0.69-0.81x) and she turns 0.91x the recorded rate (0.73x), but with a turn asked every
-    # 3 s she fell: the page's led turn at seed 8 (training seed 1), 2 of 30 steered seeds with a
-    # bad second (training seed 2; the shipped follower 0). At 4x she turns 0.64x, at 6x her pulse
-    # is 0.62x nobody steering.
-    "follower_decoder_music_4": replace(steady(OURS), model=replace(steady(OURS).model, decoder_music=True),
-                                        state_dropout=0.5, turn_weight=4.0, own_rollouts_from=10, tempo_copies=True),
-    "follower_decoder_music_5": replace(steady(OURS), model=replace(steady(OURS).model, decoder_music=True),
-                                        state_dropout=0.5, turn_weight=5.0, own_rollouts_from=10, tempo_copies=True),
-    "follower_decoder_music_6": replace(steady(OURS), model=replace(steady(OURS).model, decoder_music=True),
-                                        state_dropout=0.5, turn_weight=6.0, own_rollouts_from=10, tempo_copies=True),
-    "follower_long_own": replace(steady(OURS), state_dropout=0.5, turn_weight=4.0, tempo_copies=True,
-                                 epochs=6, lr=3e-4, own_rollouts_from=0, own_rollouts_horizon=30),
+    # The baseline by the same recipe, so that the comparison stays fair.
     "follower_ccm": replace(steady(CCM), state_dropout=0.5, turn_weight=4.0, own_rollouts_from=10, tempo_copies=True),
-    # Measured, not shipped (docs/results.md, "She reads his hand" and "He turns on his own"): only
-    # the turn starts his raised hand leads weigh more (unled_turn_weight). At 8x she reads his hand
-    # as the recorded follower does (unasked she turns in 81-84 % of the windows with his hand up and
-    # 28-38 % without; recorded 81 % and 24 %), and beside the leader who turns on his own she
-    # follows 80 % of 500 requests and turns 1.19x the recorded rate nobody asking; but in the soak
-    # she went down into deep lunges with him in 2 of 100 rollouts (1 of 100 beside the leader
-    # before). At 4x she follows 65 % of the requests. Its seeds 2-5 (docs/results.md, "Five seeds of
-    # one follower"): seed 5 fell in 3 of 12 soak rollouts, seed 4 in 1 of 57, and each dances
-    # the requests and his turns differently (seed 4: 78 %, his turns 0.45x).
-    "follower_led_onsets_8": replace(steady(OURS), state_dropout=0.5, turn_weight=8.0, unled_turn_weight=1.0,
-                                     own_rollouts_from=10),
-    "follower_led_onsets_4": replace(steady(OURS), state_dropout=0.5, turn_weight=4.0, unled_turn_weight=1.0,
-                                     own_rollouts_from=10),
-    # Measured, not shipped: the led turn starts weigh 16x (8x did not change her reading), on the
-    # networks that hear the music. She reads his hand as the recorded follower does (unasked she
-    # turns in 61 % of the windows with his hand above 1.6 m, 27 % without; with it above 1.8 m, 85 %),
-    # but his hand passes 1.8 m in a tenth of the requests: she turned after 37 % (docs/results.md,
-    # "She reads his hand").
-    "follower_led_16_music": replace(steady(OURS), state_dropout=0.5, turn_weight=16.0, unled_turn_weight=1.0,
-                                     own_rollouts_from=10, tempo_copies=True),
-    # Measured, not shipped (docs/results.md, tried: "Her turn starts his body leads"): only the
-    # turn starts his body leads weigh more (led_by "body", lead_reader.py), on the networks that
-    # hear the music. `lead --seeds 20` (the shipped follower on the same seeds: she turns after
-    # 55 % of the requests, 38 % unasked, 16.5 turns a minute): 8x 45 % / 51 % and 20.0 a minute,
-    # but his own turns 0.41x; 16x 36 % / 26 %, her turns 9.6 a minute.
-    "follower_body_led_8": replace(steady(OURS), state_dropout=0.5, turn_weight=8.0, unled_turn_weight=1.0,
-                                   led_by="body", own_rollouts_from=10, tempo_copies=True),
-    "follower_body_led_16": replace(steady(OURS), state_dropout=0.5, turn_weight=16.0, unled_turn_weight=1.0,
-                                    led_by="body", own_rollouts_from=10, tempo_copies=True),
-    # Measured, not shipped: the intention also forecasts the turn the leader leads her into over
-    # the next second (ModelConfig.turn_keys). A detector reading his body alone finds 52 % of the
-    # recorded turns half a second ahead (training.evaluation.turn_cues); cross-validated this follower
-    # matches 36 % with precision 40 % (the shipped recipe 35 % and 43 %, CCM 34 % and 48 %):
-    # no difference the 6 folds can show (docs/results.md, "Turn timing").
-    "follower_led_turn": replace(steady(OURS), model=replace(steady(OURS).model, turn_keys=feat.KEYS),
-                                 state_dropout=0.5, turn_weight=4.0, own_rollouts_from=10),
-    # Measured, not shipped (docs/results.md, "Room for his head, her hips guarded"): his body lowered by up
-    # to 0.15 m in a quarter of her samples (TrainConfig.partner_lowered_share). Beside the leader
-    # with room for his head she still followed his lunges down: the soak's first 4 seeds from 0
-    # and from 50 all fell (the shipped follower: 0 of those 8).
-    "follower_lowered": replace(steady(OURS), state_dropout=0.5, turn_weight=4.0, own_rollouts_from=10,
-                                partner_lowered_share=0.25, partner_lowered_depth=0.15),
-    # The followers shipped until then (no own rollouts, no turn weight).
-    "follower_before_own": replace(steady(OURS), state_dropout=0.5),
-    "follower_ccm_before_own": replace(steady(CCM), state_dropout=0.5),
-    # Measured, not shipped: the samples where the follower's turn starts weigh 4x
-    # (TrainConfig.turn_weight). Beside the played-back recorded leader (test takes 02, 13,
-    # variety 0.5, 5 seeds) she turns 19.3 times a minute against 11.5 (the recording: 25.9) and
-    # matches 34 % of the recorded turns against 19 %; but beside our steered leader at the page's
-    # variety 1 she crumpled to the floor in 2 of 100 seeds (the shipped pair: 0 of 100;
-    # docs/results.md, "Salsa turns"). 8x turns more often (21.0 a minute) but matches fewer (24 %,
-    # precision 35 % against 52 %); the state hidden in 70 % of the samples matches 20 %.
-    "follower_turns": replace(steady(OURS), state_dropout=0.5, turn_weight=4.0),
-    "follower_ccm_turns": replace(steady(CCM), state_dropout=0.5, turn_weight=4.0),
-    # Own rollouts of 30 frames from every 10th (the first tried): she drifts so far from the
-    # recording in a second that its next frame, asked of her from there, taught her to stand off
-    # and jitter (0 turns a minute at variety 1, FID 184, hands 0.76 m from his against 0.45).
-    "follower_own_30": replace(steady(OURS), state_dropout=0.5, turn_weight=4.0, own_rollouts_from=10,
-                               own_rollouts_horizon=30, own_rollouts_stride=10),
-    # Rollouts at variety 0.5 only (the page's), instead of 0.5 and 1 in turn.
-    "follower_own_t05": replace(steady(OURS), state_dropout=0.5, turn_weight=4.0, own_rollouts_from=10,
-                                own_rollouts_temperatures=(0.5,)),
-    "follower_turns_8": replace(steady(OURS), state_dropout=0.5, turn_weight=8.0),
-    "follower_turns_sd70": replace(steady(OURS), state_dropout=0.7, turn_weight=4.0),
-    # The leader's partner is the follower: it gets the same terms (its own weights, above).
-    # The leader reads the figure block (a turn the visitor asks for: features.figure_block),
-    # hidden in half the samples as when nobody asks. Training seed 2: how steadily a leader
-    # dances beside the followers depends on it (100 steered seeds; seconds with a dancer's hips
-    # or head low, or feet wide: seed 1 leader 3 with the contact layer, CCM follower 3; seed 2
-    # none but 1 of the CCM follower; seed 3 leader 8, our follower 7, CCM 37).
-    # Since 2026-11-25 his decoder sees its own state in half the samples, as the followers', and he
-    # trains on his own rollouts (his plan the recorded path laid from where he stands): he dances
-    # (steered, body motion 0.54 m/s against 0.33, the recording 0.83) and the page's upright guard,
-    # the follower's with a 0.07 m margin (training/mirror/guard.py), keeps him up: 0 of 100 steered
-    # seeds with a bad second. Beside him our follower turns 26.0 times a minute, steered (recording 23.0).
-    # Since 2026-11-27 he also reads a hands plan (features.hands_plan_block: where his hands go over
-    # the next second), shown in half the samples: a visitor's request raises his lead hand
-    # through it (rollout.hands_input), and beside him she turns after 77 % of requests against
-    # 58 % of the same moments unasked (the figure block alone: 56 % against 56 %).
-    # Since 2026-11-27 (evening) his foot-contact term is the followers' (weight 100 on the
-    # recorded contacts, where it was 30 on his decoded ones), sparing the samples where his recorded heading turns
-    # faster than 120 degrees a second (TrainConfig.contact_spare_turning). His steered skate in
-    # contact was 2.01x the recording's, 64 % of it his planted foot sliding from where it was;
-    # now 1.28x, and nobody steering he turns 9.5 times a minute (0.82x; before 5.6) and stays
-    # within 1.47 m of his spot (before up to 4.13 m). Without the sparing he stopped turning
-    # (0.7 a minute nobody steering; at 300, none); at 30 on the recorded contacts he turned 13.8
-    # times a minute but had a bad second in 15 of 100 steered seeds (docs/results.md, "His feet").
-    "leader": replace(LEADER_BEFORE_CONTACT, lambda_foot_contact=100.0, recorded_contacts=True,
-                      contact_spare_turning=120.0, tempo_copies=True),
-    # Measured, not shipped (docs/results.md, "He turns on his own"): the samples where his own turn
-    # starts weigh 4x (own_turn_weight). His turns had come from the few seeds where the couple spins
-    # together (nobody steering, the median seed 0.17x the recorded leader's rate; 10 of 12 recorded
-    # takes have his turns); at 4x the median seed turns 0.52x and 90 of 100 seeds turn, 0.68x
-    # pooled, body motion 0.84x, travel 1.01x, and she spins 0.94x (1.44x before), but she follows
-    # 72 % of the requests and fell in the soak (seed 64) following his lunge. At 8x he turns 1.40x
-    # and she, beside him, 1.64x (seeds 0-49).
-    # Fine-tuned from the shipped leader (--init-from runs/models/leader): the hands plan shown in
-    # 80 % of samples, 4 matching epochs at a third of the rate, own rollouts from the first.
-    "leader_plan": replace(LEADER_BEFORE_CONTACT, lambda_foot_contact=100.0, recorded_contacts=True,
-                           contact_spare_turning=120.0, tempo_copies=True, hands_plan_dropout=0.2,
-                           epochs=4, lr=3e-4, own_rollouts_from=0),
-    "leader_plan_onsets": replace(LEADER_BEFORE_CONTACT, lambda_foot_contact=100.0, recorded_contacts=True,
-                                  contact_spare_turning=120.0, tempo_copies=True, hands_plan_dropout=0.2,
-                                  epochs=6, lr=3e-4, own_rollouts_from=0, turn_weight=4.0),
-    "leader_plan_figure": replace(LEADER_BEFORE_CONTACT, lambda_foot_contact=100.0, recorded_contacts=True,
-                                  contact_spare_turning=120.0, tempo_copies=True, hands_plan_dropout=0.2,
-                                  epochs=6, lr=3e-4, own_rollouts_from=0, turn_weight=4.0,
-                                  figure_dropout=0.3, figure_partner_dropout=0.5),
-    # Fine-tuned from the shipped leader: the past paths and key joints hidden in half the samples
-    # (past_dropout), so that the count, not the last steps, says when the next one falls.
-    "leader_past_dropout": replace(LEADER_BEFORE_CONTACT, lambda_foot_contact=100.0, recorded_contacts=True,
-                                   contact_spare_turning=120.0, tempo_copies=True, epochs=6, lr=3e-4,
-                                   own_rollouts_from=0, past_dropout=0.5),
-    "leader_own_turns_4": replace(LEADER_BEFORE_CONTACT, lambda_foot_contact=100.0, recorded_contacts=True,
-                                  contact_spare_turning=120.0, own_turn_weight=4.0),
-    "leader_own_turns_8": replace(LEADER_BEFORE_CONTACT, lambda_foot_contact=100.0, recorded_contacts=True,
-                                  contact_spare_turning=120.0, own_turn_weight=8.0),
-    "leader_recorded_contact": replace(LEADER_BEFORE_CONTACT, lambda_foot_contact=100.0, recorded_contacts=True),
-    "leader_recorded_contact_300": replace(LEADER_BEFORE_CONTACT, lambda_foot_contact=300.0, recorded_contacts=True),
-    "leader_recorded_contact_30": replace(LEADER_BEFORE_CONTACT, lambda_foot_contact=30.0, recorded_contacts=True),
-    # The leader shipped until then (his decoded contacts, weight 30).
-    "leader_before_contact": LEADER_BEFORE_CONTACT,
-    # The leader shipped before that (no hands plan).
-    "leader_before_hands": replace(steady(LEADER_STOP_MOTION), figure_dropout=0.5, state_dropout=0.5,
-                                   own_rollouts_from=10, seed=2),
-    # The leader shipped until then (state always seen, no own rollouts).
-    "leader_before_own": replace(steady(LEADER_STOP_MOTION), figure_dropout=0.5, seed=2),
-    # Measured, not shipped: its decoder sees its own state in only half the samples, as the
-    # followers'. With the state always there the code carries little (the codebook loss stayed at
-    # 0.059 for 20 epochs against 0.033) and, nobody steering, the leader dances little (body
-    # motion 0.42 m/s against the recorded leader's 0.83, no turn of his own); this one dances
-    # (0.53 m/s, 5.6 turns a minute) but steered, 87 of 100 seeds have a second with his head low
-    # or his feet wide (docs/results.md, "A leader that dances"). The second: the figure shown
-    # more often, with the samples where she starts a turn weighed 4x: a request works no better.
-    "leader_state_dropout": replace(steady(LEADER_STOP_MOTION), figure_dropout=0.5, state_dropout=0.5),
-    "leader_lead": replace(steady(LEADER_STOP_MOTION), figure_dropout=0.3, state_dropout=0.5, turn_weight=4.0),
-    # Measured, not shipped: the shipped leader with the samples where he leads her turn (figure
-    # shown, her turn ahead) weighed 4x (figure shown in 70 %) and 8x. Nobody steering, 20 seeds:
-    # a request changes what a detector of his leads sees no more than before (58 % against 52 %
-    # unasked; 26 % against 24 %); at 8x he turns 9.2 times a minute (0.80x the recording, the
-    # shipped leader 0.10x) but moves his body less (0.44x) and she spins less (docs/results.md).
-    "leader_lead_own": replace(steady(LEADER_STOP_MOTION), figure_dropout=0.3, state_dropout=0.5, own_rollouts_from=10,
-                               turn_weight=4.0, seed=2),
-    "leader_lead_own_8": replace(steady(LEADER_STOP_MOTION), figure_dropout=0.5, state_dropout=0.5, own_rollouts_from=10,
-                                 turn_weight=8.0, seed=2),
-    # Measured, not shipped: her blocks hidden in half the samples that show the figure
-    # (figure_partner_dropout), so only the figure explains his lead. A request still changes
-    # nothing a reader of his body sees (8 % against 6 % unasked; with 8x, 43 % and 43 %); with
-    # 8x he turns 16.3 times a minute (1.42x) but moves his body 0.57x (docs/results.md).
-    "leader_figure_alone": replace(steady(LEADER_STOP_MOTION), figure_dropout=0.5, state_dropout=0.5,
-                                   own_rollouts_from=10, figure_partner_dropout=0.5, seed=2),
-    "leader_figure_alone_8": replace(steady(LEADER_STOP_MOTION), figure_dropout=0.5, state_dropout=0.5,
-                                     own_rollouts_from=10, figure_partner_dropout=0.5, turn_weight=8.0, seed=2),
-    # The dancing leader on rollouts of 30 frames: steered, 5 of 20 seeds with a bad second (11 with the layer).
-    # Measured, not shipped: the hands plan shown in 70 % of the samples. Nobody steering (20 seeds),
-    # a request raised his hand above 1.6 m in 47 % (the shipped leader: 80 %) and she turned after
-    # 76 % of requests against 74 % unasked.
-    "leader_hands_30": replace(steady(LEADER_STOP_MOTION), figure_dropout=0.5, state_dropout=0.5, own_rollouts_from=10,
-                               hands_plan_dropout=0.3, seed=2),
-    "leader_own_30": replace(steady(LEADER_STOP_MOTION), figure_dropout=0.5, state_dropout=0.5, own_rollouts_from=10,
-                             own_rollouts_horizon=30, own_rollouts_stride=10, seed=2),
-    # The three before their decoders read the pose (stop-motion, falls; docs/plausibility.md).
-    "leader_stop_motion": LEADER_STOP_MOTION,
-    "follower_stop_motion": OURS,
-    "follower_ccm_stop_motion": CCM,
-    # Only the noise on the own state, the decoder reading the code alone.
-    "follower_state_noise": replace(OURS, state_noise=STATE_NOISE),
-    "follower_ccm_state_noise": replace(CCM, state_noise=STATE_NOISE),
-    # The followers shipped before the state dropout: steady, but less varied (FID 219 at 0.5,
-    # docs/plausibility.md, "Why the follower is less varied"). Without the upright guard, the
-    # state-dropout follower falls in 3-11 % of steered seeds; half the state noise hardly moves
-    # the FID (206 against 219). Measured, not shipped.
-    "follower_steady": steady(OURS),
-    "follower_ccm_steady": steady(CCM),
-    "follower_state_dropout_20": replace(steady(OURS), state_dropout=0.2),
-    "follower_steady_noise_10": replace(steady(OURS), state_noise=0.1),
-    # More dials on the same (docs/plausibility.md, "More dials, and an upright guard"): hidden
-    # half the time with twice or half the state noise, the free runs at variety 0.5 swing wide
-    # (FID 446 and 377); hidden in 30 %, FID 124 but the steered follower falls in 74 of 100 seeds.
-    "follower_state_dropout_noise_40": replace(steady(OURS), state_dropout=0.5, state_noise=0.4),
-    "follower_state_dropout_noise_10": replace(steady(OURS), state_dropout=0.5, state_noise=0.1),
-    "follower_state_dropout_30": replace(steady(OURS), state_dropout=0.3),
-    # Narrower networks (hidden 384 instead of 512): 1.03 MB fewer for a phone's first visit, but
-    # the steered tables refuse them (joint angles, hands, foot skate worse; docs/measurements.md).
-    "follower_narrow": steady(replace(OURS, model=replace(FOLLOWER, hidden=384))),
-    "leader_narrow": steady(replace(LEADER_STOP_MOTION, model=replace(LEADER_STOP_MOTION.model, hidden=384))),
+    # The leader reads the figure block (a turn the visitor asks for: features.figure_block) and
+    # the hands plan (features.hands_plan_block: where his hands go over the next second), each
+    # hidden in half the samples as when nobody asks: a request raises his lead hand through the
+    # plan (rollout.hands_input), and beside him she turns after 77 % of requests against 58 % of
+    # the same moments unasked (the figure block alone: 56 % against 56 %).
+    # His decoder sees its own state in half the samples and he trains on his own rollouts (his plan
+    # the recorded path laid from where he stands), as the followers: he dances (steered, body
+    # motion 0.54 m/s against 0.33 without, the recording 0.83), and the page's upright guard keeps
+    # him up. Training seed 2: how steadily a leader dances beside the followers depends on it (100
+    # steered seeds with a dancer's hips or head low, or feet wide: seed 1, 3 seconds with the
+    # contact layer; seed 2 none but 1 of the CCM follower; seed 3, 8 and 7).
+    # His foot-contact term is the followers' (100 on the recorded contacts), sparing the samples
+    # where his recorded heading turns faster than 120 degrees a second (contact_spare_turning): his
+    # steered skate in contact is 1.28x the recording's (2.01x at 30 on his decoded contacts), and
+    # nobody steering he turns 9.5 times a minute (0.82x) within 1.47 m of his spot. Without the
+    # sparing he stopped turning (0.7 a minute nobody steering; at 300, none); at 30 on the recorded
+    # contacts he had a bad second in 15 of 100 steered seeds (docs/results.md, "His feet").
+    "leader": replace(steady(LEADER), figure_dropout=0.5, hands_plan_dropout=0.5, state_dropout=0.5,
+                      own_rollouts_from=10, lambda_foot_contact=100.0, recorded_contacts=True,
+                      contact_spare_turning=120.0, tempo_copies=True, seed=2),
+    # The paper's ablations, on the recipe without the partner terms (docs/results.md, "The paper's
+    # tables on this data"): a smaller follower (hidden 256), CCM with three times the code channels
+    # (CCM (L)), no adversarial term (w/o GAN), no noise on the intention, and the intention
+    # predictor trained jointly with (and without) scheduled sampling.
     "follower_small": TrainConfig(model=replace(FOLLOWER, hidden=256, intention_hidden=128), intention_noise=0.3),
     "follower_ccm_large": TrainConfig(model=replace(FOLLOWER, intention=False, channels=3 * FOLLOWER.channels)),
     "follower_no_gan": TrainConfig(model=FOLLOWER, lambda_generator=0.0, intention_noise=0.3),
     "follower_no_intention_noise": TrainConfig(model=FOLLOWER),
     "follower_end_to_end": TrainConfig(model=FOLLOWER, end_to_end=True),
     "follower_end_to_end_no_ss": TrainConfig(model=FOLLOWER, end_to_end=True, scheduled_sampling=False),
-    # The shipped pair trained on the tempo copies too: measured, not kept (docs/results.md,
-    # "Learning more from the same frames": FID 89.7 against 107.6, but the follower's feet slide
-    # more in the steered duet, and cross-validated no metric moves outside its interval).
-    "follower_tempo": replace(OURS, tempo_copies=True),
-    "follower_ccm_tempo": replace(CCM, tempo_copies=True),
-    # The shipped pair before proximity augmentation (the recipes training.evaluation.crossval compares).
-    "follower_no_proximity": OURS_NO_PROXIMITY,
-    "follower_ccm_no_proximity": CCM_NO_PROXIMITY,
-    # Partner terms (scripts/partner_terms.sh): one switched off, or another weight or weighting.
-    "follower_no_partner_terms": TrainConfig(model=FOLLOWER, intention_noise=0.3),
-    "follower_no_penetration": partner_variant(lambda_penetration=0.0),
-    "follower_no_foot_contact": partner_variant(lambda_foot_contact=0.0),
-    "follower_no_interaction": partner_variant(lambda_interaction=0.0),
-    "follower_recorded_contact_30": partner_variant(lambda_foot_contact=30.0),
-    "follower_interaction_hands_only": partner_variant(interaction_hands_only=True),
-    "follower_decoded_contact_5": partner_variant(lambda_foot_contact=5.0, recorded_contacts=False),
-    "follower_decoded_contact_10": partner_variant(lambda_foot_contact=10.0, recorded_contacts=False),
-    "follower_decoded_contact_30": partner_variant(lambda_foot_contact=30.0, recorded_contacts=False),
-    "follower_decoded_contact_30_penetration_100": partner_variant(lambda_foot_contact=30.0, recorded_contacts=False,
-                                                                   lambda_penetration=100.0),
 }
 SHIPPED = ["follower", "follower_ccm", "leader"]
 
@@ -612,23 +389,14 @@ def led_onsets(intention_raw: np.ndarray) -> np.ndarray:
 
 
 def onset_weights(cfg: "TrainConfig", x_raw: np.ndarray, y_raw: np.ndarray, j_raw: np.ndarray,
-                  role: str, reader: LeadReader | None = None) -> torch.Tensor:
+                  role: str) -> torch.Tensor:
     """Per-sample weights [N]: 1, turn_weight where a turn starts (turn_onsets), and for a follower
-    with unled_turn_weight that weight where a turn starts that he does not lead: by his hand
-    (led_onsets), or with cfg.led_by "body" by his body as `reader` reads it."""
+    with unled_turn_weight that weight where a turn starts that his hand does not lead (led_onsets)."""
     w = torch.ones(len(x_raw))
     onsets = turn_onsets(x_raw, y_raw, role)
     w[torch.from_numpy(onsets)] = cfg.turn_weight
     if cfg.unled_turn_weight is not None and role != "leader":
-        if cfg.led_by == "body":
-            if reader is None:
-                raise TrainError("led_by 'body' needs the lead reader fitted on the recorded samples")
-            led = reader.led(x_raw, y_raw)
-        elif cfg.led_by == "hand":
-            led = led_onsets(j_raw)
-        else:
-            raise TrainError(f"led_by {cfg.led_by!r}: 'hand' or 'body'")
-        w[torch.from_numpy(onsets & ~led)] = cfg.unled_turn_weight
+        w[torch.from_numpy(onsets & ~led_onsets(j_raw))] = cfg.unled_turn_weight
     return w
 
 
@@ -639,8 +407,8 @@ def cosine(step: int, total: int, lr: float) -> float:
 
 
 def saved_config(config: dict | None) -> dict | None:
-    """A checkpoint's recipe as asdict(TrainConfig) gives it today: model fields added since it was
-    saved (ModelConfig.decoder_music) take their defaults, which are what it was trained with."""
+    """A checkpoint's recipe as asdict(TrainConfig) gives it: model fields the checkpoint lacks
+    (ModelConfig.decoder_music) take their defaults, which are what it was trained with."""
     if not config or "model" not in config:
         return config
     return {**config, "model": asdict(ModelConfig(**config["model"]))}
@@ -668,12 +436,7 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
     mirrored = torch.from_numpy(load_mirror_flags(data, cfg.tempo_copies)).long()
     couples = load_couples(data) if cfg.own_rollouts_from is not None else []
     y, j = normalize(train["output"], stats, "output"), normalize(train["intention"], stats, "intention")
-    # The lead reader is fitted once, on the recorded samples (the tempo copies follow them), and
-    # reads the own rollouts' samples too.
-    n_recorded = len(load_mirror_flags(data))
-    reader = (LeadReader.fit(train["input"][:n_recorded], train["output"][:n_recorded])
-              if cfg.led_by == "body" and cfg.unled_turn_weight is not None and role != "leader" else None)
-    sample_weight = (onset_weights(cfg, train["input"], train["output"], train["intention"], role, reader)
+    sample_weight = (onset_weights(cfg, train["input"], train["output"], train["intention"], role)
                      if cfg.turn_weight != 1.0 else torch.ones(len(xr)))
     own_weight = own_onset_weights(cfg, train["input"], train["output"], role)
     weighted = cfg.turn_weight != 1.0 or cfg.own_turn_weight != 1.0
@@ -839,7 +602,7 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
             xr = torch.cat([xr[:recorded_n], torch.from_numpy(rolled["input"])])
             y = torch.cat([y[:recorded_n], normalize(rolled["output"], stats, "output")])
             j = torch.cat([j[:recorded_n], normalize(rolled["intention"], stats, "intention")])
-            w_own = (onset_weights(cfg, rolled["input"], rolled["output"], rolled["intention"], role, reader)
+            w_own = (onset_weights(cfg, rolled["input"], rolled["output"], rolled["intention"], role)
                      if cfg.turn_weight != 1.0 else torch.ones(len(rolled["input"])))
             sample_weight = torch.cat([sample_weight[:recorded_n], w_own])
             own_weight = torch.cat([own_weight[:recorded_n],
