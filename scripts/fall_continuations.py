@@ -14,8 +14,8 @@ matters, in minutes instead of a 40-minute soak each.
 
 A variant is `base` (the manifest as it is) or options joined by `+`: an evaluation option by its
 attribute name (guard, guard_margin, guard_hip_margin, guard_partner_low,
-guard_partner_low_hip_margin, guard_hip_drop, leader_guard, on_count, on_count_strength,
-on_count_hips, on_count_spin_keep, on_count_turn_start: training/evaluation/options.py) or a leader guard
+guard_partner_low_hip_margin, leader_guard, on_count, on_count_strength, on_count_hips:
+training/evaluation/options.py) or a leader guard
 field of the manifest as `leader.FIELD` (margin, headMargin, hipMargin), or `follower=FILE.onnx` /
 `leader=FILE.onnx`: another network dances on from the same moments (the duet up to them is the
 --models pair's), which compares trained networks (another --seed) where the fall was made. --rollout VARIANT dances the
@@ -33,13 +33,13 @@ import numpy as np
 
 from training.evaluation import options as O
 from training.evaluation import plausibility as P
-from training.evaluation.soak import steering_script
+from training.evaluation.duet import steering_script
 from training.mirror.rollout import NOW, OnnxPolicy, start_duet, step
 from training.mirror.skeleton import FPS
 
 OPTIONS = ("temperature", "follower_temperature", "guard", "guard_margin", "guard_hip_margin",
-           "guard_partner_low", "guard_partner_low_hip_margin", "guard_hip_drop", "leader_guard",
-           "on_count", "on_count_strength", "on_count_hips", "on_count_spin_keep", "on_count_turn_start")
+           "guard_partner_low", "guard_partner_low_hip_margin", "leader_guard",
+           "on_count", "on_count_strength", "on_count_hips")
 WHOLE = ("guard", "leader_guard", "on_count")   # options that count samples
 
 

@@ -30,7 +30,7 @@ from training.evaluation import options as O
 from training.evaluation import plausibility as P
 from training.evaluation.evaluate_inputs import find_models, load_onnx
 from training.evaluation.lead import unasked_duet
-from training.evaluation.soak import soak_one
+from training.evaluation.duet import soak_one
 from training.mirror.skeleton import FPS, PARENTS
 
 ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -101,8 +101,7 @@ for k, ax in enumerate(axes.flat):
     # Flagged within the half second this frame stands for (a guard's choice is a single step).
     ax.set_title(f"t={t / FPS:.1f} s{'  ' + label if bad[t:t + FPS // 2].any() else ''}", fontsize=9)
 mode = "nobody steering" if args.nobody_steering else "steered"
-drop = f", hip drop {args.guard_hip_drop:g} m" if args.guard_hip_drop else ""
-guard = f" (guard K={args.guard}, {args.guard_margin:g} m{drop})" if args.guard else ""
+guard = f" (guard K={args.guard}, {args.guard_margin:g} m)" if args.guard else ""
 which = f"the 6 s from {args.at:g} s" if args.at is not None else f"the 6 s with most {args.dancer} frames flagged"
 fig.suptitle(f"{args.models}, {mode} seed {args.seed}{guard}: {which} ({label}: {bad.mean():.1%} of the "
              f"{args.dancer}'s frames), side view (x, height), a frame every 0.5 s")

@@ -252,44 +252,19 @@ def test_her_spin_steps_on_the_count_among_the_samples_that_keep_it():
         OC.OnCount("follower", spin_keep=-0.5)
 
 
-@pytest.mark.parametrize("key, option, attr, value, off, bad", [
-    ("spinKeep", "--on-count-spin-keep", "spin_keep", 0.7, "-1", "-0.5"),
-    ("turnStart", "--on-count-turn-start", "turn_start", 180.0, "-1", "0"),
-])
-def test_options_give_her_the_manifests_choices_and_him_none(key, option, attr, value, off, bad):
-    """The manifest's onCount.spinKeep and .turnStart reach her chooser, never his; -1 turns each
-    off; a manifest without the key leaves it off, as the page does."""
-    m = {"defaultTemperature": 1.0, "leaderTemperature": 0.5, "plausibility": RANGES,
-         "skeleton": {"offsets": {"follower": OFFSETS.tolist(), "leader": OFFSETS.tolist()}},
-         "guard": {"samples": 32, "margin": 0.05}, "leaderGuard": {"samples": 8, "margin": 0.07},
-         "onCount": {"samples": 8, "strength": 1.0, "hips": 1.0, key: value}}
-    dest = "on_count_" + attr
-    args = parse()
-    assert O.resolve(args, m) is None and getattr(args, dest) == value
-    assert getattr(O.follower_policy(policy_stub, m, args, 0.5).on_count, attr) == value
-    assert getattr(O.leader_policy(policy_stub, m, args).on_count, attr) is None
-    args = parse(option, off)
-    assert O.resolve(args, m) is None and getattr(O.follower_policy(policy_stub, m, args, 0.5).on_count, attr) is None
-    without = m | {"onCount": {"samples": 8, "strength": 1.0}}
-    args = parse()
-    assert O.resolve(args, without) is None and getattr(args, dest) == -1
-    assert getattr(O.follower_policy(policy_stub, without, args, 0.5).on_count, attr) is None
-    assert option in O.resolve(parse(option, bad), m)
-
-
 def test_every_option_reaches_the_seeds_workers():
     """seeds builds its dancers in worker processes from a dict of the resolved options: it takes
-    every option add_options adds, so a new one (as --on-count-spin-keep was) cannot be left out."""
+    every option add_options adds, so a new one cannot be left out."""
     names = O.option_names()
-    assert {"on_count_spin_keep", "on_count_hips", "guard_hip_drop", "leader_guard", "tempo"} <= set(names)
-    args = parse("--on-count-spin-keep", "0.5")
+    assert {"on_count_hips", "on_count_strength", "leader_guard", "tempo"} <= set(names)
+    args = parse("--on-count-hips", "0.5")
     m = {"defaultTemperature": 1.0, "leaderTemperature": 0.5, "plausibility": RANGES,
          "skeleton": {"offsets": {"follower": OFFSETS.tolist(), "leader": OFFSETS.tolist()}},
          "guard": {"samples": 32, "margin": 0.05}, "leaderGuard": {"samples": 8, "margin": 0.07},
          "onCount": {"samples": 8, "strength": 1.0}}
     assert O.resolve(args, m) is None
     again = argparse.Namespace(**{k: getattr(args, k) for k in names})   # what a worker gets
-    assert O.follower_policy(policy_stub, m, again, 0.5).on_count.spin_keep == 0.5
+    assert O.follower_policy(policy_stub, m, again, 0.5).on_count.hips == 0.5
 
 
 def turning_output(footwork: float, degrees: float, hip: float = 1.0) -> np.ndarray:

@@ -125,16 +125,3 @@ def test_the_shipped_manifest_carries_the_guards_export_writes():
     if G.LEADER_KEEP_PLAN:
         leader["keepPlan"] = True
     assert shipped["guard"] == follower and shipped["leaderGuard"] == leader
-
-
-def test_her_guard_reads_a_hip_drop_from_the_option_or_the_manifest():
-    m = manifest(guard={"samples": 8, "margin": 0.05})
-    args = parse()
-    assert O.resolve(args, m) is None and args.guard_hip_drop is None
-    assert O.follower_policy(policy, m, args, 1.0).hip_drop is None          # the page's manifest: never
-    args = parse("--guard-hip-drop", "0.015")
-    assert O.resolve(args, m) is None and O.follower_policy(policy, m, args, 1.0).hip_drop == 0.015
-    dropping = manifest(guard={"samples": 8, "margin": 0.05, "hipDrop": 0.02})
-    args = parse()
-    assert O.resolve(args, dropping) is None and O.follower_policy(policy, dropping, args, 1.0).hip_drop == 0.02
-    assert "--guard-hip-drop" in O.resolve(parse("--guard-hip-drop", "0"), m)

@@ -6,14 +6,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from training.evaluation import soak
+from training.evaluation import duet, soak
 from training.mirror.skeleton import FPS
 
 MODELS = Path(__file__).resolve().parents[2] / "public" / "models"
 
 
 def test_steering_script_has_idles_holds_and_reversals():
-    sticks = soak.steering_script(np.random.default_rng(3), 20 * 60 * FPS)
+    sticks = duet.steering_script(np.random.default_rng(3), 20 * 60 * FPS)
     assert np.all(np.linalg.norm(sticks, axis=1) <= 1 + 1e-9)
     idle = ~sticks.any(1)
     assert 0.05 < idle.mean() < 0.6
@@ -150,16 +150,17 @@ def test_fall_continuations_swap_in_another_network(capsys):
 
 
 def test_fall_continuations_set_the_choice_on_the_count():
-    """The choice on the count's options are variants too (her spins kept on the count, her turn
-    starts, its samples), each reaching only the dancer it belongs to; a bad value is refused."""
+    """The choice on the count's options are variants too (its samples, how the hips weigh), each
+    reaching both dancers' choosers; the manifest is untouched; a bad value is refused."""
     fc = _fall_continuations()
     manifest = json.loads((MODELS / "manifest.json").read_text())
-    lead, follow, _ = fc.policies(manifest, None, None, "on_count_spin_keep=0.7+on_count_turn_start=120+on_count=4")
-    assert (follow.on_count.spin_keep, follow.on_count.turn_start, follow.on_count.samples) == (0.7, 120.0, 4)
-    assert (lead.on_count.spin_keep, lead.on_count.turn_start, lead.on_count.samples) == (None, None, 4)
-    assert "spinKeep" not in manifest.get("onCount", {})           # the manifest itself is untouched
-    with pytest.raises(SystemExit, match="on-count-turn-start 0"):
-        fc.policies(manifest, None, None, "on_count_turn_start=0")
+    before = json.dumps(manifest, sort_keys=True)
+    lead, follow, _ = fc.policies(manifest, None, None, "on_count_hips=0.5+on_count=4")
+    assert (follow.on_count.hips, follow.on_count.samples) == (0.5, 4)
+    assert (lead.on_count.hips, lead.on_count.samples) == (0.5, 4)
+    assert json.dumps(manifest, sort_keys=True) == before          # the manifest itself is untouched
+    with pytest.raises(SystemExit, match="on-count-hips -1"):
+        fc.policies(manifest, None, None, "on_count_hips=-1")
 
 
 def test_fall_continuations_refuse_an_unknown_setting():

@@ -219,18 +219,6 @@ describe('createSimulation', () => {
     expect(fallen.sim.guards().upright).toBe(1);
     const q = fallen.sim.followers[0].positions;
     expect(q[4 * 3 + 1] - q[1]).toBeGreaterThan(0.4);
-    // Her spins are kept on the count with the manifest's spinKeep; his never (his walks round are his network's).
-    const spinning = simulation([{ role: 'follower' }], { role: 'leader' }, { ...counted, onCount: { samples: 3, strength: 1, spinKeep: 0.7 } });
-    const choosers = spinning.sim as unknown as { followerOnCount: { spinKeep: number | null }[]; leaderOnCount: { spinKeep: number | null } };
-    expect(choosers.followerOnCount[0].spinKeep).toBe(0.7);
-    expect(choosers.leaderOnCount.spinKeep).toBeNull();
-    expect((sim as unknown as typeof choosers).followerOnCount[0].spinKeep).toBeNull(); // absent: left to her network
-    // Her turn starts are preferred outside a spin with the manifest's turnStart; his never.
-    const starting = simulation([{ role: 'follower' }], { role: 'leader' }, { ...counted, onCount: { samples: 3, strength: 1, turnStart: 120 } });
-    const starters = starting.sim as unknown as { followerOnCount: { turnStart: number | null }[]; leaderOnCount: { turnStart: number | null } };
-    expect(starters.followerOnCount[0].turnStart).toBe(120);
-    expect(starters.leaderOnCount.turnStart).toBeNull();
-    expect((sim as unknown as typeof starters).followerOnCount[0].turnStart).toBeNull(); // absent: none preferred
     // Without onCount each takes its one sample, as before.
     const plain = simulation([{ role: 'follower' }], { role: 'leader' }, { ...counted, onCount: undefined });
     await plain.sim.step(steer, 1);

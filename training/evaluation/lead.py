@@ -209,7 +209,8 @@ def dancing_summary(per_seed: list[dict], ref: dict) -> dict:
         pooled = Fg.summarize(items)
         worst = min(range(len(items)), key=lambda i: items[i]["turns_per_min"])
         # The median seed too: a few seeds where the couple spins together like a top can carry the
-        # pooled rate while most seeds hardly turn (the leader of 2026-11-28 over seeds 0-49: pooled 0.67x, median seed 2/min).
+        # pooled rate while most seeds hardly turn (one leader measured over
+        # seeds 0-49: pooled 0.67x, median seed 2/min).
         out[who] = {**pooled, "ratio": Fg.ratios(pooled, ref[who]),
                     "worst_seed": per_seed[worst]["seed"], "worst_turns_per_min": items[worst]["turns_per_min"],
                     "median_turns_per_min": float(np.median([i["turns_per_min"] for i in items]))}
@@ -217,6 +218,12 @@ def dancing_summary(per_seed: list[dict], ref: dict) -> dict:
     out["leader_from_start_m"] = {"median": float(np.median(far)), "max": float(np.max(far)),
                                   "worst_seed": per_seed[int(np.argmax(far))]["seed"]}
     return out
+
+
+def times(value: float, reference: float) -> str:
+    """value as a multiple of reference ("1.25×"); "–" where the recording has none of it (a
+    recorded dancer who never turns)."""
+    return f"{value / reference:.2f}×" if reference else "–"
 
 
 def dancing_table(s: dict, ref: dict) -> list[str]:
@@ -228,7 +235,7 @@ def dancing_table(s: dict, ref: dict) -> list[str]:
         L.append(f"| recorded {who} | {f0['turns_per_min']:.1f} | – | {100 * f0['spin_frames']:.1f} % | "
                  f"{f0['body_motion']:.2f} | {f0['travel']:.2f} | – |")
         L.append(f"| {who} | {r['turns_per_min']:.1f} ({q['turns_per_min']:.2f}×) | "
-                 f"{r['median_turns_per_min']:.1f} ({r['median_turns_per_min'] / f0['turns_per_min']:.2f}×) | {100 * r['spin_frames']:.1f} % "
+                 f"{r['median_turns_per_min']:.1f} ({times(r['median_turns_per_min'], f0['turns_per_min'])}) | {100 * r['spin_frames']:.1f} % "
                  f"({q['spin_frames']:.2f}×) | {r['body_motion']:.2f} ({q['body_motion']:.2f}×) | {r['travel']:.2f} "
                  f"({q['travel']:.2f}×) | seed {r['worst_seed']}: {r['worst_turns_per_min']:.1f}/min |")
     far = s["leader_from_start_m"]

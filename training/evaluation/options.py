@@ -41,10 +41,6 @@ def add_options(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--guard-partner-low-hip-margin", type=float, default=None, metavar="M",
                     help="metres before the hips' edge her guard acts while his hips are low "
                          "(default: the manifest's guard.partnerLowHipMargin)")
-    ap.add_argument("--guard-hip-drop", type=float, default=None, metavar="M",
-                    help="her guard also chooses when a step would take her hips down more than M metres "
-                         "(to below guard.HIP_DROP_BELOW; measured, not in the page; default: the manifest's "
-                         "guard.hipDrop, else never)")
     ap.add_argument("--on-count", type=int, default=None, metavar="K",
                     help="both dancers' guards choose, every step, the one of K samples whose footwork follows "
                          "the count (training/mirror/on_count.py; 0: off; default: the manifest's onCount.samples)")
@@ -53,14 +49,6 @@ def add_options(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--on-count-hips", type=float, default=None, metavar="W",
                     help="m/s added to the footwork's miss of a candidate whose hips turn back; 0: the hips left alone, "
                          "and a turn's step the network's own (default: the manifest's onCount.hips)")
-    ap.add_argument("--on-count-spin-keep", type=float, default=None, metavar="F",
-                    help="her spins on the count too, among the samples that keep the spin at F times her turn "
-                         "rate or faster; -1: her spins left to the network (default: the manifest's "
-                         "onCount.spinKeep, else -1)")
-    ap.add_argument("--on-count-turn-start", type=float, default=None, metavar="DEG",
-                    help="outside a spin, her choice on the count prefers the samples whose planned path turns "
-                         "DEG degrees or more over the next second, when any stands; -1: none preferred "
-                         "(default: the manifest's onCount.turnStart, else -1)")
     ap.add_argument("--leader-guard", type=int, default=None, metavar="K",
                     help="the leader's upright guard with K samples (0: off; default: the manifest's "
                          "leaderGuard, acting at its margin)")
@@ -95,10 +83,6 @@ def resolve(args, manifest: dict) -> str | None:
         return "the guard's partnerLow needs a partnerLowHipMargin (--guard-partner-low-hip-margin)"
     if args.guard_partner_low_hip_margin is not None and args.guard_partner_low_hip_margin < 0:
         return f"--guard-partner-low-hip-margin {args.guard_partner_low_hip_margin}: metres, 0 or more"
-    if getattr(args, "guard_hip_drop", None) is None:
-        args.guard_hip_drop = guard.get("hipDrop")
-    if args.guard_hip_drop is not None and args.guard_hip_drop <= 0:
-        return f"--guard-hip-drop {args.guard_hip_drop}: metres a step, more than 0"
     if getattr(args, "leader_guard", None) is None:
         args.leader_guard = int((manifest.get("leaderGuard") or {}).get("samples", 0))
     if args.leader_guard < 0 or args.leader_guard == 1:
@@ -114,20 +98,12 @@ def resolve(args, manifest: dict) -> str | None:
         args.on_count_strength = float(on_count.get("strength", ON_COUNT_STRENGTH))
     if getattr(args, "on_count_hips", None) is None:
         args.on_count_hips = float(on_count.get("hips", ON_COUNT_HIPS))
-    if getattr(args, "on_count_spin_keep", None) is None:
-        args.on_count_spin_keep = float(on_count.get("spinKeep", -1.0))
-    if getattr(args, "on_count_turn_start", None) is None:
-        args.on_count_turn_start = float(on_count.get("turnStart", -1.0))
-    if not (args.on_count_turn_start > 0 or args.on_count_turn_start == -1):
-        return f"--on-count-turn-start {args.on_count_turn_start:g}: -1 (none preferred) or more than 0 degrees"
     if args.on_count < 0 or args.on_count == 1:
         return f"--on-count {args.on_count}: 0 (off) or at least 2 samples to choose from"
     if not 0 <= args.on_count_strength <= 1:
         return f"--on-count-strength {args.on_count_strength:g}: 0 to 1"
     if not args.on_count_hips >= 0:
         return f"--on-count-hips {args.on_count_hips:g}: 0 (the hips left alone) or more m/s"
-    if not (args.on_count_spin_keep >= 0 or args.on_count_spin_keep == -1):
-        return f"--on-count-spin-keep {args.on_count_spin_keep:g}: -1 (her spins left to the network) or 0 or more"
     if args.on_count and not (args.guard or args.leader_guard):
         return "--on-count chooses inside the upright guards: it needs --guard or --leader-guard"
     if args.guard and not manifest.get("plausibility"):
@@ -144,12 +120,11 @@ def follower_policy(policy, manifest: dict, args, leader_temperature: float):
         hips = getattr(args, "guard_hip_margin", None)
         low = getattr(args, "guard_partner_low", None) or None          # 0: never
         low_margin = getattr(args, "guard_partner_low_hip_margin", None)
-        drop = getattr(args, "guard_hip_drop", None)
         return UprightGuard(policy, manifest["plausibility"], args.guard, temperature, args.guard_margin,
                             manifest["skeleton"]["offsets"]["follower"], hip_margin=None if hips is None else float(hips),
                             partner_low=None if low is None else float(low),
                             partner_low_hip_margin=None if low is None or low_margin is None else float(low_margin),
-                            hip_drop=None if drop is None else float(drop), on_count=on_count_for("follower", args))
+                            on_count=on_count_for("follower", args))
     return policy if temperature is None else Variety(policy, temperature)
 
 
@@ -182,13 +157,8 @@ def on_count_for(role: str, args) -> OnCount | None:
     samples = getattr(args, "on_count", 0) or 0
     if not samples:
         return None
-    keep = getattr(args, "on_count_spin_keep", -1.0)
-    start = getattr(args, "on_count_turn_start", -1.0)
-    her = role == "follower"
     return OnCount(role, samples, getattr(args, "on_count_strength", ON_COUNT_STRENGTH),
-                   getattr(args, "on_count_hips", ON_COUNT_HIPS),
-                   spin_keep=keep if her and keep is not None and keep >= 0 else None,
-                   turn_start=start if her and start is not None and start > 0 else None)
+                   getattr(args, "on_count_hips", ON_COUNT_HIPS))
 
 
 def restart_count(policy) -> None:

@@ -24,7 +24,7 @@ def setup_distributed(device: str) -> tuple[int, int]:
 def wait_for_all(world: int) -> None:
     """Every process waits here until all have arrived. After training, rank 0 alone still plots
     and writes the run's files: a process that tore the group down meanwhile died at exit
-    ("terminate called without an active exception", in the two-process test of 2026-11-24)."""
+    ("terminate called without an active exception", in the two-process test)."""
     if world > 1:
         dist.barrier()
 

@@ -42,7 +42,7 @@ MANIFEST_VERSION = 1
 OPSET = 18
 # Each dancer's variety (Gumbel temperature). The follower's is the page's slider. At 1 the 24
 # code channels are drawn each on its own, and a mix of "turn" and "step" channels decodes to a
-# step: beside the recorded leader the follower of 2026-11-24 turned 1.9 times a minute at 1 against
+# step: beside the recorded leader a follower trained without own rollouts turned 1.9 times a minute at 1 against
 # 11.5 at 0.5 (the recording: 25.9). Lower varieties then let a follower sink beside our steered
 # leader, so the page kept 1; the followers trained on their own rollouts (train.py) sink in none
 # of 20 steered seeds down to 0.35, and turn 25.9 times a minute at 0.5 beside the recorded leader
@@ -194,12 +194,8 @@ def write_manifest(out: Path, models: dict[str, StepModel], data: str, prepared:
                         **({} if LEADER_HIP_MARGIN is None else {"hipMargin": LEADER_HIP_MARGIN}),
                         **({"keepPlan": True} if LEADER_KEEP_PLAN else {})},
         # Both guards choose, every step, the sample whose footwork follows the count
-        # (training/mirror/on_count.py, web/mirror/on_count.ts); with SPIN_KEEP her spins among the
-        # samples that keep them, with TURN_START_DEGREES her steps outside a spin among the
-        # samples that start a turn when any does (both measured, not shipped: None).
-        "onCount": {"samples": on_count.SAMPLES, "strength": on_count.STRENGTH, "hips": on_count.HIPS,
-                    **({} if on_count.SPIN_KEEP is None else {"spinKeep": on_count.SPIN_KEEP}),
-                    **({} if on_count.TURN_START_DEGREES is None else {"turnStart": on_count.TURN_START_DEGREES})},
+        # (training/mirror/on_count.py, web/mirror/on_count.ts).
+        "onCount": {"samples": on_count.SAMPLES, "strength": on_count.STRENGTH, "hips": on_count.HIPS},
         # The training dancers' range (evaluation.plausibility): soak counts a collapse against it
         # and training.evaluation.seeds judges every steered frame against it.
         "plausibility": plausibility_ranges(prepared),

@@ -57,15 +57,6 @@ FOLLOWER_HIP_MARGIN: float | None = 0.15   # m
 # None: no such rule.
 PARTNER_LOW: float | None = 0.88   # m, his hip height in her input
 PARTNER_LOW_HIP_MARGIN = 0.20      # m
-# Measured, not in the page yet (web/mirror/guard.ts does not mirror it, so export writes no
-# "hipDrop"): the soak's falls beside the leader who turns on his own start with her hips sinking
-# 2-3 cm a step from about 0.99 m, and by the time they are within any hip margin every sample is
-# low. With hip_drop, the guard also chooses when the step it drew takes her hips down by more than
-# hip_drop metres to below HIP_DROP_BELOW. The recorded follower's hips do that in 1.1 % of her
-# frames (1.5 cm, 0.93 m). At 0.015 m, continued from the five soak falls of that pair, she fell in
-# 1 of 150 instead of 4, and the least steady seed of her recipe in 26 instead of 37: it helps, it
-# does not cure (docs/results.md, "Five seeds of one follower"). Evaluation: --guard-hip-drop M.
-HIP_DROP_BELOW = 0.93   # m
 # The leader trained on his own rollouts dances (steered, body motion 0.54 m/s over 100 seeds against 0.33 before) but,
 # steered, a few seeds had a second with his hips low. The same guard, acting from LEADER_MARGIN
 # before the range's edge (40 steered seeds): 0.05 m acted in 3.9 % of his steps and left 1 seed
@@ -83,10 +74,10 @@ LEADER_MARGIN = 0.07   # m
 # docs/results.md, "The leader's guard" and "Room for his head, her hips guarded".
 LEADER_HEAD_MARGIN: float | None = 0.03   # m; None: the head is judged from LEADER_MARGIN
 # His hips, like hers, go down in a crouch that no sample brings back up once it is low: the one
-# steered seed with a bad second beside the leader of 2026-11-27 (seed 61) crouched from 55.5 s on,
+# steered seed with a bad second while his hips were judged from LEADER_MARGIN (seed 61) crouched from 55.5 s on,
 # hips down to 0.47 m, his guard choosing in 70 steps without finding a standing sample. Judged
 # from 0.10 m (it acts while the drawn hips are under 0.813 m, below his lunges at 0.84-0.86 m), 100
-# steered seeds had no bad second and his guard chose in 0.20 % of his steps (0.23 % before);
+# steered seeds had no bad second and his guard chose in 0.20 % of his steps (0.23 % from LEADER_MARGIN);
 # nobody steering he turns and moves as before (docs/results.md, "His hips guarded").
 LEADER_HIP_MARGIN: float | None = 0.10    # m; None: the hips are judged from LEADER_MARGIN
 # While a request runs, his guard also keeps his lead hand to the hands plan: every step it draws
@@ -106,7 +97,6 @@ HAND_HEIGHTS = [feat.block_slices(feat.LEADER_INPUT_LAYOUT)["self_pose"].start +
 HAND_PLAN_FIRST = [HANDS_PLAN_SHOWN + 1 + 3 * k + 1 for k in range(len(HANDS))]
 # The partner's hip height in a follower's input (the pose block's first joint, y, in her root space).
 PARTNER_HIPS = feat.block_slices(feat.FOLLOWER_INPUT_LAYOUT)["partner_pose"].start + 1
-SELF_HIPS = feat.block_slices(feat.FOLLOWER_INPUT_LAYOUT)["self_pose"].start + 1   # her hips' height now
 
 
 def drawn_joints(outputs: np.ndarray, offsets: np.ndarray) -> np.ndarray:
@@ -215,17 +205,6 @@ def hip_slack_for(x: np.ndarray, margin: float, hip_margin: float | None, partne
     return 0.0 if hip_margin is None else margin - hip_margin
 
 
-def drops(x: np.ndarray, joints: np.ndarray, hip_drop: float | None, below: float = HIP_DROP_BELOW) -> bool:
-    """Whether the first body drawn [B, 17, 3] (drawn_joints) takes a follower (input x) whose hips
-    are now at x's height more than `hip_drop` metres down, to under `below` (never without
-    hip_drop, or for a leader's input)."""
-    first = np.atleast_2d(x)[0]
-    if hip_drop is None or len(first) != feat.INPUT_SIZE:
-        return False
-    hips = joints[0, 0, 1]
-    return bool(hips < below and first[SELF_HIPS] - hips > hip_drop)
-
-
 class UprightGuard:
     """Wraps a policy (x, temperature, rng) -> {output, intention, ...}; `guarded` counts the steps
     in which it picked another sample (reset it per duet). `temperature` overrides the one the
@@ -233,9 +212,7 @@ class UprightGuard:
     (the leader's): the head over the hips is judged from that margin instead, except while his
     input shows a hands plan. `hip_margin` (both dancers'): the hips are judged from that margin;
     `partner_low`, `partner_low_hip_margin` (hers): from that one while her input shows his hips
-    below that height. `hip_drop` (hers, measured, not in the page): it also chooses when the
-    drawn step takes her hips down by more than that, to below `hip_drop_below` (drops).
-    `keep_plan` (his): while his input shows a hands plan, every step draws the samples and takes
+    below that height. `keep_plan` (his): while his input shows a hands plan, every step draws the samples and takes
     the standing one whose lead hand is nearest the plan (nearest_plan); `kept` counts those
     steps, `guarded` the ones among them where none stood. `on_count` (both dancers', an
     on_count.OnCount): every step draws its samples and takes the standing one whose footwork
@@ -247,7 +224,6 @@ class UprightGuard:
                  margin: float = MARGIN, offsets: np.ndarray | None = None, head_margin: float | None = None,
                  hip_margin: float | None = None, partner_low: float | None = None,
                  partner_low_hip_margin: float | None = None, keep_plan: bool = False,
-                 hip_drop: float | None = None, hip_drop_below: float = HIP_DROP_BELOW,
                  on_count: OnCount | None = None):
         if samples < 2:
             raise ValueError("the guard needs at least 2 samples to choose from")
@@ -255,9 +231,7 @@ class UprightGuard:
         self.margin, self.offsets, self.head_margin = margin, offsets, head_margin
         self.hip_margin, self.partner_low, self.partner_low_hip_margin = hip_margin, partner_low, partner_low_hip_margin
         self.hip_slack = 0.0 if hip_margin is None else margin - hip_margin   # while he stands tall
-        self.keep_plan, self.hip_drop, self.hip_drop_below = keep_plan, hip_drop, hip_drop_below
-        if hip_drop is not None and offsets is None:
-            raise ValueError("judging her hips' drop needs the dancer's bones (offsets)")
+        self.keep_plan = keep_plan
         if keep_plan and offsets is None:
             raise ValueError("keeping the hand to the plan needs the dancer's bones (offsets)")
         if on_count is not None and offsets is None:
@@ -281,9 +255,6 @@ class UprightGuard:
             many = self.policy(np.repeat(np.atleast_2d(x), self.on_count.samples, 0), t, rng)
             joints = drawn_joints(many["output"], self.offsets)
             standing = drawn_margin(joints, self.ranges, slack, hips)
-            if self.hip_drop is not None:   # a drop judged per candidate, as below for one
-                standing = np.array([-np.inf if drops(x, joints[i:i + 1], self.hip_drop, self.hip_drop_below)
-                                     else m for i, m in enumerate(standing)])
             steps = drawn_steps(many["output"], joints, x, self.on_count.role)
             best = nearest_count(drawn_footwork(steps), hips_turn_back(steps, x, self.on_count.role), target, standing,
                                  self.margin, self.on_count.hips, self.on_count.keeps(many["output"]),
@@ -295,13 +266,7 @@ class UprightGuard:
             best = most_upright(many["output"], self.ranges, self.offsets, slack, hips)
             return {k: v[best:best + 1] for k, v in many.items()}
         out = self.policy(x, t, rng)
-        if self.hip_drop is None:
-            stands = upright_margin(out["output"], self.ranges, self.offsets, slack, hips)[0] >= self.margin
-        else:   # the body drawn once for both judgements (hip_drop needs the bones: __init__)
-            joints = drawn_joints(out["output"], self.offsets)
-            stands = (drawn_margin(joints, self.ranges, slack, hips)[0] >= self.margin
-                      and not drops(x, joints, self.hip_drop, self.hip_drop_below))
-        if stands:
+        if upright_margin(out["output"], self.ranges, self.offsets, slack, hips)[0] >= self.margin:
             return out
         self.guarded += 1
         many = self.policy(np.repeat(np.atleast_2d(x), self.samples, 0), t, rng)

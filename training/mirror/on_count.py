@@ -32,25 +32,10 @@ count, and the pull on it broke her turns off (15.0 turns a minute, 0.65x the re
 against 16.5 with her spins left alone; 10 seeds of `seeds`); his walks round went from 9.6 to 4.6
 a minute, nobody steering, with his feet pulled from 3 rad/s (50 seeds of `lead`).
 
-Two more choices, measured and not shipped (the manifest carries neither; docs/music.md):
-
-- With a SPIN_KEEP, a spinning dancer's footwork is chosen on the count among the samples that keep
-  the spin going (their root turns the same way at SPIN_KEEP times her turn rate now or faster;
-  keeps_spin), so the pull cannot take the spin out of her; only when none of the standing samples
-  keeps it is the footwork left alone as above. At 0.7, over 100 steered seeds x 60 s (`seeds
-  --methods ours --on-count-spin-keep 0.7`) her pulse is 0.83x the recording's, 0.71x with her
-  spins left alone, her turns and requests as they are; but the full soak lost 1 of 100 rollouts
-  with it (rollout 20, a fall beside his lunge outside any spin) and none without. Over 20 seeds x
-  20 s (`rhythm --tempos 170`) other shares gave: 0.5, pulse 0.89x / 0.94x (steered / nobody
-  steering) but her spins slower (spin frames 0.53x) and 48 % of requests; 0.8, 0.84x / 0.79x;
-  0.95, 0.72x / 0.79x.
-- With a TURN_START_DEGREES, outside a spin the standing samples whose planned path turns that much
-  or more over the next second (starts_turn, either way) are aimed at the count before the others,
-  when any stands (OnCount.prefers). She takes the turns her samples offer: at 120 she turned after
-  63 % of 250 requests and 49 % of the same moments unasked (`lead --seeds 20` and `--seeds 30
-  --first-seed 20`, beside SPIN_KEEP 0.7 as then shipped; 53 % / 42 % without), but her pulse
-  over 100 steered seeds x 60 s fell to 0.70x (0.83x with SPIN_KEEP alone). 60, 90 and 180
-  degrees did no better on the requests.
+OnCount's `spin_keep` and `turn_start` (keeps_spin, starts_turn) are two choices measured and not
+shipped: no manifest and no option sets them, and tests/fixtures/features.json pins them in both
+languages. docs/results.md's tried table has what they did ("Her spins on the count", "Her turn
+starts taken").
 """
 from __future__ import annotations
 
@@ -67,14 +52,7 @@ MEAN_SECONDS = 1.0    # how long the dancer's own footwork is averaged over (abo
 # round (1.5-3 rad/s), hers spins (6-9).
 TURNING = {"leader": 1.5, "follower": 6.0}
 HIPS = 1.0            # m/s added to the footwork's miss of a candidate whose hips turn back
-# Her spins on the count: a candidate keeps the spin at this share of her turn rate now. None: her
-# spins left to her network, as shipped; measured at 0.7 (`--on-count-spin-keep 0.7`, the docstring).
-SPIN_KEEP = None
 STILL = 0.002         # m a frame (6 cm/s): a shorter step of the hips stands still, and turns no way
-# Her turn starts taken when offered: outside a spin, a candidate whose planned path turns at least
-# this much (degrees) over the next second is preferred to the others (starts_turn). None: none
-# preferred, as shipped; measured at 120 (`--on-count-turn-start 120`, the module's docstring).
-TURN_START_DEGREES = None
 
 # Where each role's input holds its own ankles' velocity (pose block: position, velocity, forward,
 # up per joint; the step into this frame as drawn, so the footwork now and the drawn footwork of a
@@ -176,7 +154,7 @@ def count_next(x: np.ndarray) -> float:
 
 class OnCount:
     """One dancer's footwork mean, kept across steps, and the footwork its next step aims at.
-    `spin_keep` (SPIN_KEEP; None: her spins are left to the network): while the dancer turns faster
+    `spin_keep` (None: her spins are left to the network): while the dancer turns faster
     than its TURNING, the footwork is still aimed at, among the candidates that keep the spin."""
 
     def __init__(self, role: str, samples: int = SAMPLES, strength: float = STRENGTH, hips: float = HIPS,

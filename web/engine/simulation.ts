@@ -125,7 +125,7 @@ export class DuetSimulation implements Simulation {
     this.leaderGuard = lg && lg.samples >= 2 && manifest.plausibility ? { settings: lg, ranges: manifest.plausibility } : null;
     const oc = manifest.onCount && manifest.onCount.samples >= 2 ? manifest.onCount : null;
     this.leaderOnCount = oc && this.leaderGuard ? new OnCount('leader', oc.samples, oc.strength, oc.hips) : null;
-    this.followerOnCount = followers.map(() => (oc && this.uprightGuard ? new OnCount('follower', oc.samples, oc.strength, oc.hips, oc.spinKeep ?? null, oc.turnStart ?? null) : null));
+    this.followerOnCount = followers.map(() => (oc && this.uprightGuard ? new OnCount('follower', oc.samples, oc.strength, oc.hips) : null));
     this.duet = startDuet(manifest, followers.length);
     this.shownBeat = this.duet.beat;
     this.leaderView = new View(false);

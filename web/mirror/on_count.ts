@@ -11,13 +11,10 @@
 // velocities the network writes beside them, which follow the drawn ankles only loosely. A sample
 // whose hips turn back the way they came has `hips` m/s added to its miss: the networks' own hips
 // turn back far more often than the recorded dancers'. While a dancer turns faster than TURNING (a
-// fast spin), its footwork is left to the network and only its hips are weighed, unless the dancer
-// keeps spins (her spinKeep): then her footwork is still aimed at the count, among the candidates
-// whose root turns on the same way at spinKeep times her turn rate or faster (keepsSpin), so the
-// pull cannot take the spin out of her. With her turnStart, outside a spin the candidates that start
-// a turn (startsTurn) are aimed before the others when any stands. Both are measured and not shipped
-// (the manifest carries neither; on_count.py says why). Every candidate is the network's own
-// reaction from the same state: nothing jumps, and nobody's input changes.
+// fast spin), its footwork is left to the network and only its hips are weighed. OnCount's spinKeep
+// and turnStart (keepsSpin, startsTurn) are two choices measured and not shipped, which the page
+// never sets (on_count.py says why they stay). Every candidate is the network's own reaction from
+// the same state: nothing jumps, and nobody's input changes.
 
 import { FOLLOWER_INPUT_LAYOUT, KEY_STEP, KEYS, LEADER_INPUT_LAYOUT, OUTPUT_LAYOUT, POSE_SIZE, blockSlices } from './features';
 import { MUSIC_OFFSETS, MUSIC_SIZE } from './music';
@@ -33,25 +30,13 @@ export const TURNING: Readonly<Record<Role, number>> = { leader: 1.5, follower: 
 export const HIPS = 1.0;
 /** m a frame (6 cm/s): a shorter step of the hips stands still, and turns no way. */
 export const STILL = 0.002;
-/** Her spins on the count: a candidate keeps the spin at this share of her turn rate now. null: her
- *  spins left to her network, as shipped (the manifest's onCount.spinKeep, when present, sets it). */
-export const SPIN_KEEP: number | null = null;
-/** Her turn starts taken when offered: outside a spin, a candidate whose planned path turns at least
- *  this much (degrees) over the next second is preferred to the others (startsTurn). null: none
- *  preferred, as shipped (the manifest's onCount.turnStart, when present, sets it). */
-export const TURN_START_DEGREES: number | null = null;
 
-/** The manifest's "onCount": samples each step, how far the footwork aimed at swings (0-1), what a
- *  candidate whose hips turn back adds to its miss (m/s; HIPS when absent), and the share of her turn
- *  rate a candidate keeps while she spins on the count (the follower's; absent: spins left alone),
- *  and how far (degrees) a candidate's planned path turns over the next second to be preferred as
- *  a turn start outside a spin (the follower's; absent: none preferred). */
+/** The manifest's "onCount": samples each step, how far the footwork aimed at swings (0-1), and what
+ *  a candidate whose hips turn back adds to its miss (m/s; HIPS when absent). */
 export interface OnCountSettings {
   samples: number;
   strength: number;
   hips?: number;
-  spinKeep?: number;
-  turnStart?: number;
 }
 
 export type Role = 'leader' | 'follower';
