@@ -67,9 +67,10 @@ RAISE = (0.1, 0.5, 1.8, 2.3)           # s
 # recorded and mirrored; training.evaluation.recorded_leads), and she reads the way from his body
 # over the second before her turn (docs/results.md, "Which way she turns").
 # With his plan left as it was she turned the asked way after 32 % of requests (18 % for her
-# left); with it turned and moved aside (`scripts/lead_way_probe.py plan DEG SIDE`, 20 seeds x 30
-# s, nobody steering): 45 degrees and 0 m 33 %, 0 and 0.6 m 29 %, 60 and 0.6 m 35 %, 90 and
-# 0.3 m 44 %, 90 and 0.6 m 48 %, 90 and 1.0 m 45 %, 120 and 0.6 m 38 %, 150 and 0.3 m 47 %.
+# left); with it turned and moved aside (scripts/lead_way_probe.py plan DEG SIDE at commit
+# 0c0428a, 20 seeds x 30 s, nobody steering): 45 degrees and 0 m 33 %, 0 and 0.6 m 29 %, 60 and
+# 0.6 m 35 %, 90 and 0.3 m 44 %, 90 and 0.6 m 48 %, 90 and 1.0 m 45 %, 120 and 0.6 m 38 %, 150 and
+# 0.3 m 47 %.
 # Asked 90 degrees, he turns a median 121 degrees her way over a request (5 over the same moments
 # unasked; `lead --seeds 100`).
 LEAD_TURN = 90.0   # degrees
