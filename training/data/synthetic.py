@@ -8,7 +8,11 @@ data): the tests and the whole pipeline (prepare -> train -> export -> evaluate 
 them. They are not dance: each dancer circles a drifting centre facing its partner, stepping
 (a leg swings half a cycle and stands planted the other half) and swinging its joints sinusoidally
 with seeded random amplitudes and phases. The follower repeats the leader's path around the
-centre a moment later (FOLLOW_LAG), so there is something for a follower model to learn.
+centre a moment later (FOLLOW_LAG), so there is something for a follower model to learn. Every few
+seconds (TURN_EVERY) he leads her turn: his left hand goes up over her (LEAD_SECONDS before) and she
+spins once round (TURN_SPIN seconds), either way, so the turn and lead measures have turns of both
+ways to find. Their hips sway a little on each step, so that the hips' step turns back now and then
+as a recorded dancer's does.
 
 Files look like the CMU ones to the loader: SUBJECT_TAKE.bvh, subjects 60 (lead) and 61 (follow),
 the take names and frame counts of the CMU takes (CMU_TAKES), 120 fps, CMU joint names, the
@@ -33,6 +37,12 @@ CMU_TAKES = {"01": 2242, "02": 2101, "03": 1830, "04": 1871, "06": 1772, "07": 2
 CMU_SUBJECTS = ("60", "61")
 CMU_FPS = 120
 FOLLOW_LAG = 0.25          # s the follower's path around the centre trails the leader's
+FOLLOWER_SIZE = 0.93       # her bones as a share of his
+TURN_EVERY = (2.0, 4.0)    # s between the starts of her led turns (uniform)
+TURN_SPIN = 1.0            # s her turn takes: 360 degrees
+LEAD_SECONDS = 1.0         # s his hand is up before her turn starts (and stays up through it)
+HIP_SWAY = 0.08            # m of the hips' side-to-side sway on each step
+HIP_SHAKE = 0.005          # m (standard deviation) the hips are shaken in each frame
 
 # Offsets (metres) of a plausible 17-joint dancer: arms out along x (a T pose at rest), legs down.
 OFFSETS = np.array([
@@ -114,12 +124,72 @@ def synthetic_couple(rng: np.random.Generator, frames: int, fps: float = CMU_FPS
     centre = lambda s: np.stack([cx(s), cz(s)], -1)            # noqa: E731  (x, z) of the circle's centre
     angle = lambda s: 0.6 * s + turn(s)                        # noqa: E731  the leader's place on it
     radius = rng.uniform(0.35, 0.5)
-    lead_offsets = np.round(OFFSETS * rng.uniform(0.97, 1.03), 6)
-    follow_offsets = np.round(OFFSETS * rng.uniform(0.9, 0.96), 6)
+    # The same two dancers in every take, as the CMU subjects 60 and 61 are (training reads one
+    # skeleton per dancer): he at OFFSETS, she a little smaller.
+    lead_offsets, follow_offsets = OFFSETS, np.round(OFFSETS * FOLLOWER_SIZE, 6)
     leader = procedural_dancer(rng, frames, angle(t), lead_offsets, radius, fps, centre(t))
     lag = t - FOLLOW_LAG
     follower = procedural_dancer(rng, frames, angle(lag) + np.pi, follow_offsets, radius, fps, centre(lag))
-    return leader, follower
+    spin, lift = led_turns(rng, t)
+    return sway(rng, raise_hand(leader, lift), t), sway(rng, spun(follower, spin), t + 0.3)
+
+
+def led_turns(rng: np.random.Generator, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Her extra facing [F] (radians: one full turn, either way, every TURN_EVERY seconds) and how
+    far his left hand is raised for it [F] (0 down, 1 over her head)."""
+    spin, lift = np.zeros(len(t)), np.zeros(len(t))
+    start = rng.uniform(*TURN_EVERY)
+    while start + TURN_SPIN < t[-1]:
+        way = rng.choice([-1.0, 1.0])
+        u = np.clip((t - start) / TURN_SPIN, 0, 1)
+        spin += way * 2 * np.pi * (3 * u ** 2 - 2 * u ** 3)           # eased in and out
+        up = np.clip((t - (start - LEAD_SECONDS)) / (0.4 * LEAD_SECONDS), 0, 1)
+        down = np.clip((start + TURN_SPIN + 0.3 - t) / 0.3, 0, 1)
+        lift = np.maximum(lift, np.minimum(up, down))
+        start += TURN_SPIN + rng.uniform(*TURN_EVERY)
+    return spin, lift
+
+
+def rebuilt(motion: Motion, hip: np.ndarray, world: np.ndarray) -> Motion:
+    """The motion with these hips and world rotations. The rotations are made orthonormal again
+    (procedural_dancer rounds them to 6 decimals, and a product of rounded matrices drifts), so
+    that the BVH text, which stores angles, reads back as this motion."""
+    u, _, vt = np.linalg.svd(world)
+    world = u @ vt
+    positions = forward_kinematics_reduced(motion.offsets, hip, world)
+    return Motion(np.round(positions, 6), world, motion.offsets, motion.fps)
+
+
+def spun(motion: Motion, spin: np.ndarray) -> Motion:
+    """The dancer turned about the vertical through her hips by `spin` [F] radians."""
+    world = np.stack([rotation_y(a) for a in spin])[:, None] @ motion.rotations
+    return rebuilt(motion, motion.positions[:, 0], world)
+
+
+ARM_UP = 150.0   # degrees the raised upper arm turns up from hanging down
+
+
+def raise_hand(motion: Motion, lift: np.ndarray) -> Motion:
+    """His left upper arm turned up by lift * ARM_UP degrees (about his forward axis, in the
+    shoulder's frame), the rest of the body as it was."""
+    local = motion.local_rotations()
+    arm = JOINT_NAMES.index("lShldr")
+    local[:, arm] = euler(np.stack([np.zeros_like(lift), np.zeros_like(lift), -ARM_UP * lift], -1)) @ local[:, arm]
+    world = np.empty_like(local)
+    for j, p in enumerate(PARENTS):
+        world[:, j] = local[:, j] if p < 0 else world[:, p] @ local[:, j]
+    return rebuilt(motion, motion.positions[:, 0], world)
+
+
+def sway(rng: np.random.Generator, motion: Motion, t: np.ndarray) -> Motion:
+    """The whole body moved side to side (along its hip line) by HIP_SWAY on each step, and the
+    hips shaken by HIP_SHAKE (a capture's hips are never smooth: they turn back now and then)."""
+    p = motion.positions
+    across = p[:, JOINT_NAMES.index("lThigh")] - p[:, JOINT_NAMES.index("rThigh")]
+    across[:, 1] = 0
+    across /= np.linalg.norm(across, axis=-1, keepdims=True)
+    shift = HIP_SWAY * np.sin(2 * np.pi * 1.2 * t)[:, None] * across + rng.normal(0, HIP_SHAKE, p[:, 0].shape)
+    return rebuilt(motion, p[:, 0] + shift, motion.rotations)
 
 
 # ---------------------------------------------------------------- BVH text
