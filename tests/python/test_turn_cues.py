@@ -70,7 +70,9 @@ def test_a_follower_whose_intention_forecasts_the_led_turn_trains_and_keeps_the_
 
     from training.learning import train as T
     from training.learning.runs import load_run
-    cfg = replace(T.smoke(T.MODELS["follower_led_turn"]), own_rollouts_from=1, own_rollouts_stride=40)
+    shipped = T.MODELS["follower"]   # follower_led_turn: the shipped recipe, its intention forecasting the led turn
+    led_turn = replace(shipped, model=replace(shipped.model, turn_keys=feat.KEYS), tempo_copies=False)
+    cfg = replace(T.smoke(led_turn), own_rollouts_from=1, own_rollouts_stride=40)
     T.train_model("led", cfg, str(prepared3), str(tmp_path), quiet=True)
     run = load_run(tmp_path / "led", str(prepared3))
     assert run.predictor.net[-1].out_features == feat.INTENTION_SIZE + feat.KEYS
