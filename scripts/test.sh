@@ -147,8 +147,11 @@ timed() {  # timed NAME command...: run a test part, record its wall time and re
 }
 
 say "pytest (tests/python)"
+pytest_log=$(mktemp)
 if [ $python_ready = 1 ]; then
-  timed pytest .venv/bin/python -m pytest -q tests/python
+  # -rs: one line per skipped test saying what it needs (the CMU takes: docs/data.md); the
+  # summary below repeats pytest's counts and those lines.
+  timed pytest bash -c '.venv/bin/python -m pytest -q -rs tests/python 2>&1 | tee "$1"; exit "${PIPESTATUS[0]}"' _ "$pytest_log"
   rc=$?
   if [ $rc = 5 ]; then
     # pytest's 5 means "no test collected". The repository always has Python tests, so without
@@ -174,13 +177,27 @@ else
   missing+=("node modules (vitest and end-to-end tests not run)")
 fi
 
+# The browser tests file by file (as `npm run test:e2e` runs them, one at a time), so that the
+# summary can say where their time goes and which files failed.
+e2e_times=()
+e2e_failed=()
+run_e2e() {
+  local file name t0
+  for file in tests/e2e/*.test.mjs; do
+    name=$(basename "$file" .test.mjs)
+    t0=$SECONDS
+    node --test "$file" || e2e_failed+=("$name")
+    e2e_times+=("$name $((SECONDS - t0))")
+  done
+  [ ${#e2e_failed[@]} = 0 ]
+}
 say "end-to-end (Chromium, tests/e2e)"
 if [[ " ${missing[*]} " == *chromium* ]]; then
   echo "   skipped: chromium missing"
 elif ! node_modules_ready && [ $dry = 0 ]; then
   echo "   skipped: node modules missing"
 else
-  timed e2e npm run --silent test:e2e || failed+=("end-to-end")
+  timed e2e run_e2e || failed+=("end-to-end (${e2e_failed[*]})")
 fi
 
 # ---------------------------------------------------------------- summary
@@ -188,6 +205,15 @@ echo
 [ $dry = 1 ] && say "dry run: nothing was installed or run" && echo "   CHROMIUM=${CHROMIUM:-}"
 join() { local out="" item; for item in "$@"; do out+="${out:+, }$item"; done; echo "$out"; }
 say "wall time: setup ${setup_seconds} s${timings[*]:+, $(join "${timings[@]}")}; total $((SECONDS - start)) s"
+# pytest's last line ("300 passed, 2 skipped in ...") and what each skipped test needs.
+counts=$(grep -E '^[0-9]+ (passed|failed|skipped|error)' "$pytest_log" | tail -n 1 | sed 's/ in [0-9.]*s.*//')
+[ -n "$counts" ] && say "pytest: $counts"
+grep -E '^SKIPPED' "$pytest_log" | sed 's/^/   /'
+rm -f "$pytest_log"
+if [ ${#e2e_times[@]} -gt 0 ]; then
+  # Each browser test file's seconds, longest first.
+  say "end-to-end by file (s): $(printf '%s\n' "${e2e_times[@]}" | sort -k2 -n -r | tr '\n' ' ' | sed 's/ $//; s/\([0-9]\) \([a-z]\)/\1, \2/g')"
+fi
 status=0
 if [ ${#failed[@]} -gt 0 ]; then
   echo "FAILED: $(join "${failed[@]}")"

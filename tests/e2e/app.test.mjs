@@ -6,6 +6,7 @@
 import { after, before, describe, test } from 'node:test';
 import assert from 'node:assert/strict';
 import {
+  QUICK,
   WAIT_MS,
   displacement,
   distance,
@@ -30,7 +31,7 @@ before(async () => {
   server = await startServer({ mode: 'dev' });
   // The dev server transforms modules on first request; warm it so the tests below see the page,
   // not Vite's first compile (which can reload a page mid-test).
-  const warm = await launch();
+  const warm = await launch(QUICK);
   await warm.page.goto(`${server.url}?seed=1`);
   await waitReady(warm.page).catch(() => undefined);
   await warm.close();
@@ -107,7 +108,17 @@ describe('desktop', () => {
 
   test('the follower stays within 3 m of the leader through 60 s of random steering', async () => {
     // 4× speed: 60 simulated seconds (1800 steps, every one running the real models) in ~15 s
-    // on a quiet machine; on a busy one it takes longer, and the test waits for the steps.
+    // on a quiet machine; on a busy one it takes longer, and the test waits for the steps. A
+    // browser of its own that draws at half resolution (QUICK): it takes no picture.
+    const quick = await launch({ viewport: { width: 1280, height: 800 }, ...QUICK });
+    try {
+      await steerAtRandom(quick.page);
+    } finally {
+      await quick.close();
+    }
+  });
+
+  async function steerAtRandom(page) {
     await page.goto(`${server.url}?seed=7&speed=4`);
     await waitReady(page);
     await reset(page);
@@ -141,7 +152,7 @@ describe('desktop', () => {
     }
     for (const key of held) await page.keyboard.up(key);
     assert.ok(worst < 3, `follower was ${worst.toFixed(2)} m from the leader`);
-  });
+  }
 
   test('screenshot is not blank', async () => {
     await page.goto(`${server.url}?seed=3&intentions=1`);
@@ -355,7 +366,7 @@ describe('failures show a message, not a blank page', () => {
   let browser;
 
   before(async () => {
-    browser = await launch();
+    browser = await launch(QUICK);
   });
 
   after(async () => {

@@ -9,7 +9,7 @@
 import { after, before, describe, test } from 'node:test';
 import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
-import { WAIT_MS, duet, launch, reset, sleep, startServer, waitReady, waitSteps, waitToast } from './harness.mjs';
+import { QUICK, WAIT_MS, duet, launch, reset, sleep, startServer, waitReady, waitSteps, waitToast } from './harness.mjs';
 
 const VIEWPORT = { width: 1280, height: 800 };
 
@@ -63,7 +63,7 @@ let recording = null;
 
 before(async () => {
   server = await startServer({ mode: 'dev' });
-  browser = await launch({ acceptDownloads: true, viewport: VIEWPORT });
+  browser = await launch({ acceptDownloads: true, viewport: VIEWPORT, ...QUICK });
   page = browser.page;
   await page.goto(`${server.url}?seed=1`);
   await waitReady(page);

@@ -4,7 +4,7 @@
 
 import { after, before, test } from 'node:test';
 import assert from 'node:assert/strict';
-import { build, displacement, duet, launch, pixelVariance, startServer, waitReady, waitSteps } from './harness.mjs';
+import { QUICK, build, displacement, duet, launch, pixelVariance, startServer, waitReady, waitSteps } from './harness.mjs';
 
 let server;
 let browser;
@@ -12,7 +12,7 @@ let browser;
 before(async () => {
   await build('dist');
   server = await startServer({ mode: 'preview', base: '/duet/', outDir: 'dist' });
-  browser = await launch();
+  browser = await launch(QUICK);
 });
 
 after(async () => {

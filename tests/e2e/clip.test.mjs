@@ -7,7 +7,7 @@
 import { after, before, describe, test } from 'node:test';
 import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
-import { WAIT_MS, distance, duet, launch, sleep, startServer, waitReady, waitSteps, waitToast } from './harness.mjs';
+import { QUICK, WAIT_MS, distance, duet, launch, sleep, startServer, waitReady, waitSteps, waitToast } from './harness.mjs';
 
 /** 1.5 s of dance (as in controls.test.mjs). Held that long, ArrowUp carries the spot the leader
  *  dances around (window.duet.anchor) about 0.9 m; his own hips, dancing since 2026-11-25, cover
@@ -26,7 +26,7 @@ let page;
 
 before(async () => {
   server = await startServer({ mode: 'dev' });
-  browser = await launch({ viewport: { width: 1280, height: 800 }, acceptDownloads: true });
+  browser = await launch({ viewport: { width: 1280, height: 800 }, acceptDownloads: true, ...QUICK });
   page = browser.page;
   await page.goto(`${server.url}?seed=1&speed=2`);
   await waitReady(page);

@@ -10,7 +10,7 @@
 
 import { after, before, describe, test } from 'node:test';
 import assert from 'node:assert/strict';
-import { WAIT_MS, distance, duet, launch, sleep, startServer, waitReady, waitSteps } from './harness.mjs';
+import { QUICK, WAIT_MS, distance, duet, launch, sleep, startServer, waitReady, waitSteps } from './harness.mjs';
 
 /** 1.5 s of dance. */
 const STEER_STEPS = 45;
@@ -75,7 +75,7 @@ describe('desktop: a click in the panel leaves the keys steering', () => {
   const dialogs = [];
 
   before(async () => {
-    browser = await launch({ viewport: { width: 1280, height: 800 }, permissions: ['clipboard-read', 'clipboard-write'] });
+    browser = await launch({ viewport: { width: 1280, height: 800 }, permissions: ['clipboard-read', 'clipboard-write'], ...QUICK });
     page = browser.page;
     page.on('dialog', (dialog) => {
       dialogs.push(dialog.message());
@@ -83,8 +83,8 @@ describe('desktop: a click in the panel leaves the keys steering', () => {
     });
     // With a listener the file choosers ("leader from BVH file…", the avatar) never open.
     page.on('filechooser', () => undefined);
-    // At double speed the 1.5 s of dance per check take less of the test's time.
-    await page.goto(`${server.url}?seed=1&speed=2`);
+    // At 4x speed the 1.5 s of dance per check take less of the test's time.
+    await page.goto(`${server.url}?seed=1&speed=4`);
     await waitReady(page);
     await waitSteps(page, 5);
   });
@@ -329,7 +329,7 @@ describe('the address keeps every setting', () => {
   let browser;
 
   before(async () => {
-    browser = await launch({ viewport: { width: 1280, height: 800 } });
+    browser = await launch({ viewport: { width: 1280, height: 800 }, ...QUICK });
   });
 
   after(async () => {
@@ -460,7 +460,7 @@ describe('phone: pause, reset view, and a camera that keeps the pair in view', (
   const size = { width: 390, height: 844 };
 
   before(async () => {
-    browser = await launch({ viewport: size, deviceScaleFactor: 3, isMobile: true, hasTouch: true });
+    browser = await launch({ viewport: size, isMobile: true, hasTouch: true, ...QUICK });
     page = browser.page;
     await page.goto(`${server.url}?seed=1`);
     await waitReady(page);

@@ -11,7 +11,7 @@ import assert from 'node:assert/strict';
 import { mkdtempSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { WAIT_MS, launch, waitReady, waitSteps, waitToast } from './harness.mjs';
+import { QUICK, WAIT_MS, launch, waitReady, waitSteps, waitToast } from './harness.mjs';
 import { twoBuilds, visit, waitCached } from './deploy.mjs';
 
 let dir;
@@ -21,7 +21,7 @@ let browser;
 before(async () => {
   dir = mkdtempSync(join(tmpdir(), 'duet-deploy-'));
   site = await twoBuilds(dir);
-  browser = await launch();
+  browser = await launch(QUICK);
 });
 
 after(async () => {

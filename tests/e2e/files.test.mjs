@@ -14,7 +14,7 @@ import { after, before, test } from 'node:test';
 import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
 import { join } from 'node:path';
-import { ROOT, duet, launch, startServer, waitReady, waitSteps } from './harness.mjs';
+import { QUICK, ROOT, duet, launch, startServer, waitReady, waitSteps } from './harness.mjs';
 import { TEXTURE_RGB, makeVrm } from './vrm.mjs';
 
 /** How long to wait for the page to do something before failing (as the other tests: DUET_WAIT_MS). */
@@ -41,7 +41,7 @@ function keepToasts() {
 
 before(async () => {
   server = await startServer();
-  browser = await launch();
+  browser = await launch(QUICK);
   await browser.context.addInitScript(keepToasts);
   await browser.page.goto(`${server.url}?seed=2&camera=90,75,4`); // from the side: both dancers in view
   await waitReady(browser.page, WAIT_MS);

@@ -12,7 +12,7 @@
 
 import { after, before, describe, test } from 'node:test';
 import assert from 'node:assert/strict';
-import { WAIT_MS, distance, duet, launch, pixelVariance, saveScreen, sleep, startServer, waitReady, waitSteps } from './harness.mjs';
+import { QUICK, WAIT_MS, distance, duet, launch, pixelVariance, saveScreen, sleep, startServer, waitReady, waitSteps } from './harness.mjs';
 
 // DUET_FILMSTRIP_SEEDS=1 makes one strip only (while working on the bodies).
 const SEEDS = (process.env.DUET_FILMSTRIP_SEEDS ?? '1,2,3').split(',').map(Number);
@@ -41,7 +41,7 @@ let server;
 before(async () => {
   server = await startServer({ mode: 'dev' });
   // Warm the dev server (first compile, dependency scan) so the measured pages do not reload.
-  const warm = await launch();
+  const warm = await launch(QUICK);
   warm.page.setDefaultTimeout(READY_MS);
   await warm.page.goto(`${server.url}?seed=1`).catch(() => undefined);
   await waitReady(warm.page).catch(() => undefined);

@@ -108,6 +108,17 @@ export async function startServer({ mode = 'dev', base = '/', outDir = 'dist' } 
 }
 
 /**
+ * Launch options of a test that takes no picture: the canvas drawn at half the CSS resolution
+ * (devicePixelRatio 0.5; the page draws at min(devicePixelRatio, 2)). Headless Chromium draws
+ * WebGL in software, and at full resolution the drawing took most of the CPU a dancing page had
+ * (on a busy 2-core machine, 1280x800: 8-14 steps a second at 1, 20 at 0.5, 28 at 0.25), so a
+ * test that waits for so many steps of dance waited mostly for pictures nobody looks at. Layout
+ * is in CSS pixels and unchanged. Tests that save pictures (docs/testing.md, Pictures) and the
+ * bench launch at deviceScaleFactor 1 or the phone's own.
+ */
+export const QUICK = { deviceScaleFactor: 0.5 };
+
+/**
  * Launch Chromium with a fresh user-data-dir. `options` are Playwright context options
  * (viewport, isMobile, hasTouch, ...). Returns { context, page, consoleErrors, close }.
  */

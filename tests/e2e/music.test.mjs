@@ -15,7 +15,7 @@
 
 import { after, before, describe, test } from 'node:test';
 import assert from 'node:assert/strict';
-import { WAIT_MS, displacement, duet, launch, sleep, startServer, waitReady, waitSteps } from './harness.mjs';
+import { QUICK, WAIT_MS, displacement, duet, launch, sleep, startServer, waitReady, waitSteps } from './harness.mjs';
 
 const SECONDS = Number(process.env.DUET_MUSIC_SECONDS ?? 20);
 
@@ -80,7 +80,7 @@ describe('music on a desktop', () => {
   const fetched = [];
 
   before(async () => {
-    browser = await launch({ viewport: { width: 1280, height: 800 } });
+    browser = await launch({ viewport: { width: 1280, height: 800 }, ...QUICK });
     browser.page.on('request', (request) => fetched.push(request.url()));
     await browser.page.goto(`${server.url}?seed=3`);
     await waitReady(browser.page);
@@ -181,7 +181,7 @@ describe('music on a phone', () => {
   let browser;
 
   before(async () => {
-    browser = await launch({ viewport: { width: 390, height: 844 }, deviceScaleFactor: 2, isMobile: true, hasTouch: true });
+    browser = await launch({ viewport: { width: 390, height: 844 }, isMobile: true, hasTouch: true, ...QUICK });
     await browser.page.goto(`${server.url}?seed=4`);
     await waitReady(browser.page);
   });

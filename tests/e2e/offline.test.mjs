@@ -7,7 +7,7 @@
 import { after, before, test } from 'node:test';
 import assert from 'node:assert/strict';
 import { join } from 'node:path';
-import { ROOT, WAIT_MS, build, duet, launch, sleep, waitReady, waitSteps } from './harness.mjs';
+import { QUICK, ROOT, WAIT_MS, build, duet, launch, sleep, waitReady, waitSteps } from './harness.mjs';
 import { serve } from '../../scripts/serve.mjs';
 
 let server;
@@ -16,7 +16,7 @@ let browser;
 before(async () => {
   await build('dist');
   server = await serve({ dir: join(ROOT, 'dist'), base: '/duet/' });
-  browser = await launch();
+  browser = await launch(QUICK);
 });
 
 after(async () => {

@@ -5,7 +5,7 @@
 import { after, before, describe, test } from 'node:test';
 import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
-import { WAIT_MS, distance, duet, launch, sleep, startServer, waitReady, waitSteps, waitToast } from './harness.mjs';
+import { QUICK, WAIT_MS, distance, duet, launch, sleep, startServer, waitReady, waitSteps, waitToast } from './harness.mjs';
 
 const JOINTS = [
   // name, parent, offset in metres (a plain dancer facing +Z, arms out, left = +X)
@@ -109,7 +109,7 @@ let recordedLeader = null;
 
 before(async () => {
   server = await startServer({ mode: 'dev' });
-  browser = await launch({ acceptDownloads: true });
+  browser = await launch({ acceptDownloads: true, ...QUICK });
   page = browser.page;
   // The first visit compiles the modules in the dev server; allow for it.
   await page.goto(`${server.url}?seed=1`);

@@ -13,7 +13,18 @@ import { createServer } from 'node:http';
 import { tmpdir } from 'node:os';
 import { extname, join, normalize, sep } from 'node:path';
 import {
-  CHROMIUM_ARGS, WAIT_MS, build, distance, duet, launch, pixelVariance, sleep, startServer, waitReady, waitSteps,
+  CHROMIUM_ARGS,
+  QUICK,
+  WAIT_MS,
+  build,
+  distance,
+  duet,
+  launch,
+  pixelVariance,
+  sleep,
+  startServer,
+  waitReady,
+  waitSteps,
 } from './harness.mjs';
 
 /**
@@ -157,7 +168,7 @@ let browser;
 
 before(async () => {
   server = await startServer({ mode: 'dev' });
-  browser = await launch();
+  browser = await launch(QUICK);
   // Warm the dev server's module transforms (as app.test.mjs does) so timeouts measure the page.
   await browser.page.goto(`${server.url}?seed=1`);
   await waitReady(browser.page).catch(() => undefined);
@@ -262,7 +273,7 @@ describe('bad inputs show a clear message, not a blank canvas', () => {
   });
 
   test('WebGL disabled in the browser (--disable-webgl --disable-3d-apis)', async (t) => {
-    const noGl = await launch({ args: [...CHROMIUM_ARGS, '--disable-webgl', '--disable-3d-apis'] });
+    const noGl = await launch({ args: [...CHROMIUM_ARGS, '--disable-webgl', '--disable-3d-apis'], ...QUICK });
     try {
       const { page } = await openPage(noGl);
       await page.goto(`${server.url}?seed=1`);

@@ -8,7 +8,7 @@ import { after, before, test } from 'node:test';
 import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
 import { join } from 'node:path';
-import { ROOT, launch, startServer, waitReady } from './harness.mjs';
+import { QUICK, ROOT, launch, startServer, waitReady } from './harness.mjs';
 
 const fixture = JSON.parse(readFileSync(join(ROOT, 'tests', 'fixtures', 'runtime.json'), 'utf8'));
 const manifest = JSON.parse(readFileSync(join(ROOT, 'public', 'models', 'manifest.json'), 'utf8'));
@@ -18,7 +18,7 @@ let browser;
 
 before(async () => {
   server = await startServer({ mode: 'dev' });
-  browser = await launch();
+  browser = await launch(QUICK);
 });
 
 after(async () => {

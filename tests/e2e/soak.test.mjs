@@ -17,7 +17,7 @@ import assert from 'node:assert/strict';
 import { mkdtempSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { WAIT_MS, build, distance, duet, launch, sleep, startServer, waitReady } from './harness.mjs';
+import { QUICK, WAIT_MS, build, distance, duet, launch, sleep, startServer, waitReady } from './harness.mjs';
 
 const SOAK_SECONDS = Number(process.env.DUET_SOAK_SECONDS ?? 120);
 const WARMUP_SECONDS = 10;
@@ -83,7 +83,7 @@ before(async () => {
   outDir = mkdtempSync(join(tmpdir(), 'duet-soak-'));
   await build(outDir);
   server = await startServer({ mode: 'preview', outDir });
-  browser = await launch();
+  browser = await launch(QUICK);
 });
 
 after(async () => {

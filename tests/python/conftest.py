@@ -40,8 +40,8 @@ def have_real_data() -> bool:
 
 
 needs_real_data = pytest.mark.skipif(
-    not have_real_data(), reason=f"needs the 12 CMU salsa couples (60_NN.bvh, 61_NN.bvh) in {REAL_DATA}: "
-                                 f"set DUET_DATA or see README, Data")
+    not have_real_data(), reason=f"needs the 12 CMU salsa couples (60_NN.bvh, 61_NN.bvh), not in {REAL_DATA}: "
+                                 f"docs/data.md, Getting the takes")
 
 
 def pytest_configure(config):
