@@ -1,5 +1,5 @@
 // Boot timings: when each stage of the start happened (ms since navigation, performance.now()),
-// so that the phone bench (scripts/bench_phone.mjs) can say where the time to the first dancing
+// so that the phone bench (npm run bench -- --phone) can say where the time to the first dancing
 // frame goes instead of guessing. Published as window.duet.bootTimings; each stage is also a
 // performance.mark('duet:<stage>'), visible in a DevTools performance recording. The fetcher
 // worker's stages (downloads, the wasm's compilation) reach the page as messages.
