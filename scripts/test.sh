@@ -151,7 +151,7 @@ pytest_log=$(mktemp)
 if [ $python_ready = 1 ]; then
   # -rs: one line per skipped test saying what it needs (the CMU takes: docs/data.md); the
   # summary below repeats pytest's counts and those lines.
-  timed pytest bash -c '.venv/bin/python -m pytest -q -rs tests/python 2>&1 | tee "$1"; exit "${PIPESTATUS[0]}"' _ "$pytest_log"
+  timed pytest bash -c '.venv/bin/python -m pytest -q -rs --durations=10 tests/python 2>&1 | tee "$1"; exit "${PIPESTATUS[0]}"' _ "$pytest_log"
   rc=$?
   if [ $rc = 5 ]; then
     # pytest's 5 means "no test collected". The repository always has Python tests, so without

@@ -1,6 +1,6 @@
 // End-to-end: both dancers stay whole in the part of the screen the page leaves them. On a 360x640
 // and a 390x844 phone, a phone held sideways (844x390) and a 1280x800 screen, with the settings
-// folded and open, with 0 and 8 possible reactions: every frame drawn over 10 s of dance (led
+// folded and open, with 0 possible reactions (and 8 on the 390x844 phone and the 1280x800 screen): every frame drawn over 10 s of dance (led
 // with the keys or a finger, turns asked for), the top of each dancer's head and each shoe's toe
 // and heel (window.duet.leader/follower.outline) are on screen and under neither the title card
 // nor the panel; the same during and after 20 random wheel turns and drags (two-finger pinches
@@ -21,11 +21,14 @@ import { readFileSync } from 'node:fs';
 import { join } from 'node:path';
 import { QUICK, ROOT, WAIT_MS, distance, duet, launch, saveScreen, sleep, startServer, touchDrag, waitReady, waitSteps } from './harness.mjs';
 
+// With 8 possible reactions every step runs the follower's network nine times and draws nine
+// dancers: checked on the tallest phone and the desktop, where they spread widest; the smallest
+// phone and the phone held sideways frame the pair alone.
 const VIEWS = [
-  { name: '360x640', width: 360, height: 640, phone: true },
-  { name: '390x844', width: 390, height: 844, phone: true },
-  { name: '844x390', width: 844, height: 390, phone: true },
-  { name: '1280x800', width: 1280, height: 800, phone: false },
+  { name: '360x640', width: 360, height: 640, phone: true, ghosts: [0] },
+  { name: '390x844', width: 390, height: 844, phone: true, ghosts: [0, 8] },
+  { name: '844x390', width: 844, height: 390, phone: true, ghosts: [0] },
+  { name: '1280x800', width: 1280, height: 800, phone: false, ghosts: [0, 8] },
 ];
 const PHONE = { isMobile: true, hasTouch: true, deviceScaleFactor: 1 };
 /** 10 s of dance, in steps (30 a second): counted in steps, so a slow machine dances it all. */
@@ -248,7 +251,7 @@ for (const view of VIEWS) {
       await browser?.close();
     });
 
-    for (const ghosts of [0, 8]) {
+    for (const ghosts of view.ghosts) {
       test(`${ghosts} possible reactions: heads and feet in the free part every frame, folded and open, led, zoomed, dragged`, { timeout: HANG_MS }, async () => {
         await page.goto(`${server.url}?seed=${ghosts + 1}&ghosts=${ghosts}`);
         await waitReady(page);
