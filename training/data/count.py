@@ -128,3 +128,19 @@ def measure_strength(positions: np.ndarray, count: Count, fps: float = FPS) -> d
         floor = np.median(np.abs(_fourier(x, f / beats * around, fps)))
         out[beats] = float(amp / max(floor, 1e-12))
     return out
+
+
+def plot_footwork(ax, leader_positions: np.ndarray, follower_positions: np.ndarray, start: float,
+                  seconds: float, fps: float = FPS) -> tuple[np.ndarray, slice]:
+    """Both dancers' footwork from `start` for `seconds` on a matplotlib axis (the count report's
+    and the rhythm plot's picture); returns the times drawn (s) and the frames they are."""
+    lw, fw = footwork(leader_positions, fps), footwork(follower_positions, fps)
+    # A take shorter than start + seconds is drawn to its end.
+    sl = slice(int(start * fps), min(int((start + seconds) * fps), len(lw), len(fw)))
+    t = np.arange(sl.start, sl.stop) / fps
+    lw, fw = lw[sl], fw[sl]
+    ax.plot(t, lw, color="#2a6fdb", lw=1.2, label="leader")
+    ax.plot(t, fw, color="#d62f3a", lw=1.2, label="follower")
+    # a marker glitch (an ankle jumping for a frame) would flatten the rest: clip the view
+    ax.set_ylim(0, 1.1 * np.percentile(np.concatenate([lw, fw]), 98))
+    return t, sl

@@ -12,7 +12,7 @@ import sys
 import numpy as np
 
 from ..mirror.skeleton import FPS
-from .count import Count, find_count, footwork, normalized, measure_strength, phase_at, phase_gap, window_gaps
+from .count import Count, find_count, footwork, normalized, plot_footwork, measure_strength, phase_at, phase_gap, window_gaps
 from .dataset import DataError, discover_takes, load_pair, pair_tracks
 from .folders import add_folder
 
@@ -78,13 +78,7 @@ def plot(data: str, out: str, takes: list[str], start: float = 6.0, seconds: flo
     fig, axes = plt.subplots(len(rows), 1, figsize=(10, 1.9 * len(rows)), sharex=True, squeeze=False)
     for ax, (name, lp, fp) in zip(axes[:, 0], rows):
         c = find_count(lp, fp)
-        sl = slice(int(start * FPS), int((start + seconds) * FPS))
-        t = np.arange(sl.start, sl.stop) / FPS
-        lw, fw = footwork(lp)[sl], footwork(fp)[sl]
-        ax.plot(t, lw, color="#2a6fdb", lw=1.2, label="leader")
-        ax.plot(t, fw, color="#d62f3a", lw=1.2, label="follower")
-        # a marker glitch (an ankle jumping for a frame) would flatten the rest: clip the view
-        ax.set_ylim(0, 1.1 * np.percentile(np.concatenate([lw, fw]), 98))
+        t, _ = plot_footwork(ax, lp, fp, start, seconds)
         b = c.beats(t)
         for k in range(int(np.ceil(b[0])), int(np.floor(b[-1])) + 1):
             x = (k - c.beat0) * 60.0 / c.bpm

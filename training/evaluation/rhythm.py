@@ -31,7 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..data.count import footwork
+from ..data.count import footwork, plot_footwork
 from ..data.folders import add_folder
 from ..mirror.skeleton import FPS
 
@@ -248,12 +248,7 @@ def plot(path: str, data: str, manifest, leader, follower, temperature: float, t
              rec["leader"], rec["follower"], rec["beat"])]
     fig, axes = plt.subplots(2, 1, figsize=(10, 4.2), sharex=True)
     for ax, (title, lp, fp, beat) in zip(axes, rows):
-        sl = slice(int(start * FPS), int((start + seconds) * FPS))
-        x = np.arange(sl.start, sl.stop) / FPS
-        lw, fw = footwork(lp)[sl], footwork(fp)[sl]
-        ax.plot(x, lw, color="#2a6fdb", lw=1.2, label="leader")
-        ax.plot(x, fw, color="#d62f3a", lw=1.2, label="follower")
-        ax.set_ylim(0, 1.1 * np.percentile(np.concatenate([lw, fw]), 98))
+        x, sl = plot_footwork(ax, lp, fp, start, seconds)
         b = beat[sl]
         for k in range(int(np.ceil(b[0])), int(np.floor(b[-1])) + 1):
             i = np.searchsorted(b, k)
