@@ -45,7 +45,8 @@ async function run(seed, direction) {
 }
 
 async function runOnce(seed, direction) {
-  await page.goto(`${server.url}?seed=${seed}&speed=${SPEED}`);
+  // figures=0: he leads only the turn asked for, so the control leads none.
+  await page.goto(`${server.url}?seed=${seed}&speed=${SPEED}&figures=0`);
   await waitReady(page, READY_MS);
   await armProbe(page, { askAt: ASK_AT, direction, until: ASK_AT + WINDOW });
   const probe = await readProbe(page, READY_MS);

@@ -158,7 +158,7 @@ describe('desktop: a click in the panel leaves the keys steering', () => {
     };
     report();
     const names = rows.map((r) => r.name);
-    for (const expected of ['partner', 'variety', 'tempo', 'music', 'possible reactions', 'floor paths', 'show what the partner expects', 'start again (R)', 'reset view', 'copy link to this view', 'skeleton']) {
+    for (const expected of ['partner', 'variety', 'tempo', 'music', 'his own turns', 'possible reactions', 'floor paths', 'show what the partner expects', 'start again (R)', 'reset view', 'copy link to this view', 'skeleton']) {
       assert.ok(names.includes(expected), `the panel has "${expected}" (it has ${names.join(', ')})`);
     }
 

@@ -52,10 +52,13 @@ export function armProbe(page, { askAt, direction, until }) {
               leaderHeading: this.leader.heading,
               followerHeading: this.followers[0].heading,
               turnAsked: this.turnAsked,
-              // The leader model's figure block as it read it this step (inputs 660-666), and
-              // the first numbers of his hands plan (667: shown, then the left hand's first move).
-              figure: Array.from(this.leaderPolicy?.input?.slice(660, 667) ?? []),
-              handsPlan: Array.from(this.leaderPolicy?.input?.slice(667, 671) ?? []),
+              // The figure danced on this step or coming ({way, asked, coming}: Simulation.figure).
+              led: this.figure ? { ...this.figure } : null,
+              // The figure block both dancers read this step (the leader's inputs 660-711: per key
+              // t-30..t+30, per way (her left, her right), inside and progress), and the first
+              // numbers of his hands plan (712: shown, then the left hand's first move).
+              figure: Array.from(this.leaderPolicy?.input?.slice(660, 712) ?? []),
+              handsPlan: Array.from(this.leaderPolicy?.input?.slice(712, 716) ?? []),
               steerActive: steer.active,
               t: performance.now(),
             });

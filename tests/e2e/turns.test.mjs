@@ -6,7 +6,8 @@
 // filmstrip-led-turn-desktop.png and filmstrip-led-turn-phone.png in runs/screens/ (harness.SCREENS).
 //
 // Asserts, from the page's own simulation:
-// - the page takes the request and holds it for a while (turnAsked), then lets it go;
+// - the page takes the request and holds it while it is planned and danced (turnAsked: from the
+//   next beat, FIGURE_BEATS long), then lets it go; his own figures are off (?figures=0);
 // - the two runs are the same dance up to the request (so what differs after it is the request's
 //   doing), and the leader's pose differs by more than 1 cm within 1 s after it;
 // - the request raises his hand: his higher hand goes above LEAD_HAND m within 2.5 s (the lead a
@@ -71,7 +72,8 @@ async function runOnce(view, direction, strip, seed = SEED, until = UNTIL) {
   try {
     const { page, consoleErrors } = browser;
     page.setDefaultTimeout(READY_MS);
-    await page.goto(`${server.url}?seed=${seed}`);
+    // figures=0: he leads only the turn asked for, so the control run leads none.
+    await page.goto(`${server.url}?seed=${seed}&figures=0`);
     await waitReady(page);
     await armProbe(page, { askAt: ASK_AT, direction, until });
     let capture = null;
@@ -163,10 +165,15 @@ describe(`leading a turn (seed ${SEED})`, () => {
     // The strip: six frames from the request on, none blank.
     const { states, variances } = asked.shot;
     assert.equal(states.length, FRAMES);
+    // window.duet.figure names the asked turn while it is danced: from the next beat (within 11
+    // steps at 170 beats a minute) for FIGURE_BEATS (38 steps); none once it is over (?figures=0).
+    const herTurn = { name: 'her_turn', way: DIRECTION > 0 ? 'left' : 'right', asked: true };
     states.forEach((state, k) => {
       assert.equal(state.error, null);
       assert.ok(state.frame >= ASK_AT + k * (FPS / 2), `strip frame ${k} is of step ${state.frame}`);
       assert.ok(variances[k] > MIN_VARIANCE, `strip frame ${k} looks blank (variance ${variances[k].toFixed(1)})`);
+      if (state.frame >= ASK_AT + 12 && state.frame <= ASK_AT + 38) assert.deepEqual(state.figure, herTurn, `strip frame ${k}: window.duet.figure`);
+      if (state.frame > ASK_AT + 2 * FPS) assert.equal(state.figure, null, `strip frame ${k}: a figure 2 s after the request`);
     });
 
     const a = followerTurn(asked.probe.steps, ASK_AT, DIRECTION);

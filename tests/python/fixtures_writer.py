@@ -7,7 +7,9 @@ tests/python/test_fixtures.py checks that the files still match this code.
 
 And tests/fixtures/runtime.json: inputs for each shipped model (public/models) and what Python's
 onnxruntime computes from them, which tests/e2e/runtime.test.mjs asks of the page's onnxruntime-web
-(another version, compiled to WebAssembly). Re-export the models, then rerun this script.
+(another version, compiled to WebAssembly). Re-export the models, then rerun this script (on a VNNI
+CPU, docs/testing.md; `--only runtime` writes that file alone, `--only bvh features rollout contact`
+all but it).
 
 All motion here is procedural (sinusoidal joint rotations, seeded random rotations, two dancers
 circling each other) and every BVH is generated text: no recorded motion is ever written out.
@@ -340,6 +342,8 @@ def features_fixture(rng: np.random.Generator, lead: Track, follow: Track) -> di
             "FOLLOWER_INPUT_LAYOUT": feat.FOLLOWER_INPUT_LAYOUT, "LEADER_INPUT_LAYOUT": feat.LEADER_INPUT_LAYOUT,
             "OUTPUT_LAYOUT": feat.OUTPUT_LAYOUT, "INTENTION_LAYOUT": feat.INTENTION_LAYOUT,
             "CONTACT_HEIGHT": feat.CONTACT_HEIGHT, "CONTACT_SPEED": feat.CONTACT_SPEED,
+            "LEADER_INPUT_SIZE": feat.LEADER_INPUT_SIZE, "FIGURE_SIZE": feat.FIGURE_SIZE,
+            "FIGURE_WAYS": list(feat.FIGURE_WAYS), "FIGURE_OFFSETS": feat.FIGURE_OFFSETS.tolist(),
             "followerSlices": {k: [v.start, v.stop] for k, v in feat.block_slices(feat.FOLLOWER_INPUT_LAYOUT).items()},
         },
         "rootSpace": {
@@ -366,18 +370,45 @@ def features_fixture(rng: np.random.Generator, lead: Track, follow: Track) -> di
         },
         "followerInput": out7(feat.follower_input(lead, follow, frames)),
         "leaderInput": out7(feat.leader_input(follow, lead, frames)),
-        # The figure block asked for: the follower's own turn ahead, as the leader's samples carry it.
-        "partnerTurn": out7(feat.partner_turn(follow, frames)),
-        # ... and the hands plan of the leader's samples: his own hands' moves over the next second.
+        # The figure block (features.figure_block) for spans around the fixture's frames.
+        "figureBlocks": figure_block_cases(frames),
+        # Both inputs with a figure being led (the figure block of LED_SPANS, in the tracks' frames)
+        # and the leader's with the hands plan of his samples: his own hands' moves over the next second.
+        "ledSpans": exact(LED_SPANS),
         "handsMoves": out7(feat.hands_moves(lead, frames)),
-        "leaderInputAsked": out7(feat.leader_input(follow, lead, frames,
-                                                   feat.figure_block(feat.partner_turn(follow, frames), len(frames)),
-                                                   feat.hands_plan_block(feat.hands_moves(lead, frames), len(frames)))),
+        "followerInputLed": out7(feat.follower_input(lead, follow, frames, feat.figure_block(LED_SPANS, frames))),
+        "leaderInputLed": out7(feat.leader_input(follow, lead, frames, feat.figure_block(LED_SPANS, frames),
+                                                 feat.hands_plan_block(feat.hands_moves(lead, frames), len(frames)))),
         "followerOutput": out7(feat.output_features(follow, frames)),
         "leaderOutput": out7(feat.output_features(lead, frames)),
         "followerIntention": out7(feat.intention_target(lead, follow, frames)),
         "leaderIntention": out7(feat.intention_target(follow, lead, frames)),
     }
+
+
+# Her turns to her left (+1) and right (-1) in the features fixture's frames (t = 30, 31): one ended
+# 10 frames ago, one running, one beginning 12 frames on; the running and the coming overlap.
+LED_SPANS = np.array([(1, -5, 20), (-1, 14, 40), (1, 43, 70)])
+
+
+def figure_block_cases(frames: np.ndarray) -> list[dict]:
+    """features.figure_block at the fixture's frames: no figure, and spans that start or end on a
+    key, overlap (the same way: the later one's progress; both ways: each its own), last one frame
+    or none (start == end), or lie beyond the block's reach (t-30, t+30)."""
+    cases = [
+        None,
+        [],
+        [(1, 30, 60)],                             # begins now at t = 30, a frame ago at t = 31
+        [(-1, 0, 30)],                             # began at the block's first key, ends now
+        [(1, 10, 40), (1, 35, 50)],                # the same way, overlapping: the later one's progress
+        [(1, 10, 40), (-1, 35, 50)],               # both ways at once
+        [(-1, 45, 45), (1, 20, 21)],               # a one-frame figure, and one of two frames
+        [(1, -40, -1), (-1, 62, 90)],              # out of reach at t = 30 (the past key -1 is t-31)
+        [(-1, 5, 61), (1, 61, 95), (-1, 70, 80)],  # the last key's edge at t = 31
+    ]
+    return [{"figures": None if c is None else [list(map(int, f)) for f in c],
+             "expected": out7(feat.figure_block(None if c is None else np.array(c).reshape(-1, 3), frames))}
+            for c in cases]
 
 
 # ---------------------------------------------------------------- rollout
@@ -483,6 +514,76 @@ def on_count_cases(rng: np.random.Generator, outputs: np.ndarray, ranges: dict, 
                          for m in (-9.0, 0.0, 0.05, 9.0) for k in (0.0, 0.7, 1.5)}}
 
 
+class Draws:
+    """A stand-in for Figures.rng: .random() gives these numbers in order (the TypeScript tests feed
+    the same list to their Figures), so both sides plan the same own figures."""
+
+    def __init__(self, numbers):
+        self.numbers = [float(v) for v in numbers]
+        self.used = 0
+
+    def random(self) -> float:
+        self.used += 1
+        return self.numbers[self.used - 1]
+
+
+def led_state(figures: ro.Figures) -> list[list]:
+    """Every figure of a duet as [way, start, end, asked]."""
+    return [[x.way, x.start, x.end, x.asked] for x in figures.led]
+
+
+# The schedule fixture: a duet's clock alone (no models), the visitor's asks at some frames, his
+# own figures switched off for a while; (frame, direction) before that frame's step.
+SCHEDULE_FRAMES = 420
+SCHEDULE_ASKS = [
+    (40, -1),     # his own figure runs (24-58): the ask follows it (63)
+    (41, 1),      # asked again before that began: the second takes the place of the first
+    (95, -1),     # the asked figure runs (63-97): this one follows it
+    (190, 1),     # his own is planned (221), not begun: the ask takes its place, on the next beat
+    (300, -1),    # his own are off: on the next beat (309)
+    (301, -1),    # and again before it began
+]
+SCHEDULE_OWN_OFF = (260, 330)   # frames [from, to) with Figures.own off
+
+
+def figures_fixture(manifest: dict) -> dict:
+    """The figures of a duet (rollout.Figures) over SCHEDULE_FRAMES steps of its clock at a tempo
+    between beats, his own drawn from a fixed list: each step the visitor's asks, then plan_figures
+    (as step() and the page run it), then what is danced; and the count helpers on their own."""
+    draws = Draws(np.round(np.random.default_rng(SEED + 4).random(40), 6))
+    duet = ro.start_duet(manifest, tempo=183.0)
+    duet.beat = 0.61
+    duet.figures = ro.Figures(own=True, rng=draws)
+    asks = dict(SCHEDULE_ASKS)
+    steps = []
+    for frame in range(SCHEDULE_FRAMES):
+        assert duet.frame == frame
+        duet.figures.own = not (SCHEDULE_OWN_OFF[0] <= frame < SCHEDULE_OWN_OFF[1])
+        if frame in asks:
+            ro.ask_turn(duet, asks[frame])
+        ro.plan_figures(duet)
+        at = duet.figures.at(frame)
+        steps.append({"led": led_state(duet.figures), "at": None if at is None else duet.figures.led.index(at),
+                      "spans": duet.figures.spans(frame).ravel().tolist()})
+        duet.frame += 1
+        duet.beat += music.beats_per_step(duet.tempo)
+    # The helpers on a clock at frame 7, beat 2.95 (0.05 before the 3).
+    clock = ro.start_duet(manifest, tempo=171.0)
+    clock.frame, clock.beat = 7, 2.95
+    to_beat = [{"frame": f, "beat": b, "expected": ro.frames_to_beat(clock, f, b)}
+               for f, b in ((7, 3.0), (7, 2.9), (7, 2.95), (7, 4.0), (12, 4.0), (3, 3.0))]
+    figure_from = [{"frame": f, "way": w, "asked": a, "expected": led_state(ro.Figures(led=[ro.figure_from(clock, f, w, a)]))[0]}
+                   for f, w, a in ((7, 1, True), (8, -1, False), (10, 0, True), (40, -3, False))]
+    led = ro.Led(-1, 20, 56)
+    share = [{"frame": f, "share": ro.figure_share(led, f), "raised": ro.raised(led, f)}
+             for f in (0, 19, 20, 21, 26, 32, 38, 50, 56, 57, 64, 71, 72, 100)]
+    return {"tempo": 183.0, "beat": 0.61, "draws": draws.numbers, "drawn": draws.used, "asks": SCHEDULE_ASKS,
+            "ownOff": list(SCHEDULE_OWN_OFF), "steps": steps,
+            "FIGURE_BEATS": ro.FIGURE_BEATS, "OWN_GAP_BEATS": list(ro.OWN_GAP_BEATS), "RAISE": list(ro.RAISE),
+            "clock": {"tempo": 171.0, "frame": 7, "beat": 2.95, "framesToBeat": to_beat, "figureFrom": figure_from},
+            "led": [led.way, led.start, led.end], "share": share}
+
+
 def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_offsets, follow_offsets) -> dict:
     vectors_f = np.round(rng.normal(size=(5, 3)), 6)
     vectors_u = np.round(rng.normal(size=(5, 3)), 6)
@@ -505,8 +606,11 @@ def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_o
         return o.astype(np.float32).astype(np.float64)
 
     # The music at another tempo than the default, its count between beats: each step reads both.
+    # His own figure is planned at the first step (her turn to her left, 1.2 beats on), and taken
+    # over by the visitor's ask before the second (to her right, on the next beat).
+    step_draws = Draws([0.02, 0.3])
     duet = ro.Duet(ro.Dancer(lead_offsets, window(lead)), ro.Dancer(follow_offsets, window(follow)), start_pose,
-                   tempo=176.5, beat=0.3)
+                   tempo=176.5, beat=0.3, figures=ro.Figures(own=True, rng=step_draws))
     duet.steering.velocity = np.array([0.3, -0.2])
     steps = []
     scenarios = [
@@ -521,8 +625,9 @@ def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_o
         if i in ask:
             ro.ask_turn(duet, ask[i])
         before_velocity = duet.steering.velocity.copy()
+        ro.plan_figures(duet)   # as step(): first
         ro.steer_plan(duet.leader, duet.steering, np.array(stick, float))
-        ro.lead_plan(duet)   # from step 1 a request runs: the plan bent her way
+        ro.lead_plan(duet)   # a figure is near from the first step: the plan bent her way
         planned_root, planned_heading = duet.leader.track.root.copy(), duet.leader.track.heading.copy()
         xl, xf = ro.step_inputs(duet)
         ol, of = plausible(lead, 30 + i % 2), plausible(follow, 30 + i % 2)
@@ -542,7 +647,7 @@ def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_o
             "leaderInput": out7(xl), "followerInput": out7(xf),
             "leaderOutput": [None if not np.isfinite(v) else float(v) for v in lead_out],
             "followerOutput": [float(v) for v in follow_out],
-            "followerIntention": exact(fi), "absurd": absurd, "ask": ask.get(i),
+            "followerIntention": exact(fi), "absurd": absurd, "ask": ask.get(i), "led": led_state(duet.figures),
             "leader": dancer_state(duet.leader), "follower": dancer_state(duet.follower),
         })
     # The guards: the leader drawn toward its anchor; a follower 3.3 m away leashed.
@@ -606,17 +711,52 @@ def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_o
         "startDuet": {"leader": dancer_state(started.leader), "follower": dancer_state(started.follower),
                       "tempo": started.tempo, "beat": started.beat},
         "steps": steps,
-        # A request's figure keys over its life: (frames since asked, direction) -> keys; None once over.
-        "figureInputs": [{"frame": f, "direction": d,
-                          "keys": out7(ro.figure_input(ro.TurnRequest(d, f)))}
-                         for f, d in ((0, 1), (7, -1), (30, 1), (59, -1), (74, 1))],
-        # ... and its hands plan, for the leader standing at frame 30 of the procedural track, his
-        # hands at the request given.
-        "handsInputs": [{"frame": f, "direction": d, "hands": exact(h),
-                         "moves": out7(ro.hands_input(ro.TurnRequest(d, f, h), ro.Dancer(lead_offsets, window(lead))))}
-                        for f, d, h in ((0, 1, request_hands[0]), (9, -1, request_hands[1]),
-                                        (30, 1, request_hands[0]), (59, -1, request_hands[1]), (74, 1, request_hands[1]))],
+        "stepDraws": step_draws.numbers, "stepDrawn": step_draws.used,
+        "figures": figures_fixture(manifest),
+        "handsInputs": hands_input_cases(lead_offsets, window(lead), request_hands),
+        "leadPlans": lead_plan_cases(lead_offsets, window(lead)),
     }
+
+
+# A figure at duet frames 40-76 for the hands plan and the bent path, read at frames around it.
+HANDS_FIGURE = (40, 76)
+HANDS_FRAMES = (5, 10, 11, 25, 40, 46, 52, 70, 76, 80, 91, 92)
+
+
+def hands_input_cases(offsets, track: Track, hands: np.ndarray) -> list[dict]:
+    """rollout.hands_input for the leader standing at frame 30 of the procedural track, a figure of
+    each way (his hands when its plan began given, or taken now: None) at HANDS_FRAMES, and two
+    figures at once (the plan is for the first near one)."""
+    out = []
+    for way, given in ((1, hands[0]), (-1, hands[1]), (-1, None)):
+        for frame in HANDS_FRAMES:
+            duet = ro.Duet(ro.Dancer(offsets, track), ro.Dancer(offsets, track), {}, frame=frame)
+            led = ro.Led(way, *HANDS_FIGURE, hands=None if given is None else given.copy())
+            duet.figures.led = [led]
+            moves = ro.hands_input(duet)
+            out.append({"way": way, "frame": frame, "hands": None if given is None else exact(given),
+                        "moves": None if moves is None else out7(moves),
+                        "handsAfter": None if led.hands is None else out7(led.hands)})
+    duet = ro.Duet(ro.Dancer(offsets, track), ro.Dancer(offsets, track), {}, frame=70)
+    duet.figures.led = [ro.Led(1, 20, 56, hands=hands[0].copy()), ro.Led(-1, 60, 96, hands=hands[1].copy())]
+    out.append({"two": [[1, 20, 56], [-1, 60, 96]], "hands": [exact(hands[0]), exact(hands[1])], "frame": 70,
+                "moves": out7(ro.hands_input(duet))})
+    return out
+
+
+def lead_plan_cases(offsets, track: Track) -> list[dict]:
+    """rollout.lead_plan on the leader's planned path (the procedural track's frames 31-60) for a
+    figure of each way and for two at once, at frames before, in and after them."""
+    out = []
+    for spans in ([(1, *HANDS_FIGURE)], [(-1, *HANDS_FIGURE)], [(1, 20, 56), (-1, 60, 96)]):
+        for frame in (0, 15, 30, 45, 58, 70, 76, 90):
+            leader = ro.Dancer(offsets, Track(track.positions, track.rotations, track.root.copy(), track.heading.copy()))
+            duet = ro.Duet(leader, leader, {}, frame=frame)
+            duet.figures.led = [ro.Led(w, a, b) for w, a, b in spans]
+            ro.lead_plan(duet)
+            out.append({"figures": [list(x) for x in spans], "frame": frame,
+                        "root": out7(leader.track.root), "heading": out7(leader.track.heading)})
+    return out
 
 
 def contact_fixture(rng: np.random.Generator, leader: Motion, follower: Motion) -> dict:
@@ -689,27 +829,38 @@ def runtime_fixture(rng) -> dict:
     return out
 
 
-def build() -> dict[str, dict]:
+FIXTURES = ("bvh", "features", "rollout", "contact", "runtime")
+
+
+def build(names=FIXTURES) -> dict[str, dict]:
+    """The fixtures named (bvh, features and rollout draw from one generator in turn: all three are
+    always made, and only the named returned)."""
     rng = np.random.default_rng(SEED)
     bvh = bvh_fixture(rng)
     leader, follower = procedural_pair(rng)
     lead, follow = rounded_track(leader), rounded_track(follower)
-    return {
+    made = {
         "bvh": bvh,
         "features": features_fixture(rng, lead, follow),
         "rollout": rollout_fixture(rng, lead, follow, leader.offsets, follower.offsets),
-        "contact": contact_fixture(np.random.default_rng(SEED + 1), leader, follower),
-        "runtime": runtime_fixture(np.random.default_rng(SEED + 2)),
     }
+    if "contact" in names:
+        made["contact"] = contact_fixture(np.random.default_rng(SEED + 1), leader, follower)
+    if "runtime" in names:
+        made["runtime"] = runtime_fixture(np.random.default_rng(SEED + 2))
+    return {name: made[name] for name in names}
 
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default=str(OUT_DIR))
+    ap.add_argument("--only", nargs="+", choices=FIXTURES, default=list(FIXTURES),
+                    help="write these fixtures alone (runtime needs the shipped models, and a VNNI CPU "
+                         "for outputs the other CPUs reproduce: docs/testing.md)")
     args = ap.parse_args(argv)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    for name, data in build().items():
+    for name, data in build(args.only).items():
         path = out / f"{name}.json"
         path.write_text(json.dumps(data, separators=(",", ":"), allow_nan=False) + "\n")
         print(f"{path}: {path.stat().st_size / 1024:.0f} KiB")

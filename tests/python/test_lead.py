@@ -1,6 +1,6 @@
-"""Leading a turn: the leader's figure block (features.figure_block, partner_turn), the request's
-plan (rollout.ask_turn, figure_input), the training's hidden figures and turn onsets, and the
-evaluation tool training.evaluation.lead."""
+"""Leading a turn: the figure block both dancers read (features.figure_block), the figures of a
+duet (rollout.ask_turn, plan_figures) and his hands plan and path for them, the training's hidden
+hands plan and turn onsets, and the evaluation tool training.evaluation.lead."""
 from __future__ import annotations
 
 import json
@@ -17,42 +17,72 @@ from training.mirror.features import FUTURE_OFFSETS, KEYS, Track
 from training.mirror.skeleton import FPS, HANDS
 
 
-def spinning_track(frames: int, degrees_per_second: float) -> Track:
-    """A track whose root heading turns at a constant rate (positions unused by partner_turn)."""
-    heading = np.angle(np.exp(1j * np.radians(degrees_per_second) * np.arange(frames) / FPS))
-    return Track(np.zeros((frames, 17, 3)), np.zeros((frames, 17, 3, 3)), np.zeros((frames, 2)), heading)
+def test_the_figure_block_reads_each_figure_over_the_past_and_next_second():
+    assert np.all(feat.figure_block(None, np.arange(3)) == 0)
+    # Her turn to her left from frame 100 to 140, to her right from 150 to 170.
+    figures = np.array([(1, 100, 140), (-1, 150, 170)])
+    block = feat.figure_block(figures, np.array([90, 120, 160])).reshape(3, len(feat.FIGURE_OFFSETS), 2, 2)
+    t = np.array([90, 120, 160])[:, None] + feat.FIGURE_OFFSETS[None]
+    left = (t >= 100) & (t <= 140)
+    right = (t >= 150) & (t <= 170)
+    assert np.array_equal(block[..., 0, 0], left) and np.array_equal(block[..., 1, 0], right)
+    assert np.allclose(block[..., 0, 1], np.where(left, (t - 100) / 40, 0))
+    assert np.allclose(block[..., 1, 1], np.where(right, (t - 150) / 20, 0))
+    # His control stands where her partner's planned path stands; the hands plan is his alone.
+    assert feat.LEADER_INPUT_SIZE == feat.INPUT_SIZE + feat.HANDS_PLAN_SIZE
 
 
-def test_partner_turn_counts_whole_turns_through_the_wrap():
-    # 540 deg/s: one and a half turns a second, wrapping the heading many times.
-    turns = feat.partner_turn(spinning_track(200, 540.0), np.array([40, 90]))
-    assert np.allclose(turns, 1.5 * FUTURE_OFFSETS[None] / FPS, atol=1e-9)
-    clockwise = feat.partner_turn(spinning_track(200, -200.0), np.array([50]))
-    assert np.all(clockwise < 0) and clockwise[0, -1] == pytest.approx(-200 / 360)
-
-
-def test_the_figure_block_says_whether_anyone_asked():
-    assert np.all(feat.figure_block(None, 3) == 0)
-    asked = feat.figure_block(np.full((2, KEYS), 0.25), 2)
-    assert asked.shape == (2, feat.FIGURE_SIZE) and np.all(asked[:, 0] == 1) and np.all(asked[:, 1:] == 0.25)
-    assert feat.LEADER_INPUT_SIZE == feat.INPUT_SIZE + feat.FIGURE_SIZE + feat.HANDS_PLAN_SIZE
-
-
-def test_a_request_plans_one_full_turn_and_ends():
-    assert ro.planned_turn(0.0) == 0 and ro.planned_turn(ro.TURN_START + ro.TURN_SECONDS) == 1
-    keys = [ro.figure_input(ro.TurnRequest(-1, f)) for f in range(int(ro.REQUEST_SECONDS * FPS))]
-    assert all(np.all(k <= 0) for k in keys)                       # clockwise all the way
-    # Summed over the request, the keys 1 s ahead cover the whole planned turn once.
-    ahead = [-k[-1] for k in keys]
-    assert max(ahead) == pytest.approx(ro.planned_turn(1.0 + 0.4) - ro.planned_turn(0.4), abs=0.05)
-    assert ro.figure_input(None) is None
+def manifest_duet(**kw):
     offsets = np.zeros((17, 3)).tolist()
-    duet = ro.start_duet({"skeleton": {"offsets": {"leader": offsets, "follower": offsets}}, "startPose": START_POSE})
+    return ro.start_duet({"skeleton": {"offsets": {"leader": offsets, "follower": offsets}}, "startPose": START_POSE}, **kw)
+
+
+def run_steps(duet, n):
+    """Move the duet's clock n steps on (the figures' own timing only; nobody dances)."""
+    for _ in range(n):
+        ro.plan_figures(duet)
+        duet.frame += 1
+        duet.beat += ro.music.beats_per_step(duet.tempo)
+
+
+def test_a_figure_asked_for_starts_on_the_next_beat_and_both_dancers_read_it():
+    duet = manifest_duet(figures=False)
+    run_steps(duet, 40)
     ro.ask_turn(duet, 1)
+    (led,) = duet.figures.led
+    per = ro.music.beats_per_step(duet.tempo)
+    start_beat = duet.beat + (led.start - duet.frame) * per
+    assert led.way == 1 and led.asked and 0 <= led.start - duet.frame <= 1 / per + 1
+    assert start_beat == pytest.approx(round(start_beat), abs=per)        # on a beat of the count
+    assert (led.end - led.start) * per == pytest.approx(ro.FIGURE_BEATS, abs=per)
     x_leader, x_follower = ro.step_inputs(duet)
-    fig = feat.block_slices(feat.LEADER_INPUT_LAYOUT)["figure"]
-    assert x_leader.shape == (feat.LEADER_INPUT_SIZE,) and x_leader[fig][0] == 1
-    assert x_follower.shape == (feat.INPUT_SIZE,)                  # the follower is never told
+    fl = x_leader[feat.block_slices(feat.LEADER_INPUT_LAYOUT)["figure"]]
+    ff = x_follower[feat.block_slices(feat.FOLLOWER_INPUT_LAYOUT)["figure"]]
+    assert np.array_equal(fl, ff) and fl.reshape(-1, 2, 2)[-1, 0, 0] == 1   # coming within the second, her left
+    # Asked again before it begins, the new way takes its place.
+    ro.ask_turn(duet, -1)
+    assert [(f.way, f.asked) for f in duet.figures.led] == [(-1, True)]
+    # A request while one runs waits for it to end; a later one takes the waiting one's place.
+    run_steps(duet, duet.figures.led[0].start - duet.frame + 2)
+    ro.ask_turn(duet, 1)
+    ro.ask_turn(duet, -1)
+    first, second = duet.figures.led
+    assert (first.way, second.way, second.asked) == (-1, -1, True) and second.start > first.end
+
+
+def test_nobody_asking_he_leads_his_own_figures_at_the_recorded_rate():
+    duet = manifest_duet(figures=True, seed=5)
+    starts, ways = set(), []
+    for _ in range(30 * 600):     # ten minutes
+        run_steps(duet, 1)
+        for f in duet.figures.led:
+            if f.start not in starts:
+                starts.add(f.start)
+                ways.append(f.way)
+    per_minute = len(starts) / 10
+    assert 14 < per_minute < 20                      # the recorded couples: 16.9 a minute at 163-187 bpm
+    assert 0.35 < np.mean(np.array(ways) > 0) < 0.65
+    assert not manifest_duet(figures=False).figures.own
 
 
 START_POSE = {r: {"hip": [0.0, 0.9, 0.0], "forward": [[0.0, 0.0, 1.0]] * 17, "up": [[0.0, 1.0, 0.0]] * 17}
@@ -78,55 +108,52 @@ def test_hands_moves_are_where_his_hands_go_less_where_they_are():
     assert np.all(feat.hands_plan_block(None, 2) == 0)
 
 
-def test_a_request_raises_his_lead_hand_and_lowers_it():
-    assert ro.raised(0.0) == 0 and ro.raised(ro.RAISE[1]) == 1 and ro.raised(ro.RAISE[3]) == 0
-    offsets = np.zeros((17, 3)).tolist()
-    duet = ro.start_duet({"skeleton": {"offsets": {"leader": offsets, "follower": offsets}}, "startPose": START_POSE})
+def test_a_figure_raises_his_lead_hand_and_lowers_it():
+    duet = manifest_duet(figures=False)
     ro.ask_turn(duet, -1)                                  # her turn to the right: his right hand leads
-    request, leader = duet.request, duet.leader
+    led, leader = duet.figures.led[0], duet.leader
     hands = feat.to_root_space_points(leader.positions[HANDS], leader.root, leader.heading)
-    assert np.allclose(request.hands, hands)
-    tops = []
-    for f in range(int(ro.REQUEST_SECONDS * FPS)):
-        request.frame = f
-        moves = ro.hands_input(request, leader)
-        assert np.allclose(moves[:, 0], 0.0)               # the other hand stays where it was
-        tops.append(hands[1] + moves[-1, 1])              # where the lead hand is to be 1 s ahead
-    tops = np.array(tops)
+    assert ro.raised(led, led.start) == 0 and ro.raised(led, led.start + ro.RAISE[0] * FPS) == 1
+    assert ro.raised(led, led.end + ro.RAISE[1] * FPS) == 0
     top = np.array(ro.LEAD_HAND_RAISED) * [-1, 1, 1]
-    raised = tops[int(0.2 * FPS):int(0.8 * FPS)]          # keys 1 s ahead: 1.2-1.8 s, held up
-    assert np.allclose(raised, top)
-    assert np.allclose(tops[-1], hands[1], atol=1e-9)      # and down again where it was by the end
-    assert ro.hands_input(None, leader) is None
+    tops = []
+    for f in range(led.end + int(ro.RAISE[1] * FPS) + 2):
+        duet.frame = f
+        moves = ro.hands_input(duet)
+        if moves is None:
+            tops.append(None)
+            continue
+        assert np.allclose(moves[:, 0], 0.0)               # the other hand stays where it was
+        tops.append(hands[1] + moves[0, 1])               # where the lead hand is to be 1/6 s ahead
+    assert np.allclose(led.hands, hands)
+    up = tops[led.start + int(ro.RAISE[0] * FPS):led.end - 5]
+    assert up and all(np.allclose(t, top) for t in up)  # held up while she turns
+    assert tops[-1] is None                                # and no plan once it is down
+    duet.frame = led.start
     x_leader, _ = ro.step_inputs(duet)
     assert x_leader[feat.block_slices(feat.LEADER_INPUT_LAYOUT)["hands_plan"]][0] == 1
 
 
-@pytest.mark.parametrize("block", ["figure", "hands_plan"])
-def test_training_hides_a_block_in_a_share_of_samples(block):
+def test_his_planned_path_leads_her_turns_way():
+    duet = manifest_duet(figures=False)
+    ro.ask_turn(duet, 1)
+    led = duet.figures.led[0]
+    duet.frame = led.start
+    before = duet.leader.track.heading.copy()
+    ro.lead_plan(duet)
+    turned = np.degrees(duet.leader.track.heading - before)[ro.NOW + FUTURE_OFFSETS]
+    share = np.array([ro.figure_share(led, led.start + o) for o in FUTURE_OFFSETS])
+    assert np.allclose(turned, ro.LEAD_TURN * share) and turned[-1] > 0
+
+
+def test_training_hides_the_hands_plan_in_a_share_of_samples():
+    block = "hands_plan"
     x = torch.ones(4000, feat.LEADER_INPUT_SIZE)
     hidden = T.hide_block(x, block, 0.5, torch.Generator().manual_seed(0))
     sl = feat.block_slices(feat.LEADER_INPUT_LAYOUT)[block]
     share = (hidden[:, sl] == 0).all(1).float().mean().item()
     assert 0.45 < share < 0.55
     assert torch.equal(hidden[:, :sl.start], x[:, :sl.start]) and torch.equal(hidden[:, sl.stop:], x[:, sl.stop:])
-
-
-def test_the_partner_is_hidden_only_where_the_figure_is_shown():
-    sl = feat.block_slices(feat.LEADER_INPUT_LAYOUT)
-    x = torch.randn(4000, feat.LEADER_INPUT_SIZE)
-    x[:2000, sl["figure"].start] = 1.0      # figure shown
-    x[2000:, sl["figure"]] = 0.0            # nobody asks
-    mean = torch.full((feat.LEADER_INPUT_SIZE,), 7.0)
-    out = T.hide_partner_when_figure(x, 0.5, mean, torch.Generator().manual_seed(0))
-    partner = torch.cat([torch.arange(feat.LEADER_INPUT_SIZE)[sl[b]] for b in
-                         ("partner_trajectory_past", "partner_key_joints_past", "partner_pose")])
-    hidden = (out[:, partner] == 7.0).all(1)
-    assert 0.45 < hidden[:2000].float().mean().item() < 0.55
-    assert not hidden[2000:].any()
-    rest = torch.ones(feat.LEADER_INPUT_SIZE, dtype=torch.bool)
-    rest[partner] = False
-    assert torch.equal(out[:, rest], x[:, rest])       # his own blocks, control and figure untouched
 
 
 def test_turn_onsets_need_a_turn_ahead_and_none_behind():
@@ -255,7 +282,7 @@ def test_recorded_leads_reads_his_hands_around_her_turns(data3, capsys):
     r = recorded_leads.windows(str(data3))
     up, she = r[:, 0], r[:, 1]
     assert 0 < up.sum() < len(r) and she.mean() == pytest.approx((she[up].sum() + she[~up].sum()) / len(r))
-    assert f"In {len(r)} windows of 2.5 s" in out
+    assert f"In {len(r)} windows of {lead.REQUEST_SECONDS:g} s" in out
     # The recorded couple read as requests: with his hand up against all windows, and a follower
     # who turned after every raise: never below her share with his hand up.
     recorded, every = recorded_leads.request_contrast(r)

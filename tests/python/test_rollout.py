@@ -204,29 +204,32 @@ def test_steering_bends_the_leader_plan(duet_and_output):
 
 
 @pytest.mark.parametrize("direction", [1, -1])
-def test_a_request_turns_his_plan_her_way_and_moves_it_aside(duet_and_output, direction):
+def test_a_figure_turns_his_plan_her_way_and_moves_it_aside(duet_and_output, direction):
     duet, _ = duet_and_output
     t, keys = duet.leader.track, R.NOW + feat.FUTURE_OFFSETS
     root, heading = t.root[keys].copy(), t.heading[keys].copy()
-    R.lead_plan(duet)                                     # nobody asks: the plan as it was
+    duet.figures.led = []
+    R.lead_plan(duet)                                     # no figure: the plan as it was
     np.testing.assert_array_equal(t.root[keys], root)
     np.testing.assert_array_equal(t.heading[keys], heading)
     R.ask_turn(duet, direction)
-    duet.request.frame = int(R.TURN_START * FPS)          # her planned turn starts now
+    led = duet.figures.led[0]
+    duet.frame = led.start                                # her turn starts now
     R.lead_plan(duet)
     turned = np.degrees(t.heading[keys] - heading) * direction
     # Over the next second the plan turns her way, more at each key, up to the share of her turn
-    # made by then (the turn's first second of its 1.2).
-    assert np.all(np.diff(turned) > 0) and turned[0] > 0
-    np.testing.assert_allclose(turned[-1], R.LEAD_TURN * R.planned_turn(R.TURN_START + 1.0), rtol=1e-9)
+    # planned by then.
+    share = R.figure_share(led, led.start + feat.FUTURE_OFFSETS[-1])
+    assert np.all(np.diff(turned) >= 0) and turned[0] > 0 and 0 < share < 1
+    np.testing.assert_allclose(turned[-1], R.LEAD_TURN * share, rtol=1e-9)
     # ... and moves to his other side: his right for her turn to the left, in his root space.
     local = feat.to_root_space_directions(
         np.stack([t.root[keys, 0] - root[:, 0], np.zeros(len(keys)), t.root[keys, 1] - root[:, 1]], -1),
         t.heading[R.NOW])
-    np.testing.assert_allclose(local[-1, 0], -direction * R.LEAD_SIDE * R.planned_turn(R.TURN_START + 1.0), rtol=1e-9)
+    np.testing.assert_allclose(local[-1, 0], -direction * R.LEAD_SIDE * share, rtol=1e-9)
     np.testing.assert_allclose(local[:, 2], 0, atol=1e-12)
-    # Once the request is over the plan is left alone again.
-    duet.request = None
+    # Once the figure is over the plan is left alone again.
+    duet.frame = led.end + 1
     before = t.root[keys].copy()
     R.lead_plan(duet)
     np.testing.assert_array_equal(t.root[keys], before)

@@ -24,6 +24,9 @@ describe('constants and layouts', () => {
     expect(F.OUTPUT_LAYOUT).toEqual(c.OUTPUT_LAYOUT);
     expect(F.INTENTION_LAYOUT).toEqual(c.INTENTION_LAYOUT);
     expect([F.CONTACT_HEIGHT, F.CONTACT_SPEED]).toEqual([c.CONTACT_HEIGHT, c.CONTACT_SPEED]);
+    expect([F.LEADER_INPUT_SIZE, F.FIGURE_SIZE]).toEqual([c.LEADER_INPUT_SIZE, c.FIGURE_SIZE]);
+    expect([...F.FIGURE_WAYS]).toEqual(c.FIGURE_WAYS);
+    expect([...F.FIGURE_OFFSETS]).toEqual(c.FIGURE_OFFSETS);
   });
 
   it('blockSlices gives Python slices', () => {
@@ -104,6 +107,22 @@ describe('blocks', () => {
   });
 });
 
+describe('figureBlock', () => {
+  it('reads each figure\'s way, inside and progress at every key of the past and next second', () => {
+    for (const [n, c] of (data.figureBlocks as { figures: number[][] | null; expected: number[] }[]).entries()) {
+      const flat = c.figures === null ? null : c.figures.flat();
+      const out = perFrame(F.FIGURE_SIZE, (t, o, at) => F.figureBlock(flat, t, o, at));
+      expectClose(out, c.expected, `figure block, case ${n} ${JSON.stringify(c.figures)}`);
+    }
+  });
+  it('overwrites what was there, and writes nothing beyond its 52 numbers', () => {
+    const out = new Float64Array(F.FIGURE_SIZE + 4).fill(7);
+    F.figureBlock(null, 30, out, 2);
+    expect([...out.subarray(0, 2), ...out.subarray(F.FIGURE_SIZE + 2)]).toEqual([7, 7, 7, 7]);
+    expect(out.subarray(2, F.FIGURE_SIZE + 2).every((v) => v === 0)).toBe(true);
+  });
+});
+
 /** Run a per-frame feature function at every fixture frame t into one [N × size] array. */
 function perFrame(size: number, f: (t: number, out: Float64Array, at: number) => void): Float64Array {
   const out = new Float64Array(times.length * size);
@@ -118,15 +137,22 @@ describe('model inputs, outputs and intention', () => {
   it('leaderInput (partner = follower, control = own future)', () => {
     expectClose(perFrame(F.LEADER_INPUT_SIZE, (t, o, at) => F.leaderInput(follower, leader, t, o, at)), data.leaderInput, 'leader input');
   });
-  it('leaderInput with a figure asked for (the partner\'s turn ahead) and a hands plan (his hands\' moves)', () => {
-    const turns = data.partnerTurn as number[];
+  it('both inputs with a figure being led, the leader\'s with a hands plan (his hands\' moves)', () => {
+    const spans = data.ledSpans as number[];
     const moves = data.handsMoves as number[];
     const size = F.HANDS_PLAN_SIZE - 1;
-    const asked = perFrame(F.LEADER_INPUT_SIZE, (t, o, at) => {
+    const figure = new Float64Array(F.FIGURE_SIZE);
+    const led = perFrame(F.LEADER_INPUT_SIZE, (t, o, at) => {
       const i = at / F.LEADER_INPUT_SIZE;
-      F.leaderInput(follower, leader, t, o, at, turns.slice(i * F.KEYS, (i + 1) * F.KEYS), moves.slice(i * size, (i + 1) * size));
+      F.figureBlock(spans, t, figure);
+      F.leaderInput(follower, leader, t, o, at, figure, moves.slice(i * size, (i + 1) * size));
     });
-    expectClose(asked, data.leaderInputAsked, 'leader input, asked');
+    expectClose(led, data.leaderInputLed, 'leader input, a figure led');
+    const felt = perFrame(F.INPUT_SIZE, (t, o, at) => {
+      F.figureBlock(spans, t, figure);
+      F.followerInput(leader, follower, t, o, at, figure);
+    });
+    expectClose(felt, data.followerInputLed, 'follower input, a figure led');
   });
   it('outputFeatures of both dancers (incl. foot contacts)', () => {
     expectClose(perFrame(F.OUTPUT_SIZE, (t, o, at) => F.outputFeatures(follower, t, o, at)), data.followerOutput, 'follower output');

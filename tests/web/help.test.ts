@@ -86,7 +86,7 @@ describe('the help, against the manifest and the page', () => {
 
   it('the brief names every control of the panel', () => {
     const terms = BRIEF.map(([term]) => term).join(' · ');
-    for (const key of ['model', 'temperature', 'tempo', 'music', 'ghosts', 'trajectories', 'intentions', 'skeleton', 'view', 'share'] as const) {
+    for (const key of ['model', 'temperature', 'tempo', 'music', 'figures', 'ghosts', 'trajectories', 'intentions', 'skeleton', 'view', 'share'] as const) {
       expect(terms).toContain(CONTROLS[key][0]);
     }
   });

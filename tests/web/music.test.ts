@@ -44,7 +44,7 @@ describe('music block', () => {
     const heard = new Float64Array(M.MUSIC_SIZE);
     M.musicBlock(2.25, 3, heard);
     const out = new Float32Array(F.INPUT_SIZE);
-    F.followerInput(track, track, 30, out, 0, heard);
+    F.followerInput(track, track, 30, out, 0, null, heard);
     expectClose(out.subarray(F.INPUT_SIZE - M.MUSIC_SIZE), [...heard], 'the music given');
   });
 });

@@ -1,15 +1,47 @@
 // web/mirror/rollout.ts against training/mirror/rollout.py: start pose, and four steps of the duet loop from the
-// procedural dancers (steering, both inputs, outputs applied, intention, and absurd outputs that
-// reset a dancer: NaN, a root jump, a joint too far).
+// procedural dancers (his own figure planned, a visitor's ask, steering, both inputs, outputs applied,
+// intention, and absurd outputs that reset a dancer: NaN, a root jump, a joint too far); the figures'
+// schedule on the count over 420 steps (his own drawn from a fixed list), their hands plan and bent path.
 
 import { describe, expect, it } from 'vitest';
 import { INPUT_SIZE, LEADER_INPUT_SIZE } from '../../web/mirror/features';
 import * as R from '../../web/mirror/rollout';
+import { beatsPerStep } from '../../web/mirror/music';
 import { type Json, expectClose, fixture, trackOf } from './fixture';
 
 const data = fixture('rollout');
 const features = fixture('features');
 const NOW = R.NOW;
+
+/** Figures.rng giving these numbers in order (Python's fixture feeds the same list), counting its draws. */
+function draws(numbers: number[]): { rng: () => number; used: () => number } {
+  let used = 0;
+  return { rng: () => numbers[used++], used: () => used };
+}
+
+/** Every figure as Python's fixture writes it: [way, start, end, asked]. */
+const ledState = (figures: R.Figures) => figures.led.map((x) => [x.way, x.start, x.end, x.asked]);
+
+/** A leader standing at frame 30 of the procedural track (his track: its frames 0..60). */
+function standingLeader(): R.Dancer {
+  const leader = new R.Dancer(Float64Array.from(data.offsets.leader));
+  const source = trackOf(features, 'leader', R.TRACK_FRAMES);
+  leader.track.positions.set(source.positions);
+  leader.track.rotations.set(source.rotations);
+  leader.track.root.set(source.root);
+  leader.track.heading.set(source.heading);
+  return leader;
+}
+
+/** A duet of that leader (his own partner: these functions read only him) at `frame`, with these figures. */
+function duetAt(frame: number, led: R.Led[], leader = standingLeader()): R.Duet {
+  const figures = new R.Figures(false, () => Number.NaN);
+  figures.led = led;
+  return { leader, followers: [leader], startPose: data.startPose, steering: new R.Steering(), frame, figures, tempo: 170, beat: 0 };
+}
+
+const led = (way: number, start: number, end: number, hands: number[] | null = null): R.Led =>
+  ({ way, start, end, asked: false, hands: hands === null ? null : Float64Array.from(hands) });
 
 function expectDancer(d: R.Dancer, expected: Json, label: string): void {
   const t = d.track;
@@ -80,22 +112,25 @@ describe('the duet loop, step by step', () => {
     d.track.heading.set(source.heading);
     return d;
   };
+  const stepDraws = draws(data.stepDraws);
   const duet: R.Duet = {
     leader: dancer('leader'),
     followers: [dancer('follower')],
     startPose: data.startPose,
     steering: new R.Steering(),
     frame: 0,
-    request: null,
+    figures: new R.Figures(true, stepDraws.rng),
     tempo: data.tempo,
     beat: data.beat,
   };
   const nan = (values: (number | null)[]) => Float32Array.from(values, (v) => (v === null ? NaN : v));
 
   (data.steps as Json[]).forEach((step, i) => {
-    it(`step ${i}: steerPlan, leadPlan, stepInputs, outputIsAbsurd, finishStep (absurd: ${step.absurd})`, () => {
+    it(`step ${i}: askTurn, planFigures, steerPlan, leadPlan, stepInputs, outputIsAbsurd, finishStep (absurd: ${step.absurd})`, () => {
       if (step.ask !== null) R.askTurn(duet, step.ask);
       duet.steering.velocity.set(step.steeringBefore);
+      R.planFigures(duet);
+      expect(ledState(duet.figures), 'the figures').toEqual(step.led);
       R.steerPlan(duet.leader, duet.steering, step.stick[0], step.stick[1]);
       R.leadPlan(duet);
       expectClose(duet.steering.velocity, step.steeringAfter, 'steering velocity');
@@ -117,40 +152,84 @@ describe('the duet loop, step by step', () => {
       expect(duet.frame).toBe(i + 1);
     });
   });
-  it('the count moved on one step of the tempo per step', () => {
+  it('the count moved on one step of the tempo per step, and his own figure drew as Python\'s', () => {
     expect(duet.beat).toBeCloseTo(data.beatAfter, 12);
+    expect(stepDraws.used()).toBe(data.stepDrawn);
   });
 });
 
-describe('a turn asked for', () => {
-  it('figureInput gives the planned partner turn over the request\'s life', () => {
-    for (const c of data.figureInputs as { frame: number; direction: number; keys: number[] }[]) {
-      expectClose(R.figureInput({ frame: c.frame, direction: c.direction, hands: new Float64Array(6) })!, c.keys, `figure keys at ${c.frame}`);
-    }
-    expect(R.figureInput(null)).toBeNull();
+describe('the figures', () => {
+  const f = data.figures;
+
+  it('constants match Python', () => {
+    expect([R.FIGURE_BEATS, [...R.OWN_GAP_BEATS], [...R.RAISE]]).toEqual([f.FIGURE_BEATS, f.OWN_GAP_BEATS, f.RAISE]);
   });
-  it('handsInput raises his lead hand and lowers it over the request\'s life', () => {
-    const leader = new R.Dancer(Float64Array.from(data.offsets.leader));
-    const source = trackOf(features, 'leader', R.TRACK_FRAMES);
-    leader.track.positions.set(source.positions);
-    leader.track.rotations.set(source.rotations);
-    leader.track.root.set(source.root);
-    leader.track.heading.set(source.heading);
-    for (const c of data.handsInputs as { frame: number; direction: number; hands: number[][]; moves: number[] }[]) {
-      const request = { frame: c.frame, direction: c.direction, hands: Float64Array.from(c.hands.flat()) };
-      expectClose(R.handsInput(request, leader)!, c.moves, `hands plan at ${c.frame}`);
+
+  it('framesToBeat and figureFrom keep to the count', () => {
+    const c = f.clock;
+    const clock = duetAt(c.frame, []);
+    clock.tempo = c.tempo;
+    clock.beat = c.beat;
+    for (const t of c.framesToBeat) expect(R.framesToBeat(clock, t.frame, t.beat), `to beat ${t.beat} from ${t.frame}`).toBe(t.expected);
+    for (const t of c.figureFrom) {
+      const x = R.figureFrom(clock, t.frame, t.way, t.asked);
+      expect([x.way, x.start, x.end, x.asked], `from ${t.frame}, way ${t.way}`).toEqual(t.expected);
     }
-    expect(R.handsInput(null, leader)).toBeNull();
   });
-  it('a request ends after REQUEST_SECONDS', () => {
-    const duet = R.startDuet({ skeleton: { offsets: data.offsets }, startPose: data.startPose });
-    R.askTurn(duet, 1);
-    const still = new Float32Array(data.steps[0].followerOutput.length);
-    for (let i = 0; i < R.REQUEST_SECONDS * 30; i++) {
-      expect(duet.request).not.toBeNull();
-      R.finishStep(duet, null, [still]);
+
+  it('figureShare and raised over a figure', () => {
+    const [way, start, end] = f.led;
+    for (const c of f.share) {
+      expect(R.figureShare(led(way, start, end), c.frame), `share at ${c.frame}`).toBeCloseTo(c.share, 12);
+      expect(R.raised(led(way, start, end), c.frame), `raised at ${c.frame}`).toBeCloseTo(c.raised, 12);
     }
-    expect(duet.request).toBeNull();
+  });
+
+  it(`askTurn and planFigures: the same schedule as Python's over ${f.steps.length} steps`, () => {
+    const d = draws(f.draws);
+    const duet = R.startDuet({ skeleton: { offsets: { leader: chunk(data.offsets.leader), follower: chunk(data.offsets.follower) } }, startPose: data.startPose }, 1, f.tempo, true, d.rng);
+    duet.beat = f.beat;
+    const asks = new Map<number, number>(f.asks);
+    (f.steps as { led: unknown[]; at: number | null; spans: number[] }[]).forEach((expected, frame) => {
+      expect(duet.frame).toBe(frame);
+      duet.figures.own = !(f.ownOff[0] <= frame && frame < f.ownOff[1]);
+      if (asks.has(frame)) R.askTurn(duet, asks.get(frame)!);
+      R.planFigures(duet);
+      expect(ledState(duet.figures), `the figures at frame ${frame}`).toEqual(expected.led);
+      const at = duet.figures.at(frame);
+      expect(at === null ? null : duet.figures.led.indexOf(at), `the figure danced at ${frame}`).toBe(expected.at);
+      expect(duet.figures.spans(frame), `spans at ${frame}`).toEqual(expected.spans);
+      duet.frame += 1; // the clock alone, as Python's fixture runs it (no models)
+      duet.beat += beatsPerStep(duet.tempo);
+    });
+    expect(d.used()).toBe(f.drawn);
+  });
+
+  it('handsInput raises his lead hand for a figure near, and lowers it after', () => {
+    for (const c of data.handsInputs as Json[]) {
+      const figures = c.two
+        ? (c.two as number[][]).map(([w, a, b], i) => led(w, a, b, c.hands[i]))
+        : [led(c.way, 40, 76, c.hands)];
+      const duet = duetAt(c.frame, figures);
+      const moves = R.handsInput(duet);
+      const label = `hands plan, way ${c.way ?? 'two'} at ${c.frame}`;
+      if (c.moves === null) expect(moves, label).toBeNull();
+      else expectClose(moves!, c.moves, label);
+      if (!c.two) {
+        if (c.handsAfter === null) expect(figures[0].hands, `${label}: hands kept`).toBeNull();
+        else expectClose(figures[0].hands!, c.handsAfter, `${label}: hands kept`);
+      }
+    }
+  });
+
+  it('leadPlan bends his planned path for every figure near', () => {
+    for (const c of data.leadPlans as Json[]) {
+      const duet = duetAt(c.frame, (c.figures as number[][]).map(([w, a, b]) => led(w, a, b)));
+      R.leadPlan(duet);
+      const label = `bent path, ${JSON.stringify(c.figures)} at ${c.frame}`;
+      expectClose(duet.leader.track.root, c.root, label);
+      expectClose(duet.leader.track.heading, c.heading, `${label}, its facing`);
+    }
   });
 });
 

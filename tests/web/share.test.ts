@@ -45,6 +45,18 @@ describe('readSettings', () => {
     expect(defaultSettings(0.5, 181).tempo).toBe(181);
   });
 
+  it('reads whether the leader leads figures of his own: on unless ?figures=0, written only when off', () => {
+    expect(defaults.figures).toBe(true);
+    expect(read('?figures=0').figures).toBe(false);
+    expect(read('?figures=1').figures).toBe(true);
+    expect(read('?figures=maybe').figures).toBe(true);
+    expect(new URLSearchParams(writeSettings(defaults, null, 0.5)).has('figures')).toBe(false);
+    const off = writeSettings({ ...defaults, figures: false }, null, 0.5);
+    expect(new URLSearchParams(off).get('figures')).toBe('0');
+    expect(read(`?${off}`).figures).toBe(false);
+    expect(new URLSearchParams(addressQuery('?figures=0&bodies=sticks', defaults, null, 0.5)).toString()).toBe('bodies=sticks&seed=42');
+  });
+
   it('writes the tempo only when it is not the manifest\'s, and music=0 only when muted', () => {
     const q = (s: Partial<Settings>, tempo = 170) => new URLSearchParams(writeSettings({ ...defaults, ...s }, null, 0.5, tempo));
     expect(q({}).has('tempo')).toBe(false);

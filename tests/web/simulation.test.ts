@@ -133,10 +133,13 @@ class FakePolicy implements StepPolicy {
 const policy = (o: FakeOptions) => new FakePolicy(o);
 const steer = { x: 0, z: 0, active: false };
 
-function simulation(followers: FakeOptions[] = [{ role: 'follower', intention: true }], leader: FakeOptions = { role: 'leader' }, extra: Partial<Manifest> = {}) {
+function simulation(
+  followers: FakeOptions[] = [{ role: 'follower', intention: true }], leader: FakeOptions = { role: 'leader' }, extra: Partial<Manifest> = {},
+  figures = true,
+) {
   const lead = new FakePolicy(leader);
   const follow = followers.map((o) => new FakePolicy(o));
-  const sim = createSimulation({ manifest: { ...manifest, ...extra }, leader: lead, followers: follow, seed: 1 });
+  const sim = createSimulation({ manifest: { ...manifest, ...extra }, leader: lead, followers: follow, seed: 1, figures });
   return { sim, lead, follow };
 }
 
@@ -230,7 +233,8 @@ describe('createSimulation', () => {
     const ranges = { hip_low: 0.7, head_above_hip_low: 0.4, feet_wide: 1.07, angle_high: [2.5, 0.59] };
     const keep = { leaderTemperature: 0.5, leaderGuard: { samples: 4, margin: 0.05, keepPlan: true }, plausibility: ranges };
     // Sample i stands 2 cm x i further to his side (the fake's spread): the samples differ, all stand.
-    const { sim, lead } = simulation([{ role: 'follower' }], { role: 'leader', spread: 0.02 }, keep);
+    // His own figures are off: only the visitor's leads (a hands plan only for it).
+    const { sim, lead } = simulation([{ role: 'follower' }], { role: 'leader', spread: 0.02 }, keep, false);
     await sim.step(steer, 1);
     expect(lead.temperatures).toEqual([0.5]); // nobody asks: his one run, standing, as before
     expect(sim.askTurn(-1)).toBe(true);
@@ -240,7 +244,7 @@ describe('createSimulation', () => {
     expect(lead.temperatures).toEqual([0.5, 0.5]);
     expect(sim.guards().upright).toBe(0); // a standing sample was kept: not a guarded step
     // Without keepPlan the same request takes his one sample, as before.
-    const plain = simulation([{ role: 'follower' }], { role: 'leader', spread: 0.02 }, { ...keep, leaderGuard: { samples: 4, margin: 0.05 } });
+    const plain = simulation([{ role: 'follower' }], { role: 'leader', spread: 0.02 }, { ...keep, leaderGuard: { samples: 4, margin: 0.05 } }, false);
     await plain.sim.step(steer, 1);
     plain.sim.askTurn(-1);
     await plain.sim.step(steer, 1);
@@ -390,6 +394,97 @@ describe('createSimulation', () => {
   });
 });
 
+describe('figures', () => {
+  const LEADER_FIGURE = blockSlices(LEADER_INPUT_LAYOUT).figure;
+  const FOLLOWER_FIGURE = blockSlices(FOLLOWER_INPUT_LAYOUT).figure;
+  const leaderFigure = (p: FakePolicy) => Array.from(p.input.subarray(LEADER_FIGURE.start, LEADER_FIGURE.end));
+  const followerFigure = (input: Float32Array, at = 0) => Array.from(input.subarray(at + FOLLOWER_FIGURE.start, at + FOLLOWER_FIGURE.end));
+  const none = (block: number[]) => block.every((v) => v === 0);
+
+  it('he leads his own, drawn from the seed; the leader, the followers and the possible reactions all read the same block', async () => {
+    const { sim, lead, follow } = simulation([{ role: 'follower' }, { role: 'follower' }]);
+    const s = sim as DuetSimulation;
+    let felt = 0;
+    let danced = 0;
+    const ways = new Set<number>();
+    for (let i = 0; i < 300; i++) {
+      await sim.step(steer, 0.5);
+      const block = leaderFigure(lead);
+      expect(followerFigure(follow[0].input), `step ${i}: her block is his`).toEqual(block);
+      expect(followerFigure(follow[1].input), `step ${i}: the compare follower's too`).toEqual(block);
+      if (!none(block)) felt++;
+      const figure = sim.figure;
+      if (figure && !figure.coming) {
+        danced++;
+        ways.add(figure.way);
+        expect(figure.asked).toBe(false);
+        expect(sim.turnAsked).toBe(0);
+      }
+      if (i === 150) {
+        // The possible reactions read the figure block of the step they take: all alike.
+        await sim.ghosts(2);
+        const rows = follow[0].batchInput(2);
+        expect(followerFigure(rows, INPUT_SIZE)).toEqual(followerFigure(rows, 0));
+      }
+    }
+    expect(felt).toBeGreaterThan(60); // 10 s: a figure every 10 beats or so, each felt from a second before
+    expect(danced).toBeGreaterThan(30);
+    expect(s.duet.figures.led.every((x) => !x.asked)).toBe(true);
+    // The same seed draws the same figures; reset() draws them anew from it.
+    const again = simulation([{ role: 'follower' }]);
+    for (let i = 0; i < 120; i++) await again.sim.step(steer, 0.5);
+    const first = (again.sim as DuetSimulation).duet.figures.led.map((x) => [x.way, x.start, x.end]);
+    again.sim.reset();
+    for (let i = 0; i < 120; i++) await again.sim.step(steer, 0.5);
+    expect((again.sim as DuetSimulation).duet.figures.led.map((x) => [x.way, x.start, x.end])).toEqual(first);
+  });
+
+  it('?figures=0: only the turns asked for; switched off, his own not begun yet go at once, switched on they come again', async () => {
+    const { sim, lead } = simulation([{ role: 'follower' }], { role: 'leader' }, {}, false);
+    expect(sim.ownFigures).toBe(false);
+    for (let i = 0; i < 200; i++) {
+      await sim.step(steer, 0.5);
+      expect(none(leaderFigure(lead)), `step ${i}: a figure nobody asked for`).toBe(true);
+    }
+    expect(sim.figure).toBeNull();
+    sim.ownFigures = true;
+    await sim.step(steer, 0.5);
+    const s = sim as DuetSimulation;
+    expect(s.duet.figures.led).toHaveLength(1); // planned on the step after the switch
+    expect(sim.figure?.coming).toBe(true);
+    sim.ownFigures = false;
+    expect(s.duet.figures.led).toEqual([]); // not begun: gone with the switch
+    expect(sim.figure).toBeNull();
+  });
+
+  it('askTurn: on the next beat, turnAsked from the ask until the figure ends, danced as asked', async () => {
+    const { sim, lead } = simulation([{ role: 'follower' }], { role: 'leader' }, {}, false);
+    for (let i = 0; i < 10; i++) await sim.step(steer, 0.5);
+    expect(sim.turnAsked).toBe(0);
+    expect(sim.askTurn(-1)).toBe(true);
+    expect(sim.turnAsked).toBe(-1);
+    expect(sim.figure).toMatchObject({ way: -1, asked: true, coming: true });
+    let steps = 0;
+    let dancing = 0;
+    while (sim.turnAsked !== 0) {
+      await sim.step(steer, 0.5);
+      steps++;
+      if (sim.figure && !sim.figure.coming) {
+        dancing++;
+        expect(sim.figure).toMatchObject({ way: -1, asked: true });
+        // A hands plan is shown, and both read her turn to her right (FIGURE_WAYS[1]) inside now (key 6).
+        expect(lead.input[blockSlices(LEADER_INPUT_LAYOUT).hands_plan.start]).toBe(1);
+        expect(leaderFigure(lead)[2 * (6 * 2 + 1)]).toBe(1);
+      }
+      expect(steps).toBeLessThan(100);
+    }
+    // FIGURE_BEATS at the manifest's tempo (170): 37 steps danced, after at most a beat's wait.
+    expect(dancing).toBe(Math.round(3.5 / (170 / 60 / 30)) + 1);
+    expect(steps - dancing).toBeLessThanOrEqual(Math.ceil(30 * 60 / 170));
+    expect(sim.figure).toBeNull();
+  });
+});
+
 describe('leader playback', () => {
   const features = fixture('features');
   const track = trackOf(features, 'leader');
@@ -426,6 +521,28 @@ describe('leader playback', () => {
     s.setLeaderPlayback(null);
     await sim.step(steer, 0.5);
     expect(lead.runs).toBe(1);
+  });
+
+  it('leads no figure: those planned go, none is planned or asked for, and the followers read none', async () => {
+    const FIGURE = blockSlices(FOLLOWER_INPUT_LAYOUT).figure;
+    const { sim, follow } = simulation([{ role: 'follower' }]);
+    const s = sim as DuetSimulation;
+    for (let i = 0; i < 60; i++) await sim.step(steer, 0.5);
+    expect(s.duet.figures.led.length).toBeGreaterThan(0); // his own, planned or danced
+    sim.askTurn(1);
+    s.setLeaderPlayback(recording);
+    expect(sim.figure).toBeNull();
+    expect(sim.turnAsked).toBe(0);
+    expect(sim.askTurn(-1)).toBe(false);
+    for (let i = 0; i < 200; i++) {
+      await sim.step(steer, 0.5);
+      expect(follow[0].input.subarray(FIGURE.start, FIGURE.end).every((v) => v === 0), `step ${i}: a figure read`).toBe(true);
+    }
+    expect(s.duet.figures.led).toEqual([]);
+    // Back with the model, he plans his own again.
+    s.setLeaderPlayback(null);
+    await sim.step(steer, 0.5);
+    expect(s.duet.figures.led).toHaveLength(1);
   });
 
   it('after reset() the recording starts over from a still first frame at the start position', async () => {

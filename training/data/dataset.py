@@ -15,11 +15,10 @@ import numpy as np
 
 from ..mirror.bvh import BvhError, read_bvh
 from ..mirror.features import (HISTORY, Track, figure_block, follower_input, hands_moves, hands_plan_block,
-                               intention_target, leader_input,
-                               output_features, partner_turn,
-                       valid_frames)
+                               intention_target, leader_input, output_features, valid_frames)
 from ..mirror.skeleton import FPS, HEAD, SCALE, Motion, mirror_motion, reduce_bvh, resample, time_warp
 from .count import Count, find_count
+from .led_figures import figure_spans
 
 # Split by take so no validation or test frame has a near-duplicate neighbour in training.
 # 12 is clean; 02 and 13 are full-length takes without the head glitches of 06/07.
@@ -145,13 +144,14 @@ def pair_tracks(leader: Motion, follower: Motion, phase: int = 0, mirror: bool =
 def samples(lead: Track, follow: Track) -> dict[str, np.ndarray]:
     """Every valid frame of one take as samples for both roles (float32)."""
     frames = valid_frames(lead.frames)
+    # Both dancers read the figure being led, as the recorded couple danced it (led_figures).
+    figure = figure_block(figure_spans(lead.positions, follow.positions), frames)
     out = {
-        "follower_input": follower_input(lead, follow, frames),
+        "follower_input": follower_input(lead, follow, frames, figure),
         "follower_output": output_features(follow, frames),
         "follower_intention": intention_target(lead, follow, frames),
-        # The leader's samples carry the figure the follower really danced (train.py hides it in
-        # a share of them, so the leader also learns to lead on his own).
-        "leader_input": leader_input(follow, lead, frames, figure_block(partner_turn(follow, frames), len(frames)),
+        # His hands plan: where his recorded hands went (train.py hides it in a share of them).
+        "leader_input": leader_input(follow, lead, frames, figure,
                                      hands_plan_block(hands_moves(lead, frames), len(frames))),
         "leader_output": output_features(lead, frames),
         "leader_intention": intention_target(follow, lead, frames),

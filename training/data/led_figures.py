@@ -33,7 +33,6 @@ import numpy as np
 
 from ..evaluation.figures import HAND_RAISED, TURN_DEGREES, TURN_SECONDS, facing, turns
 from ..mirror.skeleton import FPS, HANDS
-from .dataset import DataError, discover_takes, load_pair, pair_tracks, select_takes
 from .folders import default_data
 
 SETTLED_DEG_PER_S = 120.0   # a facing turning slower than this has not begun / has finished a turn
@@ -113,8 +112,17 @@ def figures_of(lead_positions: np.ndarray, follow_positions: np.ndarray) -> list
     return sorted(found, key=lambda f: (f.start, f.name))
 
 
+def figure_spans(lead_positions: np.ndarray, follow_positions: np.ndarray) -> np.ndarray:
+    """[M, 3] int (way, start, end) of every her_turn of one couple: the figures both networks read
+    (features.figure_block), labelled from the recording for training and evaluation."""
+    spans = [(f.way, f.start, f.end) for f in figures_of(lead_positions, follow_positions) if f.name == "her_turn"]
+    return np.array(spans, dtype=np.int64).reshape(-1, 3)
+
+
 def take_figures(data: str, names: list[str] | None = None, mirror: bool = False) -> dict[str, dict]:
     """{take: {"seconds", "beat" [T], "figures" [Figure]}} of the recorded takes at 30 fps."""
+    # Imported here: dataset labels its samples with figure_spans.
+    from .dataset import discover_takes, load_pair, pair_tracks, select_takes
     out = {}
     for take in select_takes(discover_takes(data), names):
         lead, follow = pair_tracks(*load_pair(take), mirror=mirror)
@@ -184,6 +192,7 @@ def main(argv=None) -> int:
     ap.add_argument("--mirror", action="store_true", help="the mirrored couples (every way flipped)")
     ap.add_argument("--out", default="runs/figures", metavar="DIR", help="writes led_figures.json and led_figures.md there")
     args = ap.parse_args(argv)
+    from .dataset import DataError
     try:
         takes = take_figures(args.data or default_data(), args.takes.split(",") if args.takes else None, args.mirror)
     except DataError as e:

@@ -101,11 +101,12 @@ def prepare(data: str, out: str, validation: list[str], test: list[str], leader:
     for role in ("follower", "leader"):
         for kind in ("input", "output", "intention"):
             mean, std = F.normalization(arrays["train"][f"{role}_{kind}"])
-            if role == "leader" and kind == "input":
-                # The figure block is read as it is (turns, and `asked` in {0, 1}): every stored
-                # sample is asked, so its own statistics would put the unasked 0 a hundred stds away.
-                fig = F.block_slices(F.LEADER_INPUT_LAYOUT)["figure"]
+            if kind == "input":
+                # The figure block is read as it is (inside and progress, 0 to 1): a figure seldom
+                # at the past second's first key would otherwise be scaled far past the others.
+                fig = F.block_slices(F.LEADER_INPUT_LAYOUT if role == "leader" else F.FOLLOWER_INPUT_LAYOUT)["figure"]
                 mean[fig], std[fig] = 0.0, 1.0
+            if role == "leader" and kind == "input":
                 # The hands plan likewise keeps `shown` raw and its moves centred on "stay": a hidden
                 # plan (zeros) then reads as no move, and the moves keep their own spread.
                 plan = F.block_slices(F.LEADER_INPUT_LAYOUT)["hands_plan"]

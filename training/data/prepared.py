@@ -32,29 +32,14 @@ def require_tempo_copies(prepared: str) -> None:
                          f"`python -m training.data.prepare --prepared {prepared} --tempos` (its default) first")
 
 
-# The turn a leader leads (the follower's turn over the next second, in full turns at each future
-# key: the leader's figure block, features.partner_turn) forecast beside his key joints by a
-# follower whose intention also reads it (ModelConfig.turn_keys). Normalized by this fixed scale
-# (not a statistic, so every reader agrees without stats.npz changing): a quarter turn ahead
-# reads 1, as far as a typical key joint's coordinate from its mean.
-LED_TURN_SCALE = 0.25
-
-
-def load_split(prepared: str, split: str, role: str, tempo_copies: bool = False,
-               led_turn: bool = False) -> dict[str, np.ndarray]:
+def load_split(prepared: str, split: str, role: str, tempo_copies: bool = False) -> dict[str, np.ndarray]:
     """{"input", "output", "intention"} raw float32 arrays of one split and role; with
-    `tempo_copies` the training split is followed by its time-warped copies (train_tempo.npz);
-    with `led_turn` (a follower whose intention forecasts the turn he leads) the intention is
-    followed by that turn ([N, KEYS], from the leader's figure block of the same samples)."""
+    `tempo_copies` the training split is followed by its time-warped copies (train_tempo.npz)."""
     if tempo_copies:
-        a = load_split(prepared, split, role, led_turn=led_turn)    # the recorded samples first (and their checks)
+        a = load_split(prepared, split, role)    # the recorded samples first (and their checks)
         require_tempo_copies(prepared)
-        b = load_split(prepared, "train_tempo", role, led_turn=led_turn)
+        b = load_split(prepared, "train_tempo", role)
         return {k: np.concatenate([a[k], b[k]]) for k in a}
-    if led_turn:
-        a = load_split(prepared, split, role)
-        turn = load_split(prepared, split, "leader")["input"][:, feat.block_slices(feat.LEADER_INPUT_LAYOUT)["figure"]][:, 1:]
-        return {**a, "intention": np.concatenate([a["intention"], turn], -1)}
     path = Path(prepared) / f"{split}.npz"
     if not path.exists():
         raise TrainError(f"{path} not found: run `python -m training.data.prepare --prepared {prepared}` first")
@@ -82,15 +67,6 @@ def load_stats(prepared: str, role: str) -> dict[str, torch.Tensor]:
                     for k in ("input", "output", "intention") for s in ("mean", "std")}
     except Exception as e:
         raise _unreadable(path, e) from None
-
-
-def with_led_turn(stats: dict[str, torch.Tensor], keys: int) -> dict[str, torch.Tensor]:
-    """The intention's normalization extended by the led turn's `keys` columns (mean 0, LED_TURN_SCALE)."""
-    if not keys:
-        return stats
-    mean, std = stats["intention_mean"], stats["intention_std"]
-    return {**stats, "intention_mean": torch.cat([mean, torch.zeros(keys, dtype=mean.dtype)]),
-            "intention_std": torch.cat([std, torch.full((keys,), LED_TURN_SCALE, dtype=std.dtype)])}
 
 
 def normalize(a: np.ndarray, stats: dict[str, torch.Tensor], key: str) -> torch.Tensor:

@@ -51,7 +51,7 @@ def soak_one(manifest, leader, follower, seed: int, frames: int, temperature: fl
     sticks = steering_script(rng, frames)
     if not steer:
         sticks[:] = 0.0
-    duet = start_duet(manifest, tempo=tempo)
+    duet = start_duet(manifest, tempo=tempo, seed=seed)
     worst = {"nonfinite": 0, "max_distance": 0.0, "bone_error": 0.0, "min_foot": np.inf}
     speeds = np.zeros((frames, 2))
     if record is not None:

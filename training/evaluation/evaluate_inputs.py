@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from ..data.dataset import DataError, discover_takes, load_pair, pair_tracks, select_takes, take_count
+from ..data.led_figures import figure_spans
 from ..mirror import features as feat
 from ..mirror.features import HISTORY, Track, output_features
 from ..mirror.rollout import OnnxPolicy
@@ -32,6 +33,15 @@ class EvalTake:
     lead_offsets: np.ndarray
     follow_offsets: np.ndarray
     frames: np.ndarray       # the current frames t evaluated (each predicts t+1)
+    figures: np.ndarray = None   # [M, 3] the figures the recorded leader led (led_figures.figure_spans)
+
+    def __post_init__(self):
+        if self.figures is None:
+            self.figures = figure_spans(self.lead.positions, self.follow.positions)
+
+    def figure(self, frames: np.ndarray) -> np.ndarray:
+        """The figure block both dancers read at `frames` (features.figure_block): the recorded lead."""
+        return feat.figure_block(self.figures, np.asarray(frames))
 
 
 def load_eval_takes(data: str, names: list[str], max_frames: int | None, leader: str | None,

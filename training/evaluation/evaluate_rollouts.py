@@ -105,12 +105,13 @@ def rollout(take: EvalTake, follower_policy, temperature: float, seed: int, star
             bend_plan(leader.track, bend)
         now = np.array([NOW])
         heard = music_at(take.lead.beat, np.array([t]))   # the take's count, found in its footwork
-        xf = follower_input(leader.track, follower.track, now, heard)[0]
+        figure = take.figure(np.array([t]))              # the figure the recorded leader led
+        xf = follower_input(leader.track, follower.track, now, figure, heard)[0]
         if isinstance(follower_policy, RecordingPolicy):
             follower_policy.seek(take.follow, t)
         of = np.asarray(follower_policy(xf, temperature, rng)["output"][0], np.float64)
         if leader_mode != "playback":
-            xl = leader_input(follower.track, leader.track, now, music=heard)[0]
+            xl = leader_input(follower.track, leader.track, now, figure, music=heard)[0]
             ol = np.asarray(leader_policy(xl, temperature, rng)["output"][0], np.float64)
             # Leader first, as rollout.finish_step does.
             if output_is_absurd(ol):

@@ -19,7 +19,7 @@ OUT = feat.block_slices(feat.OUTPUT_LAYOUT)
 
 def teacher_forced(takes, policies: dict, mm_oracle: MotionMatching | None, bar) -> dict:
     """Per method: predicted O [N, 323] for every evaluated frame (inputs from the recording)."""
-    x = np.concatenate([follower_input(t.lead, t.follow, t.frames) for t in takes])
+    x = np.concatenate([follower_input(t.lead, t.follow, t.frames, t.figure(t.frames)) for t in takes])
     y = np.concatenate([output_features(t.follow, t.frames) for t in takes])
     outputs, codes = {}, {}
     for name, policy in policies.items():

@@ -105,7 +105,7 @@ def teacher_forced_row(takes: list[EvalTake], policy, ranges: dict) -> dict:
     kinematics from its decoded rotations, as the loop places it) against the recorded leader."""
     items = []
     for t in takes:
-        x = follower_input(t.lead, t.follow, t.frames)
+        x = follower_input(t.lead, t.follow, t.frames, t.figure(t.frames))
         if hasattr(policy, "reset"):
             policy.reset()
             out = np.asarray(policy(x)["output"], np.float64)

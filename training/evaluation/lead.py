@@ -5,12 +5,13 @@ when nobody steers? -> lead.json + lead.md
 
 Two measurements on the shipped models, the dancers run as the page runs them (options.py):
 
-1. Requests. Each seed dances a duet with nobody steering; every REQUEST_EVERY seconds the duet is
-   copied and the copy is asked to lead a turn (rollout.ask_turn, a random direction), while the
-   original goes on unasked. Both are danced REQUEST_SECONDS on with the same random stream and the
-   follower's turns are counted (figures.turns, from the request on): a request works when the
-   follower completes a turn in that time, and the same moment unasked tells how often she would
-   have turned anyway. The follower never sees the request; she reads the leader.
+1. Requests. Each seed dances a duet with nobody steering and, unless --figures 1, no figures of
+   his own (the page's ?figures=0); every REQUEST_EVERY seconds the duet is copied and the copy is
+   asked to lead her turn (rollout.ask_turn, a random way), while the original goes on unasked.
+   Both are danced REQUEST_SECONDS on with the same random stream and the follower's turns are
+   counted (figures.turns, from the request on): a request works when the follower completes a
+   turn in that time, and the same moment unasked tells how often she would have turned anyway.
+   Both dancers read the figure being led (features.figure_block); she gets no command to act.
 2. Unasked dancing. The same duets, before any copy: each dancer's turns per minute, spin frames,
    body motion and travel (figures.py) against the recorded dancers of --takes, and how far the
    leader goes from where he started (the couple must stay on screen).
@@ -29,7 +30,7 @@ from tqdm import tqdm
 
 from ..data.dataset import DataError, TEST_TAKES
 from ..data.folders import add_folder
-from ..mirror.rollout import NOW, REQUEST_SECONDS, ask_turn, start_duet, step
+from ..mirror.rollout import NOW, ask_turn, start_duet, step
 from ..mirror import features as feat
 from ..mirror.skeleton import FPS, HANDS
 from . import figures as Fg
@@ -42,7 +43,8 @@ from .evaluate_inputs import EvalError, find_models, load_eval_takes, load_onnx
 # reads: he leads it by then (it finds 52 % of the recorded turns at 0.5 s, chance 18 %; 1.5 s
 # ahead, before her turn has begun, 25 %: the recorded lead comes with her turn).
 LEGIBILITY_LEAD = 0.5
-REQUEST_EVERY = 6.0      # s between requests in one duet (a turn and the time to settle after it)
+REQUEST_SECONDS = 4.0    # s of dance after a request in which her turn counts
+REQUEST_EVERY = 7.0      # s between requests in one duet: pressed 3 s and 10 s into the dance
 WARM_UP = 3.0            # s of dancing before the first request
 
 
@@ -99,9 +101,9 @@ def request_frames(frames: int) -> set[int]:
 
 
 def one_duet(manifest, leader, follower, temperature: float, seed: int, seconds: float,
-             detector: C.Detector | None = None, tempo: float | None = None) -> dict:
+             detector: C.Detector | None = None, tempo: float | None = None, figures: bool = False) -> dict:
     rng = np.random.default_rng(seed)
-    duet = start_duet(manifest, tempo=tempo)
+    duet = start_duet(manifest, tempo=tempo, figures=figures, seed=seed)
     frames = int(seconds * FPS)
     window = int(REQUEST_SECONDS * FPS)
     ask_at = request_frames(frames)
@@ -145,7 +147,7 @@ def dancing(lead: np.ndarray, follow: np.ndarray, start: np.ndarray | None = Non
 
 
 def unasked_duet(manifest, leader, follower, temperature: float, seed: int, seconds: float,
-                 ask: tuple[float, int] | None = None, tempo: float | None = None) -> dict:
+                 ask: tuple[float, int] | None = None, tempo: float | None = None, figures: bool = False) -> dict:
     """The duet one_duet dances for `seed`, without its request copies (the random stream is the
     same: each request's direction is still drawn): world positions [frames, 17, 3] of `leader`
     and `follower` as the networks left them (what one_duet measures) and `leader_shown`,
@@ -154,7 +156,7 @@ def unasked_duet(manifest, leader, follower, temperature: float, seed: int, seco
     the duet itself is asked for a turn then (one_duet asks that request's copy at frame
     seconds * FPS, with its own random stream: the film shows the request, not the same draws)."""
     rng = np.random.default_rng(seed)
-    duet = start_duet(manifest, tempo=tempo)
+    duet = start_duet(manifest, tempo=tempo, figures=figures, seed=seed)
     frames = int(seconds * FPS)
     ask_at = request_frames(frames)
     out = {k: np.zeros((frames, 17, 3)) for k in ("leader", "follower", "leader_shown", "follower_shown")}
@@ -310,10 +312,11 @@ def run(args) -> dict:
     per_seed = []
     for seed in tqdm(range(args.first_seed, args.first_seed + args.seeds), desc="duets", unit="duet",
                      file=sys.stderr, disable=args.quiet):
-        per_seed.append(one_duet(manifest, leader, follower, args.temperature, seed, args.seconds, detector, args.tempo))
+        per_seed.append(one_duet(manifest, leader, follower, args.temperature, seed, args.seconds, detector, args.tempo,
+                                 bool(args.figures)))
     return {"takes": takes, "recording": ref, "per_seed": per_seed, "summary": summary(per_seed, ref),
             "config": {"models": str(args.models), "method": args.method, "seeds": args.seeds,
-                       "seconds": args.seconds, "temperature": args.temperature,
+                       "seconds": args.seconds, "figures": args.figures, "temperature": args.temperature,
                        "follower_temperature": args.follower_temperature, "guard": args.guard,
                        "wall_seconds": time.time() - t0}}
 
@@ -327,7 +330,9 @@ def main(argv=None) -> int:
     ap.add_argument("--takes", default=",".join(TEST_TAKES))
     ap.add_argument("--seeds", type=int, default=100)
     ap.add_argument("--first-seed", type=int, default=0)
-    ap.add_argument("--seconds", type=float, default=30.0, help="per duet (a request every 6 s after 3 s)")
+    ap.add_argument("--seconds", type=float, default=14.0, help="per duet (a request every 7 s after 3 s)")
+    ap.add_argument("--figures", type=int, choices=(0, 1), default=0,
+                    help="1: he also leads figures of his own (the page's default); 0: only those asked (?figures=0)")
     ap.add_argument("--no-legibility", dest="legibility", action="store_false",
                     help="skip the lead detector (fitted on every take of --data, about 20 s here)")
     O.add_options(ap)

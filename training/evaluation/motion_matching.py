@@ -46,6 +46,7 @@ from ..mirror import features as feat
 from ..data.dataset import (TEST_TAKES, VALIDATION_TAKES, DataError, discover_takes,
                       load_pair, pair_tracks, select_takes)
 from ..data.folders import add_folder
+from ..data.led_figures import figure_spans
 from ..mirror.features import FUTURE_OFFSETS, KEYS, Track, output_features, trajectory_block, valid_frames
 
 FOLLOWER_IN = feat.block_slices(feat.FOLLOWER_INPUT_LAYOUT)
@@ -119,10 +120,11 @@ def own_future(me: Track, frames: np.ndarray) -> np.ndarray:
 def database_arrays(lead: Track, follow: Track, role: str):
     """One take's database rows: model input [N, 660], own future [N, 24], output [N, 323]."""
     frames = valid_frames(lead.frames)
+    figure = feat.figure_block(figure_spans(lead.positions, follow.positions), frames)
     if role == "follower":
-        me, x = follow, feat.follower_input(lead, follow, frames)
+        me, x = follow, feat.follower_input(lead, follow, frames, figure)
     else:
-        me, x = lead, feat.leader_input(follow, lead, frames)
+        me, x = lead, feat.leader_input(follow, lead, frames, figure)
     return x, own_future(me, frames), output_features(me, frames)
 
 

@@ -33,15 +33,14 @@ from ..data.folders import add_folder
 from ..mirror import features as feat
 from ..mirror.skeleton import FPS, HANDS
 from . import figures as F
-from ..mirror.rollout import REQUEST_SECONDS
 from .figures import HAND_RAISED
-from .lead import winding
+from .lead import REQUEST_SECONDS, winding
 
 WINDOW = (-2.0, 0.5)   # s around the turn's completion
 PEAK = 1.5             # s before completion where the lead's peak is looked for
 WIND = 1.0             # s before completion over which the winding is read
 EVERY = 6              # frames between the windows' starts
-FACING_SPAN = (-1.7, 0.8)   # s around the turn's completion: REQUEST_SECONDS, as a request's turn
+FACING_SPAN = (-1.7, 0.8)   # s around the turn's completion
 
 
 def couples(data: str):

@@ -38,16 +38,6 @@ class ModelConfig:
     input_size: int = INPUT_SIZE
     output_size: int = OUTPUT_SIZE
     intention_size: int = INTENTION_SIZE
-    # Follower only: the intention also forecasts the turn the leader leads her into over the next
-    # second (at each of these future keys, prepared.load_split's led_turn): the leader's intention
-    # in the sense a dancer means it. Predicted from the same input (the leader's motion and her
-    # own), never given; the page's intention output stays the key joints (INTENTION_SIZE).
-    turn_keys: int = 0
-
-    @property
-    def intention_width(self) -> int:
-        """What the intention predictor forecasts: the partner's key joints, then the led turn."""
-        return self.intention_size + self.turn_keys
 
     @property
     def latent(self) -> int:
@@ -93,7 +83,7 @@ class IntentionPredictor(nn.Module):
     def __init__(self, cfg: ModelConfig):
         super().__init__()
         h = cfg.intention_hidden
-        self.net = mlp([cfg.input_size, h, h, cfg.intention_width], cfg.dropout)
+        self.net = mlp([cfg.input_size, h, h, cfg.intention_size], cfg.dropout)
 
     def forward(self, x: torch.Tensor) -> torch.Tensor:
         return self.net(x)
@@ -130,7 +120,7 @@ class CodebookMatching(nn.Module):
     def __init__(self, cfg: ModelConfig):
         super().__init__()
         self.cfg = cfg
-        h, extra = cfg.hidden, (cfg.intention_width if cfg.intention else 0)
+        h, extra = cfg.hidden, (cfg.intention_size if cfg.intention else 0)
         self.input_encoder = mlp([cfg.input_size + extra, h, h, cfg.latent], cfg.dropout)
         self.output_encoder = mlp([cfg.output_size + cfg.input_size + extra, h, h, cfg.latent], cfg.dropout)
         self.decoder = mlp([cfg.latent + len(cfg.state_columns), h, h, cfg.output_size], cfg.dropout)

@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
+from ..data.led_figures import figure_spans
 from ..data.prepared import TrainError
 from ..mirror import features as feat
 from ..mirror.features import HISTORY, Track
@@ -39,7 +40,7 @@ class Couple:
     leader: Track
     follower: Track
     mirror: bool
-    partner_turn: np.ndarray     # [F, KEYS] the follower's turn ahead of each frame (the leader's figure)
+    figures: np.ndarray          # [M, 3] (way, start, end): the figures both read (led_figures.figure_spans)
 
 
 def load_couples(prepared: str) -> list[Couple]:
@@ -52,10 +53,7 @@ def load_couples(prepared: str) -> list[Couple]:
         out = []
         for i in range(n):
             lead, follow = (Track(*(z[f"{i}_{role}_{k}"] for k in FIELDS)) for role in ("leader", "follower"))
-            turn = np.zeros((follow.frames, feat.KEYS))
-            frames = np.arange(follow.frames - HISTORY)
-            turn[frames] = feat.partner_turn(follow, frames)
-            out.append(Couple(lead, follow, bool(z[f"{i}_mirror"]), turn))
+            out.append(Couple(lead, follow, bool(z[f"{i}_mirror"]), figure_spans(lead.positions, follow.positions)))
     return out
 
 
@@ -77,32 +75,29 @@ def recorded_hands(recorded: Track, t: int, me: Track) -> np.ndarray:
     return future - now[None, None]
 
 
-def inputs_at(run: Run, role: str, led_turn: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def inputs_at(run: Run, role: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(input, recorded output, intention target) of a rollout at its frame: the input from its own
-    track beside the recorded partner; the targets the recording's (with `led_turn`, the
-    intention target is followed by the recorded turn he leads, prepared.load_split)."""
+    track beside the recorded partner; the figure and the targets the recording's."""
     c, t, now = run.couple, run.t, np.array([NOW])
     heard = music_at(c.leader.beat, np.array([t]))    # the recorded take's count, where the recording is
+    figure = feat.figure_block(c.figures, np.array([t]))
     if role == "follower":
         partner, recorded = window(c.leader, t), c.follower
-        x = feat.follower_input(partner, run.me.track, now, heard)[0]
+        x = feat.follower_input(partner, run.me.track, now, figure, heard)[0]
     else:
         partner, recorded = window(c.follower, t), c.leader
         steer_along_recording(run.me, recorded, t)   # his plan: the recorded path, laid from where he stands
         # His hands plan: where the recorded hands went over the next second, from where his are.
         plan = feat.hands_plan_block(recorded_hands(recorded, t, run.me.track), 1)
-        x = feat.leader_input(partner, run.me.track, now, feat.figure_block(c.partner_turn[t][None], 1), plan, heard)[0]
+        x = feat.leader_input(partner, run.me.track, now, figure, plan, heard)[0]
     y = feat.output_features(recorded, np.array([t]))[0]
     j = feat.intention_target(partner, run.me.track, now)[0]
-    if led_turn:
-        j = np.concatenate([j, c.partner_turn[t]])
     return x, y, j
 
 
 @torch.no_grad()
 def own_rollout_samples(step, couples: list[Couple], offsets: np.ndarray, role: str, every: int,
-                        horizon: int, temperatures: tuple[float, ...], gen: torch.Generator,
-                        led_turn: bool = False) -> dict[str, np.ndarray]:
+                        horizon: int, temperatures: tuple[float, ...], gen: torch.Generator) -> dict[str, np.ndarray]:
     """Roll `step` (a StepModel on raw features) out for `horizon` frames from every `every`-th
     frame of each couple, all rollouts as one batch per step, at temperatures taken in turn. The
     first frame of each is the recording itself and is skipped; a rollout that produces absurd
@@ -120,7 +115,7 @@ def own_rollout_samples(step, couples: list[Couple], offsets: np.ndarray, role: 
         live = [i for i, r in enumerate(runs) if r.steps > 0]
         if not live:
             break
-        batch = [inputs_at(runs[i], role, led_turn) for i in live]
+        batch = [inputs_at(runs[i], role) for i in live]
         x = np.stack([b[0] for b in batch])
         if k > 0:
             xs.append(x); ys.append(np.stack([b[1] for b in batch])); js.append(np.stack([b[2] for b in batch]))
@@ -143,6 +138,6 @@ def own_rollout_samples(step, couples: list[Couple], offsets: np.ndarray, role: 
     if not xs:
         size = feat.INPUT_SIZES[role]
         return {"input": np.zeros((0, size), np.float32), "output": np.zeros((0, feat.OUTPUT_SIZE), np.float32),
-                "intention": np.zeros((0, feat.INTENTION_SIZE + (feat.KEYS if led_turn else 0)), np.float32), "mirror": np.zeros(0, bool)}
+                "intention": np.zeros((0, feat.INTENTION_SIZE), np.float32), "mirror": np.zeros(0, bool)}
     return {"input": np.concatenate(xs).astype(np.float32), "output": np.concatenate(ys).astype(np.float32),
             "intention": np.concatenate(js).astype(np.float32), "mirror": np.concatenate(ms)}

@@ -15,7 +15,7 @@ from pathlib import Path
 import torch
 
 from .models import CodebookMatching, IntentionPredictor, ModelConfig, StepModel
-from ..data.prepared import TrainError, load_stats, with_led_turn
+from ..data.prepared import TrainError, load_stats
 
 
 def save_checkpoint(path: Path, state: dict):
@@ -80,6 +80,6 @@ def load_run(run: str | Path, prepared: str) -> Run:
     predictor.load_state_dict(ck["predictor"])
     matching.load_state_dict(ck["matching"])
     predictor.eval(); matching.eval()
-    stats = with_led_turn(load_stats(prepared, cfg.role), cfg.turn_keys)
+    stats = load_stats(prepared, cfg.role)
     model = StepModel(cfg, predictor if cfg.intention else None, matching, stats).eval()
     return Run(run, ck["config"], predictor, matching, stats, model)

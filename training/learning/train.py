@@ -35,7 +35,7 @@ from .models import CodebookMatching, Discriminator, IntentionPredictor, ModelCo
 from .own_rollouts import load_couples, own_rollout_samples
 from ..mirror.on_count import planned_turn
 from ..data.prepared import (TrainError, load_mirror_flags, load_offsets, load_split, load_stats, normalize,
-                             pose_error_cm, with_led_turn)
+                             pose_error_cm)
 from .runs import load_checkpoint, save_checkpoint
 from .partner_losses import (INTERACTION_JOINTS, block_positions, decoded_positions, input_slices,
                              partner_terms, penetration_loss)
@@ -107,8 +107,7 @@ class TrainConfig:
     # Train on the tempo copies too (prepare's train_tempo.npz): more varied samples, same steps.
     tempo_copies: bool = False
     # Weight of the samples where the follower's turn starts (turn_onsets) in the reconstruction
-    # and codebook losses; 1 weighs every sample alike. For the leader, these are the moments he
-    # leads her turn, when his figure block is shown (hidden, he cannot know she will turn). The recorded follower turns 20-27 times a
+    # and codebook losses; 1 weighs every sample alike. The recorded follower turns 20-27 times a
     # minute, but a turn's first frames are few beside the frames that continue one, and a model
     # that reads its own history learns to continue turns far better than to start them.
     turn_weight: float = 1.0
@@ -118,18 +117,9 @@ class TrainConfig:
     # hand goes up and in 24 % of the others (recorded_leads): weighing only the led starts asks her
     # to read his hand.
     unled_turn_weight: float | None = None
-    # Leader: weight of the samples where his own turn starts (own_turn_onsets), figure shown or
-    # not. The recorded leader turns 6-7 times a minute, in 10 of 12 takes; turn_weight only weighs
+    # Leader: weight of the samples where his own turn starts (own_turn_onsets). The recorded leader turns 6-7 times a minute, in 10 of 12 takes; turn_weight only weighs
     # the moments he leads hers, and a leader who turns only beside a spinning partner turns in few seeds.
     own_turn_weight: float = 1.0
-    # Leader: share of samples whose figure block (features.figure_block: the turn the partner
-    # really made over the next second) is hidden, as when nobody asks for a figure. Shown, the
-    # leader learns what leading that turn looks like; hidden, he learns to lead on his own.
-    figure_dropout: float = 1.0
-    # Leader: share of the samples with the figure shown whose partner blocks are hidden (set to
-    # their mean). In the recording his lead comes with her turn, so a leader who reads her turning
-    # can explain his raised hand by it and leaves the figure unread; hidden, only the figure tells.
-    figure_partner_dropout: float = 0.0
     # Leader: share of samples whose hands plan (features.hands_plan_block: where his recorded
     # hands went over the next second) is hidden, as when nobody asks. Shown, he learns to take his
     # hands where the plan says, which is how a request raises his lead hand; 1: never shown.
@@ -215,11 +205,11 @@ MODELS = {
     "follower": replace(steady(OURS), state_dropout=0.5, turn_weight=4.0, own_rollouts_from=10, tempo_copies=True),
     # The baseline by the same recipe, so that the comparison stays fair.
     "follower_ccm": replace(steady(CCM), state_dropout=0.5, turn_weight=4.0, own_rollouts_from=10, tempo_copies=True),
-    # The leader reads the figure block (a turn the visitor asks for: features.figure_block) and
-    # the hands plan (features.hands_plan_block: where his hands go over the next second), each
-    # hidden in half the samples as when nobody asks: a request raises his lead hand through the
-    # plan (rollout.hands_input), and beside him she turns after 77 % of requests against 58 % of
-    # the same moments unasked (the figure block alone: 56 % against 56 %).
+    # Both dancers read the figure being led (features.figure_block: her turns as the recording
+    # labels them, training/data/led_figures.py; at run time the visitor's and his own,
+    # rollout.Figures), always shown. The leader also reads the hands plan
+    # (features.hands_plan_block: where his hands go over the next second), hidden in half the
+    # samples as when nobody plans: a figure raises his lead hand through it (rollout.hands_input).
     # His decoder sees its own state in half the samples and he trains on his own rollouts (his plan
     # the recorded path laid from where he stands), as the followers: he dances (steered, body
     # motion 0.54 m/s against 0.33 without, the recording 0.83), and the page's upright guard keeps
@@ -232,7 +222,7 @@ MODELS = {
     # nobody steering he turns 9.5 times a minute (0.82x) within 1.47 m of his spot. Without the
     # sparing he stopped turning (0.7 a minute nobody steering; at 300, none); at 30 on the recorded
     # contacts he had a bad second in 15 of 100 steered seeds (docs/results.md, "His feet").
-    "leader": replace(steady(LEADER), figure_dropout=0.5, hands_plan_dropout=0.5, state_dropout=0.5,
+    "leader": replace(steady(LEADER), hands_plan_dropout=0.5, state_dropout=0.5,
                       own_rollouts_from=10, lambda_foot_contact=100.0, recorded_contacts=True,
                       contact_spare_turning=120.0, tempo_copies=True, seed=2),
     # The paper's ablations, on the recipe without the partner terms (docs/results.md, "The paper's
@@ -270,25 +260,12 @@ def augment_control(x: torch.Tensor, cfg: TrainConfig, gen: torch.Generator) -> 
 
 
 def hide_block(x: torch.Tensor, block: str, share: float, gen: torch.Generator) -> torch.Tensor:
-    """Leader inputs (raw) -> a copy with one block zeroed in `share` of the samples: the figure
-    (nobody asks) or the hands plan (no plan)."""
+    """Leader inputs (raw) -> a copy with one block zeroed in `share` of the samples: the hands
+    plan (no plan)."""
     sl = feat.block_slices(feat.LEADER_INPUT_LAYOUT)[block]
     hidden = torch.rand(len(x), generator=gen) < share
     x = x.clone()
     x[hidden, sl] = 0.0
-    return x
-
-
-def hide_partner_when_figure(x: torch.Tensor, share: float, mean: torch.Tensor, gen: torch.Generator) -> torch.Tensor:
-    """Leader inputs (raw) -> a copy where `share` of the samples whose figure is shown have the
-    partner's blocks (past path, key joints, pose) at their mean: what the leader then does can
-    only come from the figure."""
-    sl = feat.block_slices(feat.LEADER_INPUT_LAYOUT)
-    shown = x[:, sl["figure"].start] > 0
-    hidden = shown & (torch.rand(len(x), generator=gen) < share)
-    x = x.clone()
-    for block in ("partner_trajectory_past", "partner_key_joints_past", "partner_pose"):
-        x[hidden, sl[block]] = mean[sl[block]].to(x.dtype)
     return x
 
 
@@ -350,16 +327,9 @@ def key_heading_change(keys: np.ndarray, now_last: bool) -> np.ndarray:
 
 
 def turn_onsets(x_raw: np.ndarray, y_raw: np.ndarray, role: str = "follower") -> np.ndarray:
-    """Samples (raw input and output) -> bool [N]: the follower's turn starts here. She turns at
+    """Samples (raw input and output) -> bool [N]: the dancer's turn starts here. It turns at
     least ONSET_FUTURE_DEGREES over the next second and turned less than ONSET_PAST_DEGREES over
-    the last: read from her own path in her samples (12 % of them), and in the leader's from the
-    figure block (her turn ahead) and her past path as he sees it (the moments he leads a turn)."""
-    if role == "leader":
-        si = feat.block_slices(feat.LEADER_INPUT_LAYOUT)
-        past = key_heading_change(x_raw[:, si["partner_trajectory_past"]].reshape(len(x_raw), feat.KEYS, 4), True)
-        future = 360.0 * x_raw[:, si["figure"].stop - 1]
-        return (x_raw[:, si["figure"].start] > 0) & (np.abs(future) >= ONSET_FUTURE_DEGREES) & \
-            (np.abs(past) < ONSET_PAST_DEGREES)
+    the last, read from its own path (12 % of the follower's samples)."""
     return own_turn_onsets(x_raw, y_raw, role)
 
 
@@ -420,10 +390,9 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
     torch.manual_seed(cfg.seed)
     np.random.seed(cfg.seed)
     role = cfg.model.role
-    led_turn = cfg.model.turn_keys > 0
-    train = load_split(data, "train", role, cfg.tempo_copies, led_turn)
-    val = load_split(data, "validation", role, led_turn=led_turn)
-    stats = with_led_turn(load_stats(data, role), cfg.model.turn_keys)
+    train = load_split(data, "train", role, cfg.tempo_copies)
+    val = load_split(data, "validation", role)
+    stats = load_stats(data, role)
     run = Path(out) / name
     run.mkdir(parents=True, exist_ok=True)
     ckpt_path = run / "checkpoint.pt"
@@ -512,10 +481,6 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
         x, moved, altered = xr[idx], None, None
         if role == "leader" and cfg.control_noise + cfg.control_rotation > 0:
             x = augment_control(x, cfg, gen)
-        if role == "leader" and cfg.figure_dropout > 0:
-            x = hide_block(x, "figure", cfg.figure_dropout, gen)
-        if role == "leader" and cfg.figure_partner_dropout > 0:
-            x = hide_partner_when_figure(x, cfg.figure_partner_dropout, stats["input_mean"], gen)
         if role == "leader" and cfg.hands_plan_dropout > 0:
             x = hide_block(x, "hands_plan", cfg.hands_plan_dropout, gen)
         if proximity and role == "follower" and cfg.proximity_share > 0:
@@ -598,7 +563,7 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
             step_model = StepModel(mcfg, predictor if mcfg.intention else None, matching, stats).eval()
             rolled = own_rollout_samples(step_model, couples, offsets.cpu().double().numpy(), role,
                                       cfg.own_rollouts_stride, cfg.own_rollouts_horizon,
-                                      cfg.own_rollouts_temperatures, gen, led_turn)
+                                      cfg.own_rollouts_temperatures, gen)
             xr = torch.cat([xr[:recorded_n], torch.from_numpy(rolled["input"])])
             y = torch.cat([y[:recorded_n], normalize(rolled["output"], stats, "output")])
             j = torch.cat([j[:recorded_n], normalize(rolled["intention"], stats, "intention")])
@@ -650,9 +615,6 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
                 l_r, l_c = F.mse_loss(recon, yb), F.mse_loss(code, code_hat)
             else:
                 w = sample_weight[idx].clone()
-                if role == "leader":     # her turn onsets weigh more only where he is told of them
-                    fig = slices["figure"]
-                    w[x_clean[:, fig.start].cpu() < 0.5] = 1.0
                 w = torch.maximum(w, own_weight[idx])   # his own weigh more always
                 w = w.to(device)[:, None]
                 w = w / w.mean()

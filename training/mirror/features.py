@@ -28,7 +28,11 @@ KEY_JOINTS_SIZE = KEYS * N_KEY_JOINTS * 3    # 90
 POSE_SIZE = N_JOINTS * 12                    # 204
 ROOT_UPDATE_SIZE = 3
 CONTACTS_SIZE = 2
-FIGURE_SIZE = 1 + KEYS                       # 7: asked, then the partner's planned turn at each key
+# The figure being led (figure_block): her turn to her left (way +1) or to her right (-1), read at
+# each key of the past second, now, and each key of the next second, as (inside, progress).
+FIGURE_WAYS = (1, -1)
+FIGURE_OFFSETS = np.arange(-KEYS, KEYS + 1) * KEY_STEP                 # t-30 ... t ... t+30
+FIGURE_SIZE = len(FIGURE_OFFSETS) * len(FIGURE_WAYS) * 2               # 52
 HANDS_PLAN_SIZE = 1 + KEYS * len(HANDS) * 3  # 37: shown, then where each hand is to go at each key
 
 # (name, size) in order; docs/features.md explains each block.
@@ -36,7 +40,7 @@ FOLLOWER_INPUT_LAYOUT = [
     ("partner_trajectory_past", TRAJECTORY_SIZE), ("partner_trajectory_future", TRAJECTORY_SIZE),
     ("partner_key_joints_past", KEY_JOINTS_SIZE), ("partner_pose", POSE_SIZE),
     ("self_trajectory_past", TRAJECTORY_SIZE), ("self_key_joints_past", KEY_JOINTS_SIZE),
-    ("self_pose", POSE_SIZE), ("music", MUSIC_SIZE),
+    ("self_pose", POSE_SIZE), ("figure", FIGURE_SIZE), ("music", MUSIC_SIZE),
 ]
 LEADER_INPUT_LAYOUT = [
     ("partner_trajectory_past", TRAJECTORY_SIZE), ("partner_key_joints_past", KEY_JOINTS_SIZE),
@@ -50,8 +54,8 @@ OUTPUT_LAYOUT = [
     ("key_joints_future", KEY_JOINTS_SIZE), ("pose", POSE_SIZE), ("contacts", CONTACTS_SIZE),
 ]
 INTENTION_LAYOUT = [("partner_key_joints_future", KEY_JOINTS_SIZE)]
-INPUT_SIZE = sum(s for _, s in FOLLOWER_INPUT_LAYOUT)     # 713: the follower's input
-LEADER_INPUT_SIZE = sum(s for _, s in LEADER_INPUT_LAYOUT)  # 757: the same blocks, control, figure, hands plan, music
+INPUT_SIZE = sum(s for _, s in FOLLOWER_INPUT_LAYOUT)     # 765: the follower's input
+LEADER_INPUT_SIZE = sum(s for _, s in LEADER_INPUT_LAYOUT)  # 802: the same blocks, control, figure, hands plan, music
 OUTPUT_SIZE = sum(s for _, s in OUTPUT_LAYOUT)            # 323
 INTENTION_SIZE = KEY_JOINTS_SIZE                          # 90
 INPUT_SIZES = {"follower": INPUT_SIZE, "leader": LEADER_INPUT_SIZE}
@@ -194,9 +198,11 @@ def music_of(partner: Track, me: Track, frames: np.ndarray, music: np.ndarray | 
                      "(a recorded take's count: training/data/count.py; a rollout's: its clock)")
 
 
-def follower_input(partner: Track, me: Track, frames: np.ndarray, music: np.ndarray | None = None) -> np.ndarray:
-    """Input I [N, 713] for the follower at `frames` (partner = leader, whose future is steered),
-    the music last (music_block's [N, 53]; None: the count the tracks carry)."""
+def follower_input(partner: Track, me: Track, frames: np.ndarray, figure: np.ndarray | None = None,
+                   music: np.ndarray | None = None) -> np.ndarray:
+    """Input I [N, 765] for the follower at `frames` (partner = leader, whose future is steered),
+    then the figure being led (figure_block's [N, 52]; None: none) and the music last
+    (music_block's [N, 53]; None: the count the tracks carry)."""
     root, heading = me.root[frames], me.heading[frames]
     return np.concatenate([
         _trajectory_at(partner, frames, PAST_OFFSETS, root, heading),
@@ -206,28 +212,31 @@ def follower_input(partner: Track, me: Track, frames: np.ndarray, music: np.ndar
         _trajectory_at(me, frames, PAST_OFFSETS, root, heading),
         _key_joints_at(me, frames, PAST_OFFSETS, root, heading),
         _pose_at(me, frames, root, heading),
+        figure_block(None, frames) if figure is None else figure,
         music_of(partner, me, frames, music),
     ], -1)
 
 
-def figure_block(partner_turn: np.ndarray | None, n: int) -> np.ndarray:
-    """The leader's figure block [n, 7]: `asked` (1 when a figure is asked for), then how far the
-    partner is to have turned at each future key, in full turns from now (signed like the heading:
-    +1 is a full turn counterclockwise seen from above). None: nobody asks (zeros), and the leader
-    leads what he likes, as he learnt from the samples whose figure was hidden."""
-    out = np.zeros((n, FIGURE_SIZE))
-    if partner_turn is not None:
-        out[:, 0] = 1.0
-        out[:, 1:] = partner_turn
-    return out
+def figure_block(figures: np.ndarray | None, frames: np.ndarray) -> np.ndarray:
+    """The figure being led [N, 52], which both dancers read: at each of FIGURE_OFFSETS from each
+    frame (the past second, now, the next second), for each of FIGURE_WAYS, `inside` (1 while a
+    figure of that way runs) and `progress` (0 at its start to 1 at its end; 0 outside).
 
-
-def partner_turn(partner: Track, frames: np.ndarray) -> np.ndarray:
-    """[N, KEYS] the recorded partner's turn from each frame to each future key, in full turns
-    (the root heading unwrapped over the take): the figure label of the leader's samples."""
-    heading = np.unwrap(partner.heading)
-    idx = frames[:, None] + FUTURE_OFFSETS[None]
-    return (heading[idx] - heading[frames][:, None]) / (2 * np.pi)
+    `figures` [M, 3] holds (way, start, end) per figure, in the frames of `frames` (a figure runs
+    from its start to its end frame, both included); None or empty: no figure. In training they
+    are the recorded couple's (training/data/led_figures.py: her turns, from his preparation to her
+    finish); at run time the visitor's and the leader's own (rollout.Figures). A salsa lead reaches
+    the follower through the joined hands, which a capture of positions does not hold: this block
+    stands for what her hand feels and his hand does. It asks nothing of her body or timing."""
+    frames = np.asarray(frames)
+    out = np.zeros((len(frames), len(FIGURE_OFFSETS), len(FIGURE_WAYS), 2))
+    t = frames[:, None] + FIGURE_OFFSETS[None]
+    for way, start, end in (np.zeros((0, 3)) if figures is None else np.asarray(figures)):
+        w = FIGURE_WAYS.index(1 if way > 0 else -1)
+        inside = (t >= start) & (t <= end)
+        out[..., w, 0] = np.maximum(out[..., w, 0], inside)
+        out[..., w, 1] = np.where(inside, (t - start) / max(end - start, 1), out[..., w, 1])
+    return out.reshape(len(frames), FIGURE_SIZE)
 
 
 def hands_plan_block(moves: np.ndarray | None, n: int) -> np.ndarray:
@@ -255,9 +264,9 @@ def hands_moves(me: Track, frames: np.ndarray) -> np.ndarray:
 
 def leader_input(partner: Track, me: Track, frames: np.ndarray, figure: np.ndarray | None = None,
                  hands_plan: np.ndarray | None = None, music: np.ndarray | None = None) -> np.ndarray:
-    """Input I [N, 757] for the leader (partner = follower, control = own future trajectory, then
-    the figure block: figure_block's [N, 7], and the hands plan: hands_plan_block's [N, 37], zeros
-    when not given; the music last, as the follower's)."""
+    """Input I [N, 802] for the leader (partner = follower, control = own future trajectory, then
+    the figure being led: figure_block's [N, 52], and the hands plan: hands_plan_block's [N, 37],
+    none when not given; the music last, as the follower's)."""
     root, heading = me.root[frames], me.heading[frames]
     return np.concatenate([
         _trajectory_at(partner, frames, PAST_OFFSETS, root, heading),
@@ -267,7 +276,7 @@ def leader_input(partner: Track, me: Track, frames: np.ndarray, figure: np.ndarr
         _key_joints_at(me, frames, PAST_OFFSETS, root, heading),
         _pose_at(me, frames, root, heading),
         _trajectory_at(me, frames, FUTURE_OFFSETS, root, heading),
-        figure_block(None, len(frames)) if figure is None else figure,
+        figure_block(None, frames) if figure is None else figure,
         hands_plan_block(None, len(frames)) if hands_plan is None else hands_plan,
         music_of(partner, me, frames, music),
     ], -1)

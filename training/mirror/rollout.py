@@ -38,29 +38,30 @@ ANCHOR_FREE = 0.75         # m around the anchor where a leader nobody steers is
 LEASH_DISTANCE = 2.0       # m: beyond this a follower is drawn toward its leader ...
 LEASH_RATE = 0.1           # ... closing this share of the excess every frame
 START_DISTANCE = 0.8       # m between the partners at the start and after a reset
-# A visitor's request to lead the partner's turn (ask_turn) becomes the leader's figure block
-# (features.figure_block): the partner's planned turn, one full turn eased in and out from
-# TURN_START to TURN_START + TURN_SECONDS after the request. Recorded turns take about 1.3 s from
-# their first 30 degrees to 300 (median 39 frames over the 79 whole turns of the 12 takes). The request
-# ends after REQUEST_SECONDS, when the leader leads as he likes again.
-TURN_START = 0.4           # s
-TURN_SECONDS = 1.2         # s
-REQUEST_SECONDS = 2.5      # s
-# The request also becomes his hands plan (features.hands_plan_block): his lead hand (the left for
+# The figures both dancers read (features.figure_block, rollout.Figures): her turn, one way or the
+# other, from his preparation to her finish, FIGURE_BEATS long. The recorded her turns last a
+# median 3.3 beats (10-90 %: 2.0-8.2; training/data/led_figures.py), 16.9 a minute, and start
+# anywhere in the two-beat group (4 7 6 9 7 9 4 10 per quarter beat): a figure asked for starts on
+# the next whole beat (under 0.4 s of waiting at 170 beats a minute), or when the figure running
+# ends. Nobody asking, the leader leads figures of his own (Figures.own): after each figure he waits
+# OWN_GAP_BEATS (drawn uniformly) and leads the next, either way alike (27 left / 29 right in the
+# recording), so a figure begins every 10 beats on average, as the recorded 16.9 a minute at 170.
+FIGURE_BEATS = 3.5
+OWN_GAP_BEATS = (1.0, 12.0)
+# A figure also becomes his hands plan (features.hands_plan_block): his lead hand (the left for
 # her turn to the left, +1, the right for -1) rises above his head and comes down again, the other
 # stays where it was. In the recording (training.evaluation.recorded_leads) his higher hand peaks
 # above 1.6 m in 84 % of her turns (median 1.83 m; in 17 % of all frames), a third of a second
 # before the turn completes: the left hand for 60 % of her turns to the left, at (0.02, 1.80, 0.28)
 # m in his root space (x to his left, z ahead), the right hand mirrored for her turns to the right.
-# RAISE: (start, up, start down, down) in s after the request; the raise is held while she turns.
-# The plan asks 1.90 m, above the recorded 1.80: the network stops short of a planned hand (a median
-# 1.76 m asked for 1.90; asked for 1.80 and held to 1.6 s, his hand passed 1.6 m in 61 % of
-# requests, for 1.90 and 1.8 s in 80 %). In the recording the hand also circles the way she turns; a
+# RAISE: (up, down) in s: his hand goes up over the figure's first `up` seconds, is held until
+# the figure ends and comes down over `down` after it. The plan asks 1.90 m, above the recorded
+# 1.80: the network stops short of a planned hand (a median 1.76 m asked for 1.90). In the recording the hand also circles the way she turns; a
 # planned circle (12 or 25 cm) left his hand's path as it was, so the plan holds none
 # (docs/results.md, "The hands plan").
 LEAD_HAND_RAISED = (0.02, 1.90, 0.28)  # m, the left hand, root space
-RAISE = (0.1, 0.5, 1.8, 2.3)           # s
-# The request also bends his planned path (lead_plan): it turns LEAD_TURN her way and moves
+RAISE = (0.4, 0.5)                     # s
+# A figure also bends his planned path (lead_plan): it turns LEAD_TURN her way and moves
 # LEAD_SIDE to his other side (his right for her turn to the left), eased as her planned turn. The
 # recorded leader turns with her: over the 2.5 s from 1.7 s before her turn completes his facing
 # goes her way by a median 38 degrees (quartiles -103 and +205, the 160 turns of the 12 takes as
@@ -71,8 +72,6 @@ RAISE = (0.1, 0.5, 1.8, 2.3)           # s
 # 0c0428a, 20 seeds x 30 s, nobody steering): 45 degrees and 0 m 33 %, 0 and 0.6 m 29 %, 60 and
 # 0.6 m 35 %, 90 and 0.3 m 44 %, 90 and 0.6 m 48 %, 90 and 1.0 m 45 %, 120 and 0.6 m 38 %, 150 and
 # 0.3 m 47 %.
-# Asked 90 degrees, he turns a median 121 degrees her way over a request (5 over the same moments
-# unasked; `lead --seeds 100`).
 LEAD_TURN = 90.0   # degrees
 LEAD_SIDE = 0.6    # m
 
@@ -207,75 +206,125 @@ def steer_plan(leader: Dancer, steering: Steering, stick: np.ndarray) -> None:
 
 
 @dataclass
-class TurnRequest:
-    """The visitor asked the leader to lead the partner's turn: +1 counterclockwise seen from
-    above (her left), -1 clockwise; `frame` counts the steps since the request; `hands`: his
-    hands (left, right) where they were at the request, in his root space."""
-    direction: int
-    frame: int = 0
-    hands: np.ndarray = field(default_factory=lambda: np.zeros((2, 3)))
+class Led:
+    """One figure the leader leads: her turn to her left (way +1, counterclockwise seen from above)
+    or to her right (-1), from duet frame `start` to `end` (both danced); `asked` when the visitor
+    asked for it; `hands`: his hands (left, right) in his root space when his plan for it began."""
+    way: int
+    start: int
+    end: int
+    asked: bool = False
+    hands: np.ndarray | None = None
 
 
-def planned_turn(seconds: float) -> float:
-    """Full turns the partner is planned to have made `seconds` after a request (smoothstep)."""
-    u = min(1.0, max(0.0, (seconds - TURN_START) / TURN_SECONDS))
-    return u * u * (3 - 2 * u)
+@dataclass
+class Figures:
+    """The figures of a duet: those danced and planned, in time order, and whether the leader
+    leads his own (`own`; the page's ?figures=0 turns them off) with `rng` drawing when and which."""
+    own: bool = True
+    rng: np.random.Generator = field(default_factory=lambda: np.random.default_rng(0))
+    led: list[Led] = field(default_factory=list)
+
+    def at(self, frame: int) -> Led | None:
+        """The figure danced at `frame`, or None."""
+        return next((f for f in self.led if f.start <= frame <= f.end), None)
+
+    def spans(self, frame: int) -> np.ndarray:
+        """[M, 3] (way, start, end) of every figure, in the frames of a track whose NOW is `frame`."""
+        return np.array([(f.way, f.start - frame + NOW, f.end - frame + NOW) for f in self.led],
+                        dtype=np.int64).reshape(-1, 3)
 
 
-def figure_input(request: TurnRequest | None) -> np.ndarray | None:
-    """The leader's figure keys [KEYS] for a request (None: nobody asks): how far the partner is
-    to turn from now to each future key, in full turns, signed by the direction."""
-    if request is None:
-        return None
-    now = request.frame / FPS
-    return np.array([request.direction * (planned_turn(now + off / FPS) - planned_turn(now))
-                     for off in FUTURE_OFFSETS])
+def frames_to_beat(duet: "Duet", at_frame: int, beat: float) -> int:
+    """Frames from `at_frame` until the count reaches `beat` (the count runs on one step a frame)."""
+    now = duet.beat + (at_frame - duet.frame) * music.beats_per_step(duet.tempo)
+    return at_frame + max(0, int(np.ceil((beat - now) / music.beats_per_step(duet.tempo) - 1e-9)))
 
 
-def raised(seconds: float) -> float:
-    """How far his lead hand is raised `seconds` after a request, 0 to 1 (smoothsteps up and down)."""
-    up = min(1.0, max(0.0, (seconds - RAISE[0]) / (RAISE[1] - RAISE[0])))
-    down = min(1.0, max(0.0, (seconds - RAISE[2]) / (RAISE[3] - RAISE[2])))
-    return up * up * (3 - 2 * up) * (1 - down * down * (3 - 2 * down))
-
-
-def hands_input(request: TurnRequest | None, leader: Dancer) -> np.ndarray | None:
-    """The leader's hands plan [KEYS, 2, 3] for a request (None: nobody asks): from where his hands
-    are now to where the raise puts them at each future key, in his root space."""
-    if request is None:
-        return None
-    now = request.frame / FPS
-    lead = 0 if request.direction > 0 else 1
-    top = np.array(LEAD_HAND_RAISED) * np.array([1.0 if lead == 0 else -1.0, 1.0, 1.0])
-    hands = feat.to_root_space_points(leader.positions[HANDS], leader.root, leader.heading)
-    out = np.repeat(request.hands[None], KEYS, 0) - hands[None]
-    for k, off in enumerate(FUTURE_OFFSETS):
-        u = raised(now + off / FPS)
-        out[k, lead] = request.hands[lead] + u * (top - request.hands[lead]) - hands[lead]
-    return out
+def figure_from(duet: "Duet", frame: int, way: int, asked: bool) -> Led:
+    """A figure of `way` starting at the first whole beat of the count at or after `frame`."""
+    per = music.beats_per_step(duet.tempo)
+    beat = duet.beat + (frame - duet.frame) * per
+    start = frames_to_beat(duet, frame, np.ceil(beat - 1e-9))
+    return Led(1 if way >= 0 else -1, start, start + int(round(FIGURE_BEATS / per)), asked)
 
 
 def ask_turn(duet: "Duet", direction: int) -> None:
-    """Ask the leader to lead the partner's turn now (a request still running starts anew)."""
-    d = duet.leader
-    hands = feat.to_root_space_points(d.positions[HANDS], d.root, d.heading)
-    duet.request = TurnRequest(1 if direction >= 0 else -1, hands=hands)
+    """The visitor asks the leader to lead her turn (+1 to her left, -1 to her right): it starts on
+    the next beat, or after the figure running ends; it takes the place of a figure not begun."""
+    f = duet.figures
+    f.led = [x for x in f.led if x.start <= duet.frame]
+    after = max([duet.frame] + [x.end + 1 for x in f.led])
+    f.led.append(figure_from(duet, after, direction, True))
+
+
+def plan_figures(duet: "Duet") -> None:
+    """Each step: forget figures out of the past second, and with `own`, plan his next figure
+    OWN_GAP_BEATS after the last (or after the start) once none is running or planned."""
+    f = duet.figures
+    f.led = [x for x in f.led if x.end >= duet.frame - HISTORY]
+    if not f.own or any(x.end >= duet.frame for x in f.led):
+        return
+    last = max([x.end + 1 for x in f.led], default=duet.frame)
+    # Two uniform draws, in this order (the page's mirror draws the same): the wait, then the way.
+    gap = OWN_GAP_BEATS[0] + (OWN_GAP_BEATS[1] - OWN_GAP_BEATS[0]) * f.rng.random()
+    way = 1 if f.rng.random() < 0.5 else -1
+    start = frames_to_beat(duet, last, duet.beat + (last - duet.frame) * music.beats_per_step(duet.tempo) + gap)
+    f.led.append(figure_from(duet, max(start, duet.frame + 1), way, False))
+
+
+def figure_share(led: Led, frame: float) -> float:
+    """How much of her turn is planned done at `frame`, 0 to 1 (smoothstep over the figure)."""
+    u = min(1.0, max(0.0, (frame - led.start) / max(led.end - led.start, 1)))
+    return u * u * (3 - 2 * u)
+
+
+def raised(led: Led, frame: float) -> float:
+    """How far his lead hand is raised for `led` at `frame`, 0 to 1 (smoothsteps up and down)."""
+    up = min(1.0, max(0.0, (frame - led.start) / (RAISE[0] * FPS)))
+    down = min(1.0, max(0.0, (frame - led.end) / (RAISE[1] * FPS)))
+    return up * up * (3 - 2 * up) * (1 - down * down * (3 - 2 * down))
+
+
+def planning(duet: "Duet") -> Led | None:
+    """The figure his hands plan is for: the one danced now or beginning within the next second,
+    else one whose raise is coming down. A figure that follows another at once takes the plan
+    over as soon as the one before ends."""
+    near = [x for x in duet.figures.led if x.start - HISTORY <= duet.frame <= x.end + int(RAISE[1] * FPS)]
+    return next((x for x in near if x.end >= duet.frame), near[0] if near else None)
+
+
+def hands_input(duet: "Duet") -> np.ndarray | None:
+    """The leader's hands plan [KEYS, 2, 3] for the figure he plans (None: none): from where his
+    hands are now to where the raise puts them at each future key, in his root space."""
+    led, leader = planning(duet), duet.leader
+    if led is None:
+        return None
+    hands = feat.to_root_space_points(leader.positions[HANDS], leader.root, leader.heading)
+    if led.hands is None:
+        led.hands = hands
+    lead = 0 if led.way > 0 else 1
+    top = np.array(LEAD_HAND_RAISED) * np.array([1.0 if lead == 0 else -1.0, 1.0, 1.0])
+    out = np.repeat(led.hands[None], KEYS, 0) - hands[None]
+    for k, off in enumerate(FUTURE_OFFSETS):
+        u = raised(led, duet.frame + off)
+        out[k, lead] = led.hands[lead] + u * (top - led.hands[lead]) - hands[lead]
+    return out
 
 
 def lead_plan(duet: "Duet") -> None:
-    """While a request runs, bend the leader's planned path (after steer_plan) so that it leads
-    her turn's way: from now to each future key it turns LEAD_TURN degrees and moves LEAD_SIDE
-    metres to his other side, times the share of her planned turn made between them."""
-    r = duet.request
-    if r is None:
-        return
-    t, now = duet.leader.track, r.frame / FPS
+    """While a figure is danced or about to be, bend the leader's planned path (after steer_plan)
+    so that it leads her turn's way: from now to each future key it turns LEAD_TURN degrees and
+    moves LEAD_SIDE metres to his other side, times the share of her turn planned between them."""
+    t = duet.leader.track
     h = t.heading[NOW]
     his_left = np.array([np.cos(h), -np.sin(h)])   # his root space's +x on the floor (x, z)
-    for off in FUTURE_OFFSETS:
-        share = planned_turn(now + off / FPS) - planned_turn(now)
-        t.heading[NOW + off] += r.direction * np.radians(LEAD_TURN) * share
-        t.root[NOW + off] -= r.direction * LEAD_SIDE * share * his_left
+    for led in duet.figures.led:
+        for off in FUTURE_OFFSETS:
+            share = figure_share(led, duet.frame + off) - figure_share(led, duet.frame)
+            if share:
+                t.heading[NOW + off] += led.way * np.radians(LEAD_TURN) * share
+                t.root[NOW + off] -= led.way * LEAD_SIDE * share * his_left
 
 
 def shift_dancer(d: Dancer, shift: np.ndarray) -> None:
@@ -336,7 +385,7 @@ class Duet:
     # What is shown after the contact layer: [leader, follower] world positions [17, 3].
     shown: np.ndarray = field(default_factory=lambda: np.zeros((2, feat.N_JOINTS, 3)))
     resets_seen: int = 0
-    request: TurnRequest | None = None
+    figures: Figures = field(default_factory=Figures)
     # The music both dancers hear (training/mirror/music.py): its tempo (beats a minute) and the
     # count now (beats since it started). Each step moves the count on by one step of the tempo;
     # the page reads it from the audio clock instead (what the listener hears now).
@@ -362,16 +411,18 @@ def manifest_tempo(manifest: dict) -> float:
     return float(manifest.get("music", {}).get("tempo", music.DEFAULT_TEMPO))
 
 
-def start_duet(manifest: dict, tempo: float | None = None) -> Duet:
+def start_duet(manifest: dict, tempo: float | None = None, figures: bool = True, seed: int = 0) -> Duet:
     """Both dancers in their start poses, the music at `tempo` beats a minute (None: the
-    manifest's) and its count at 0."""
+    manifest's) and its count at 0; with `figures` the leader leads figures of his own, drawn
+    from `seed` (the page's ?figures=1 and ?seed=)."""
     sk, sp = manifest["skeleton"], manifest["startPose"]
     leader = start_dancer(sk["offsets"]["leader"], sp["leader"], [0.0, 0.0], 0.0)
     follower = start_dancer(sk["offsets"]["follower"], sp["follower"], [0.0, START_DISTANCE], np.pi)
     bpm = manifest_tempo(manifest) if tempo is None else float(tempo)
     if not np.isfinite(bpm) or bpm <= 0:
         raise ValueError(f"tempo must be a positive number of beats a minute, got {tempo}")
-    return Duet(leader, follower, sp, Steering(anchor=leader.root.copy()), tempo=bpm)
+    return Duet(leader, follower, sp, Steering(anchor=leader.root.copy()), tempo=bpm,
+                figures=Figures(own=figures, rng=np.random.default_rng([seed, 1])))
 
 
 def music_input(duet: Duet) -> np.ndarray:
@@ -380,15 +431,15 @@ def music_input(duet: Duet) -> np.ndarray:
 
 
 def step_inputs(duet: Duet) -> tuple[np.ndarray, np.ndarray]:
-    """Both models' inputs at NOW. The follower's never holds the request: she reads the leader."""
+    """Both models' inputs at NOW. Both read the figure being led (what her hand feels); only his
+    hands plan says where his hands go."""
     now = np.array([NOW])
-    keys = figure_input(duet.request)
-    figure = None if keys is None else feat.figure_block(keys[None], 1)
-    moves = hands_input(duet.request, duet.leader)
+    figure = feat.figure_block(duet.figures.spans(duet.frame), now)
+    moves = hands_input(duet)
     plan = None if moves is None else feat.hands_plan_block(moves[None], 1)
     heard = music_input(duet)
     return (leader_input(duet.follower.track, duet.leader.track, now, figure, plan, heard)[0],
-            follower_input(duet.leader.track, duet.follower.track, now, heard)[0])
+            follower_input(duet.leader.track, duet.follower.track, now, figure, heard)[0])
 
 
 def finish_step(duet: Duet, leader_output: np.ndarray, follower_output: np.ndarray,
@@ -405,10 +456,6 @@ def finish_step(duet: Duet, leader_output: np.ndarray, follower_output: np.ndarr
                 follow_anchor(d, duet.steering)
     if keep_close(duet.follower, duet.leader):
         duet.follower.leashed += 1
-    if duet.request is not None:
-        duet.request.frame += 1
-        if duet.request.frame >= REQUEST_SECONDS * FPS:
-            duet.request = None
     if follower_intention is not None:
         f = duet.follower
         keys = follower_intention.reshape(KEYS, len(KEY_JOINTS), 3)
@@ -437,6 +484,7 @@ class OnnxPolicy:
 
 def step(duet: Duet, leader_policy, follower_policy, stick, temperature: float,
          rng: np.random.Generator) -> None:
+    plan_figures(duet)
     steer_plan(duet.leader, duet.steering, np.asarray(stick, float))
     lead_plan(duet)
     xl, xf = step_inputs(duet)

@@ -11,7 +11,7 @@ import { DuetError } from '../ui/errors';
 import { createUniform, fillUniform } from './random';
 import { INPUT_SIZES, INTENTION_SIZE, OUTPUT_SIZE } from '../mirror/features';
 
-/** The input width of a model's role (the leader's input adds the figure block). */
+/** The input width of a model's role (the leader's input adds his control and hands plan). */
 function inputSize(entry: ModelEntry): number {
   return INPUT_SIZES[entry.role] ?? INPUT_SIZES.follower;
 }

@@ -6,7 +6,7 @@
 // standing sample whose footwork follows the beat), sampled ghosts and leader playback from a
 // recording. Nothing else in this file changes a number the models see.
 
-import { FUTURE_OFFSETS, INPUT_SIZE, INTENTION_SIZE, KEYS, OUTPUT_SIZE, followerInput } from '../mirror/features';
+import { FIGURE_SIZE, FUTURE_OFFSETS, INPUT_SIZE, INTENTION_SIZE, KEYS, OUTPUT_SIZE, figureBlock, followerInput } from '../mirror/features';
 import { KEY_JOINTS, type Motion, N_JOINTS, POSITIONS_SIZE, ROTATIONS_SIZE } from '../mirror/skeleton';
 import { ContactLayer, FOLLOWER_CONTACT, HipGlide } from '../mirror/contact';
 import { FootLock } from '../mirror/footik';
@@ -14,10 +14,11 @@ import { type GuardSettings, type Ranges, hipSlackFor, mostUpright, nearestPlan,
 import { OnCount, STEPPED, drawnFootwork, drawnSteps, hipsTurnBack, nearestCount } from '../mirror/on_count';
 import { LeaderPlayback } from './playback';
 import { StepTimer } from './timing';
+import { createUniform } from './random';
 import {
-  Dancer, type Duet, NOW, applyOutput, askTurn, finishStep, leadPlan, musicInput, outputIsAbsurd, startDuet, steerPlan, stepInputs,
+  Dancer, type Duet, NOW, applyOutput, askTurn, finishStep, leadPlan, musicInput, outputIsAbsurd, planFigures, startDuet, steerPlan, stepInputs,
 } from '../mirror/rollout';
-import type { DancerView, Simulation, SimulationOptions, StepPolicy, Steer } from './types';
+import type { DancerView, FigureView, Simulation, SimulationOptions, StepPolicy, Steer } from './types';
 
 /** Per dancer: what the page draws, kept up to date from the dancer after every step. */
 class View implements DancerView {
@@ -61,6 +62,10 @@ class View implements DancerView {
 /** Steps a possible reaction dances on its own before it branches from the partner again (1 s):
  *  long enough to part from her, short enough to stay a reaction to this moment. */
 const GHOST_LIFE = 30;
+
+/** The leader's own figures draw from a stream of their own, derived from the page's seed (the
+ *  policies' noise streams are seed + i·0x9e3779b9: main.ts). */
+const FIGURES_STREAM = 0x85ebca6b;
 
 export class DuetSimulation implements Simulation {
   readonly leader: DancerView;
@@ -110,6 +115,11 @@ export class DuetSimulation implements Simulation {
   private ghostBranched: boolean[] = [];
   private ghostCalls = 0;
   private readonly ghostPoses: Float32Array[] = [];
+  /** The figure block the possible reactions read (at the frame they step from, as the followers will). */
+  private readonly ghostFigure = new Float64Array(FIGURE_SIZE);
+  /** Whether the leader leads figures of his own (?figures=, the panel's switch). */
+  private own: boolean;
+  private figureView: FigureView | null = null;
 
   constructor(private readonly options: SimulationOptions) {
     const { manifest, leader, followers } = options;
@@ -126,7 +136,8 @@ export class DuetSimulation implements Simulation {
     const oc = manifest.onCount && manifest.onCount.samples >= 2 ? manifest.onCount : null;
     this.leaderOnCount = oc && this.leaderGuard ? new OnCount('leader', oc.samples, oc.strength, oc.hips) : null;
     this.followerOnCount = followers.map(() => (oc && this.uprightGuard ? new OnCount('follower', oc.samples, oc.strength, oc.hips) : null));
-    this.duet = startDuet(manifest, followers.length);
+    this.own = options.figures ?? true;
+    this.duet = this.startDuet(null);
     this.shownBeat = this.duet.beat;
     this.leaderView = new View(false);
     this.followerViews = followers.map((p) => new View(p.hasIntention));
@@ -137,8 +148,14 @@ export class DuetSimulation implements Simulation {
     this.updateViews(true);
   }
 
+  /** Both dancers in the start pose, the figures drawn anew from the page's seed. */
+  private startDuet(tempo: number | null): Duet {
+    const random = createUniform((this.options.seed + FIGURES_STREAM) >>> 0);
+    return startDuet(this.options.manifest, this.followerPolicies.length, tempo, this.own, random);
+  }
+
   reset(): void {
-    this.duet = startDuet(this.options.manifest, this.followerPolicies.length, this.duet.tempo);
+    this.duet = this.startDuet(this.duet.tempo);
     this.shownBeat = this.duet.beat;
     this.ghostBranched = []; // the possible reactions branch again from the new start
     this.upright = 0;
@@ -150,10 +167,10 @@ export class DuetSimulation implements Simulation {
   }
 
   /**
-   * Ask the leader to lead the partner's turn now: +1 counterclockwise seen from above (her left),
-   * -1 clockwise. Only the leader model reads it (its figure block); the followers read the leader.
-   * A recorded leader (playback) leads nothing: the request then does nothing. Returns whether
-   * the leader took it.
+   * Ask the leader to lead her turn: +1 counterclockwise seen from above (her left), -1 clockwise.
+   * It starts on the next beat, or after the figure running ends (rollout.ts askTurn); both dancers
+   * read it (the figure block), as the hand hold carries a lead. A recorded leader (playback) leads
+   * nothing: the request then does nothing. Returns whether the leader took it.
    */
   askTurn(direction: number): boolean {
     if (this.playback) return false;
@@ -161,13 +178,41 @@ export class DuetSimulation implements Simulation {
     return true;
   }
 
+  get ownFigures(): boolean {
+    return this.own;
+  }
+
+  /**
+   * Whether the leader leads figures of his own, from the next step on. Switched off, his own
+   * figures not begun yet are dropped with it (one planned a few beats ahead would otherwise still
+   * come); the visitor's stay.
+   */
+  set ownFigures(on: boolean) {
+    this.own = on;
+    const figures = this.duet.figures;
+    figures.own = on;
+    if (!on) figures.led = figures.led.filter((x) => x.asked || x.start <= this.duet.frame);
+  }
+
+  /** The figure danced on the step on screen, else the next one planned (coming), else null. */
+  get figure(): FigureView | null {
+    const shown = this.duet.frame - 1;
+    const led = this.duet.figures.led.find((x) => x.end >= shown) ?? null;
+    const view = this.figureView;
+    if (!led) return (this.figureView = null);
+    const coming = led.start > shown;
+    if (view && view.way === led.way && view.asked === led.asked && view.coming === coming) return view;
+    return (this.figureView = { way: led.way, asked: led.asked, coming });
+  }
+
   get anchor(): ArrayLike<number> {
     return this.duet.steering.anchor;
   }
 
-  /** Whether a turn the visitor asked for is being led, and its direction (0: none). */
+  /** The way of a figure the visitor asked for, planned or being danced (0: none). */
   get turnAsked(): number {
-    return this.duet.request?.direction ?? 0;
+    const shown = this.duet.frame - 1;
+    return this.duet.figures.led.find((x) => x.asked && x.end >= shown)?.way ?? 0;
   }
 
   /** The count of the last step taken (the one on screen); duet.beat is the next step's. */
@@ -195,6 +240,7 @@ export class DuetSimulation implements Simulation {
     if (!playing) {
       const sx = steer.active ? steer.x : 0;
       const sz = steer.active ? steer.z : 0;
+      planFigures(duet);
       steerPlan(duet.leader, duet.steering, sx, sz);
       leadPlan(duet);
     }
@@ -368,7 +414,11 @@ export class DuetSimulation implements Simulation {
     }
     const input = policy.batchInput(k);
     const heard = musicInput(this.duet);
-    for (let i = 0; i < k; i++) followerInput(this.duet.leader.track, this.ghostDancers[i].track, NOW, input, i * INPUT_SIZE, heard);
+    // The figure being led, as the followers read it (rollout.ts stepInputs): every reaction feels the same lead.
+    figureBlock(this.duet.figures.spans(this.duet.frame), NOW, this.ghostFigure, 0);
+    for (let i = 0; i < k; i++) {
+      followerInput(this.duet.leader.track, this.ghostDancers[i].track, NOW, input, i * INPUT_SIZE, this.ghostFigure, heard);
+    }
     const { output } = await policy.runBatch(k, this.temperature);
     while (this.ghostPoses.length < k) this.ghostPoses.push(new Float32Array(POSITIONS_SIZE));
     for (let i = 0; i < k; i++) {
@@ -407,7 +457,9 @@ export class DuetSimulation implements Simulation {
   /**
    * Drive the leader from a recorded motion (30 fps, e.g. motionFromBvhText) instead of the leader
    * model, or go back to the model with null. The recording starts where the leader stands now,
-   * facing where it faces, and loops.
+   * facing where it faces, and loops. A recording leads no figure: the figures planned or danced
+   * are dropped, and none is planned while it plays (the followers read none); back with the
+   * model, he plans his own again.
    */
   setLeaderPlayback(motion: Motion | null): void {
     if (!motion) {
@@ -417,6 +469,7 @@ export class DuetSimulation implements Simulation {
     const playback = new LeaderPlayback(motion);
     playback.takeOver(this.duet.leader.track);
     this.playback = playback;
+    this.duet.figures.led = [];
   }
 
   /** Whether the leader follows a recording; the recording's current frame and length. */

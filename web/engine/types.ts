@@ -38,13 +38,28 @@ export interface DancerView {
   hands?: Float32Array;
 }
 
+/** A figure the leader leads (web/mirror/rollout.ts Led), as the page shows it. */
+export interface FigureView {
+  /** Her turn to her left (+1, counterclockwise seen from above) or to her right (-1). */
+  way: number;
+  /** Whether the visitor asked for it (else it is one of his own). */
+  asked: boolean;
+  /** Planned, not begun yet on the step on screen. */
+  coming: boolean;
+}
+
 export interface Simulation {
   /** Back to the start pose; keeps the models. */
   reset(): void;
-  /** Ask the leader model to lead the partner's turn (-1 her right, +1 her left); false while a file leads. */
+  /** Ask the leader model to lead her turn (-1 her right, +1 her left) on the next beat, or after
+   *  the figure running; false while a file leads. */
   askTurn(direction: number): boolean;
-  /** The turn being led: -1, +1, or 0 when none. */
+  /** The way of a turn the visitor asked for, planned or being led: -1, +1, or 0 when none. */
   readonly turnAsked: number;
+  /** Whether the leader leads figures of his own (?figures=1); set: from the next step on. */
+  ownFigures: boolean;
+  /** The figure danced on the step on screen, else the next one planned (coming), else null. */
+  readonly figure: FigureView | null;
   /** The spot the leader dances around (world x, z): it moves only while the visitor steers.
    *  The simulation's own array (read it, do not keep or change it). */
   readonly anchor: ArrayLike<number>;
@@ -117,8 +132,11 @@ export interface SimulationOptions {
   leader: StepPolicy;
   /** [ours] or [ccm], or [ours, ccm] in compare mode. */
   followers: StepPolicy[];
-  /** Seed for anything random the simulation does itself (the policies carry their own PRNG). */
+  /** Seed for anything random the simulation does itself (the policies carry their own PRNG):
+   *  when and which figures the leader leads of his own. */
   seed: number;
+  /** Whether the leader leads figures of his own (?figures=, default true). */
+  figures?: boolean;
 }
 
 /** simulation.ts exports a function of this type named `createSimulation`. */
@@ -192,6 +210,14 @@ export interface DancerHook {
   outline?: [number, number][] | null;
 }
 
+/** A figure in the test hook: its name, her way (left: counterclockwise seen from above), and
+ *  whether the visitor asked for it. */
+export interface FigureHook {
+  name: 'her_turn';
+  way: 'left' | 'right';
+  asked: boolean;
+}
+
 /** The test hook on window.duet: the end-to-end tests (tests/e2e) read only this. */
 export interface DuetHook {
   ready: boolean;
@@ -209,11 +235,13 @@ export interface DuetHook {
   networkMs: { median: number; p95: number };
   /** Follower model in use: 'ours', 'ccm' or 'compare'. */
   model: string;
-  /** Ask the leader to lead the partner's turn, as T does (-1 her right, +1 her left); false
-   *  before the dance starts or while a file leads. */
+  /** Ask the leader to lead her turn, as T does (-1 her right, +1 her left): it starts on the next
+   *  beat, or after the figure running; false before the dance starts or while a file leads. */
   askTurn?: (direction: number) => boolean;
-  /** The turn being led: -1, +1, or 0 when none. */
+  /** The way of a turn the visitor asked for, planned or being led: -1, +1, or 0 when none. */
   turnAsked?: number;
+  /** The figure being danced on the step on screen (asked for or his own), or null. */
+  figure?: FigureHook | null;
   /** The spot the leader dances around (world x, z): it moves only while the visitor steers. */
   anchor?: [number, number];
   /** The music's tempo, beats a minute, and the count of the step on screen (beats since the

@@ -25,7 +25,11 @@ export const KEY_JOINTS_SIZE = KEYS * N_KEY_JOINTS * 3; // 90
 export const POSE_SIZE = N_JOINTS * 12; // 204
 export const ROOT_UPDATE_SIZE = 3;
 export const CONTACTS_SIZE = 2;
-export const FIGURE_SIZE = 1 + KEYS; // 7: asked, then the partner's planned turn at each key
+// The figure being led (figureBlock): her turn to her left (way +1) or to her right (-1), read at
+// each key of the past second, now, and each key of the next second, as (inside, progress).
+export const FIGURE_WAYS: readonly number[] = [1, -1];
+export const FIGURE_OFFSETS: readonly number[] = Array.from({ length: 2 * KEYS + 1 }, (_, i) => (i - KEYS) * KEY_STEP); // t-30 ... t ... t+30
+export const FIGURE_SIZE = FIGURE_OFFSETS.length * FIGURE_WAYS.length * 2; // 52
 export const HANDS_PLAN_SIZE = 1 + KEYS * HANDS.length * 3; // 37: shown, then where each hand is to go at each key
 
 export type Layout = ReadonlyArray<readonly [string, number]>;
@@ -35,7 +39,7 @@ export const FOLLOWER_INPUT_LAYOUT: Layout = [
   ['partner_trajectory_past', TRAJECTORY_SIZE], ['partner_trajectory_future', TRAJECTORY_SIZE],
   ['partner_key_joints_past', KEY_JOINTS_SIZE], ['partner_pose', POSE_SIZE],
   ['self_trajectory_past', TRAJECTORY_SIZE], ['self_key_joints_past', KEY_JOINTS_SIZE],
-  ['self_pose', POSE_SIZE], ['music', MUSIC_SIZE],
+  ['self_pose', POSE_SIZE], ['figure', FIGURE_SIZE], ['music', MUSIC_SIZE],
 ];
 export const LEADER_INPUT_LAYOUT: Layout = [
   ['partner_trajectory_past', TRAJECTORY_SIZE], ['partner_key_joints_past', KEY_JOINTS_SIZE],
@@ -50,8 +54,8 @@ export const OUTPUT_LAYOUT: Layout = [
 ];
 export const INTENTION_LAYOUT: Layout = [['partner_key_joints_future', KEY_JOINTS_SIZE]];
 const layoutSize = (layout: Layout) => layout.reduce((sum, [, size]) => sum + size, 0);
-export const INPUT_SIZE = layoutSize(FOLLOWER_INPUT_LAYOUT); // 713: the follower's input
-export const LEADER_INPUT_SIZE = layoutSize(LEADER_INPUT_LAYOUT); // 757: the same blocks, control, figure, hands plan, music
+export const INPUT_SIZE = layoutSize(FOLLOWER_INPUT_LAYOUT); // 765: the follower's input
+export const LEADER_INPUT_SIZE = layoutSize(LEADER_INPUT_LAYOUT); // 802: the same blocks, control, figure, hands plan, music
 export const OUTPUT_SIZE = layoutSize(OUTPUT_LAYOUT); // 323
 export const INTENTION_SIZE = KEY_JOINTS_SIZE; // 90
 export const INPUT_SIZES: Readonly<Record<string, number>> = { follower: INPUT_SIZE, leader: LEADER_INPUT_SIZE };
@@ -335,9 +339,9 @@ const INPUT_BLOCKS: Record<string, InputBlock> = {
   self_pose: (_partner, me, t, x, z, h, out, at) => poseAt(me, t, x, z, h, out, at),
   // The leader's control is its own planned (steered) future trajectory.
   control: (_partner, me, t, x, z, h, out, at) => trajectoryAt(me, t, FUTURE_OFFSETS, x, z, h, out, at),
-  // Nobody asks for a figure here; leaderInput writes the request over it when there is one.
-  figure: (_partner, _me, _t, _x, _z, _h, out, at) => figureBlock(null, out, at),
-  // Nor for a lead; leaderInput writes the request's hands plan over it when there is one.
+  // No figure here; followerInput / leaderInput write the one being led over it when there is one.
+  figure: (_partner, _me, t, _x, _z, _h, out, at) => figureBlock(null, t, out, at),
+  // Nor a lead; leaderInput writes the hands plan for a figure over it when there is one.
   hands_plan: (_partner, _me, _t, _x, _z, _h, out, at) => handsPlanBlock(null, out, at),
   // The count the tracks carry; followerInput / leaderInput write the rollout's clock instead.
   music: (partner, me, t, _x, _z, _h, out, at) => {
@@ -347,14 +351,31 @@ const INPUT_BLOCKS: Record<string, InputBlock> = {
 };
 
 /**
- * The leader's figure block [7] at out[at..]: `asked` (1 when a figure is asked for), then how
- * far the partner is to have turned at each future key, in full turns from now (signed like the
- * heading: +1 is a full turn counterclockwise seen from above). null: nobody asks (zeros), and
- * the leader leads what he likes, as he learnt from the samples whose figure was hidden.
+ * The figure being led [52] at out[at..], which both dancers read: at each of FIGURE_OFFSETS from
+ * frame t (the past second, now, the next second), for each of FIGURE_WAYS, `inside` (1 while a
+ * figure of that way runs) and `progress` (0 at its start to 1 at its end; 0 outside).
+ *
+ * `figures` holds (way, start, end) per figure, flat, in the frames of t (a figure runs from its
+ * start to its end frame, both included); null or empty: no figure. At run time they are the
+ * visitor's and the leader's own (rollout.ts Figures). A salsa lead reaches the follower through
+ * the joined hands, which a capture of positions does not hold: this block stands for what her
+ * hand feels and his hand does. It asks nothing of her body or timing.
  */
-export function figureBlock(partnerTurn: ArrayLike<number> | null, out: Out, at = 0): void {
-  out[at] = partnerTurn ? 1 : 0;
-  for (let k = 0; k < KEYS; k++) out[at + 1 + k] = partnerTurn ? partnerTurn[k] : 0;
+export function figureBlock(figures: ArrayLike<number> | null, t: number, out: Out, at = 0): void {
+  const ways = FIGURE_WAYS.length;
+  for (let i = 0; i < FIGURE_SIZE; i++) out[at + i] = 0;
+  const n = figures ? figures.length / 3 : 0;
+  for (let m = 0; m < n; m++) {
+    const way = figures![3 * m], start = figures![3 * m + 1], end = figures![3 * m + 2];
+    const w = FIGURE_WAYS.indexOf(way > 0 ? 1 : -1);
+    for (let k = 0; k < FIGURE_OFFSETS.length; k++) {
+      const f = t + FIGURE_OFFSETS[k];
+      if (f < start || f > end) continue;
+      const o = at + 2 * (k * ways + w);
+      out[o] = 1;
+      out[o + 1] = (f - start) / Math.max(end - start, 1);
+    }
+  }
 }
 
 /**
@@ -401,22 +422,34 @@ function copyMusic(music: ArrayLike<number> | null, partner: Track, me: Track, o
   }
 }
 
+/** The figure block given (figureBlock's [52]) over the zeros the layout wrote; null: none. */
+function copyFigure(figure: ArrayLike<number> | null, out: Out, at: number): void {
+  if (figure) for (let i = 0; i < FIGURE_SIZE; i++) out[at + i] = figure[i];
+}
+
+const FOLLOWER_FIGURE_AT = blockSlices(FOLLOWER_INPUT_LAYOUT).figure.start;
+
 /**
- * Input I [713] for the follower at frame t (partner = leader, whose future is steered), the music
- * last (musicBlock's [53]; null: the count the tracks carry).
+ * Input I [765] for the follower at frame t (partner = leader, whose future is steered), then the
+ * figure being led (figureBlock's [52]; null: none) and the music last (musicBlock's [53]; null:
+ * the count the tracks carry).
  */
-export function followerInput(partner: Track, me: Track, t: number, out: Out, at = 0, music: ArrayLike<number> | null = null): void {
+export function followerInput(
+  partner: Track, me: Track, t: number, out: Out, at = 0,
+  figure: ArrayLike<number> | null = null, music: ArrayLike<number> | null = null,
+): void {
   writeInput(FOLLOWER_PLAN, partner, me, t, out, at);
+  copyFigure(figure, out, at + FOLLOWER_FIGURE_AT);
   copyMusic(music, partner, me, out, at + FOLLOWER_MUSIC_AT);
 }
 
-const FIGURE_AT = blockSlices(LEADER_INPUT_LAYOUT).figure.start;
+const LEADER_FIGURE_AT = blockSlices(LEADER_INPUT_LAYOUT).figure.start;
 const HANDS_PLAN_AT = blockSlices(LEADER_INPUT_LAYOUT).hands_plan.start;
 
 /**
- * Input I [757] for the leader (partner = follower, control = own future trajectory, then the
- * figure block: figureBlock of `figure`, the partner's planned turn per key, and the hands plan:
- * handsPlanBlock of `handsPlan`, each zeros when null; the music last, as the follower's).
+ * Input I [802] for the leader (partner = follower, control = own future trajectory, then the
+ * figure being led: figureBlock's [52], and the hands plan: handsPlanBlock of `handsPlan`, none
+ * when null; the music last, as the follower's).
  */
 export function leaderInput(
   partner: Track, me: Track, t: number, out: Out, at = 0,
@@ -424,7 +457,7 @@ export function leaderInput(
   music: ArrayLike<number> | null = null,
 ): void {
   writeInput(LEADER_PLAN, partner, me, t, out, at);
-  if (figure) figureBlock(figure, out, at + FIGURE_AT);
+  copyFigure(figure, out, at + LEADER_FIGURE_AT);
   if (handsPlan) handsPlanBlock(handsPlan, out, at + HANDS_PLAN_AT);
   copyMusic(music, partner, me, out, at + LEADER_MUSIC_AT);
 }

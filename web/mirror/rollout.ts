@@ -12,14 +12,18 @@
 // Differences from Python, none of which changes a number: a duet has a list of followers (two in
 // compare mode, each reacting to the same leader; the leader reacts to the first); outputs are
 // read at an offset so batched (ghost) results need no copies; scratch arrays are preallocated.
-// The page's Simulation (policies in, views out) is simulation.ts.
+// One that does: Figures.rng is the page's seeded uniform generator (web/engine/random.ts), not
+// numpy's, so one seed draws other own figures here than in Python (the same draws, in the same
+// order, from other numbers). The page's Simulation (policies in, views out) is simulation.ts; its
+// step is Python's step: planFigures, steerPlan, leadPlan, stepInputs, the models, finishStep.
 
 import {
-  FUTURE_OFFSETS, HISTORY, INTENTION_SIZE, KEYS, N_JOINTS, OUTPUT_LAYOUT, OUTPUT_SIZE, Track,
-  blockSlices, followerInput, fromRootSpaceDirections, fromRootSpacePoints, leaderInput, toRootSpacePoints, wrapAngle,
+  FIGURE_SIZE, FUTURE_OFFSETS, HISTORY, INTENTION_SIZE, KEYS, N_JOINTS, OUTPUT_LAYOUT, OUTPUT_SIZE, Track,
+  blockSlices, figureBlock, followerInput, fromRootSpaceDirections, fromRootSpacePoints, leaderInput, toRootSpacePoints, wrapAngle,
 } from './features';
 import { FEET, FPS, HANDS, KEY_JOINTS, type Out, PARENTS, POSITIONS_SIZE, ROTATIONS_SIZE, forwardKinematicsReduced } from './skeleton';
 import { DEFAULT_TEMPO, MUSIC_SIZE, beatsPerStep, musicBlock } from './music';
+import { createUniform } from '../engine/random';
 
 export const NOW = HISTORY;
 export const TRACK_FRAMES = 2 * HISTORY + 1;
@@ -37,36 +41,35 @@ export const ANCHOR_FREE = 0.75; // m around the anchor where a leader nobody st
 export const LEASH_DISTANCE = 2.0; // m: beyond this a follower is drawn toward its leader ...
 export const LEASH_RATE = 0.1; // ... closing this share of the excess every frame
 export const START_DISTANCE = 0.8; // m between the partners at the start and after a reset
-// A visitor's request to lead the partner's turn (askTurn) becomes the leader's figure block
-// (features figureBlock): the partner's planned turn, one full turn eased in and out from
-// TURN_START to TURN_START + TURN_SECONDS after the request. Recorded turns take about 1.3 s from
-// their first 30 degrees to 300 (median 39 frames over the 79 whole turns of the 12 takes). The request
-// ends after REQUEST_SECONDS, when the leader leads as he likes again.
-export const TURN_START = 0.4; // s
-export const TURN_SECONDS = 1.2; // s
-export const REQUEST_SECONDS = 2.5; // s
-// The request also becomes his hands plan (features handsPlanBlock): his lead hand (the left for
+// The figures both dancers read (features figureBlock, Figures): her turn, one way or the other,
+// from his preparation to her finish, FIGURE_BEATS long. The recorded her turns last a median 3.3
+// beats (10-90 %: 2.0-8.2), 16.9 a minute, and start anywhere in the two-beat group: a figure
+// asked for starts on the next whole beat (under 0.4 s of waiting at 170 beats a minute), or when
+// the figure running ends. Nobody asking, the leader leads figures of his own (Figures.own): after
+// each figure he waits OWN_GAP_BEATS (drawn uniformly) and leads the next, either way alike (27
+// left / 29 right in the recording), so a figure begins every 10 beats on average, as recorded.
+export const FIGURE_BEATS = 3.5;
+export const OWN_GAP_BEATS: readonly number[] = [1, 12];
+// A figure also becomes his hands plan (features handsPlanBlock): his lead hand (the left for
 // her turn to the left, +1, the right for -1) rises above his head and comes down again, the other
 // stays where it was. In the recording (training.evaluation.recorded_leads) his higher hand peaks
 // above 1.6 m in 84 % of her turns (median 1.83 m; in 17 % of all frames), a third of a second
 // before the turn completes: the left hand for 60 % of her turns to the left, at (0.02, 1.80, 0.28)
 // m in his root space (x to his left, z ahead), the right hand mirrored for her turns to the right.
-// RAISE: (start, up, start down, down) in s after the request; the raise is held while she turns.
-// The plan asks 1.90 m, above the recorded 1.80: the network stops short of a planned hand (a
-// median 1.76 m asked for 1.90; asked for 1.80 and held to 1.6 s, his hand passed 1.6 m in 61 % of
-// requests, for 1.90 and 1.8 s in 80 %). In the recording the hand also circles the way she turns;
-// a planned circle (12 or 25 cm) left his hand's path as it was, so the plan holds none
-// (docs/results.md, "The hands plan").
+// RAISE: (up, down) in s: his hand goes up over the figure's first `up` seconds, is held until the
+// figure ends and comes down over `down` after it. The plan asks 1.90 m, above the recorded 1.80:
+// the network stops short of a planned hand (a median 1.76 m asked for 1.90). In the recording the
+// hand also circles the way she turns; a planned circle (12 or 25 cm) left his hand's path as it
+// was, so the plan holds none (docs/results.md, "The hands plan").
 export const LEAD_HAND_RAISED: readonly number[] = [0.02, 1.9, 0.28]; // m, the left hand, root space
-export const RAISE: readonly number[] = [0.1, 0.5, 1.8, 2.3]; // s
-// The request also bends his planned path (leadPlan): it turns LEAD_TURN her way and moves
-// LEAD_SIDE to his other side (his right for her turn to the left), eased as her planned turn. The
-// recorded leader turns with her (over the 2.5 s from 1.7 s before her turn completes, his facing
-// goes her way by a median 38 degrees, quartiles -103 and +205), and she reads the way from his
-// body over the second before her turn. With
-// his plan left as it was she turned the asked way after 32 % of requests; turned 90 degrees and
-// moved 0.6 m aside, 48 % (the other amounts tried: training/mirror/rollout.py); he turns a median
-// 121 degrees her way over a request.
+export const RAISE: readonly number[] = [0.4, 0.5]; // s
+// A figure also bends his planned path (leadPlan): it turns LEAD_TURN her way and moves LEAD_SIDE
+// to his other side (his right for her turn to the left), eased as her planned turn. The recorded
+// leader turns with her (over the 2.5 s from 1.7 s before her turn completes, his facing goes her
+// way by a median 38 degrees, quartiles -103 and +205), and she reads the way from his body over
+// the second before her turn. With his plan left as it was she turned the asked way after 32 % of
+// requests; turned 90 degrees and moved 0.6 m aside, 48 % (the other amounts tried:
+// training/mirror/rollout.py).
 export const LEAD_TURN = 90; // degrees
 export const LEAD_SIDE = 0.6; // m
 
@@ -318,23 +321,23 @@ export function steerPlan(leader: Dancer, steering: Steering, stickX: number, st
 }
 
 /**
- * While a request runs, bend the leader's planned path (after steerPlan) so that it leads her
- * turn's way: from now to each future key it turns LEAD_TURN degrees and moves LEAD_SIDE metres
- * to his other side, times the share of her planned turn made between them.
+ * While a figure is danced or about to be, bend the leader's planned path (after steerPlan) so
+ * that it leads her turn's way: from now to each future key it turns LEAD_TURN degrees and moves
+ * LEAD_SIDE metres to his other side, times the share of her turn planned between them.
  */
 export function leadPlan(duet: Duet): void {
-  const r = duet.request;
-  if (!r) return;
   const t = duet.leader.track;
-  const now = r.frame / FPS;
   const h = t.heading[NOW];
   const leftX = Math.cos(h); // his root space's +x on the floor
   const leftZ = -Math.sin(h);
-  for (const off of FUTURE_OFFSETS) {
-    const share = plannedTurn(now + off / FPS) - plannedTurn(now);
-    t.heading[NOW + off] += r.direction * ((LEAD_TURN * Math.PI) / 180) * share;
-    t.root[2 * (NOW + off)] -= r.direction * LEAD_SIDE * share * leftX;
-    t.root[2 * (NOW + off) + 1] -= r.direction * LEAD_SIDE * share * leftZ;
+  for (const led of duet.figures.led) {
+    for (const off of FUTURE_OFFSETS) {
+      const share = figureShare(led, duet.frame + off) - figureShare(led, duet.frame);
+      if (!share) continue;
+      t.heading[NOW + off] += led.way * ((LEAD_TURN * Math.PI) / 180) * share;
+      t.root[2 * (NOW + off)] -= led.way * LEAD_SIDE * share * leftX;
+      t.root[2 * (NOW + off) + 1] -= led.way * LEAD_SIDE * share * leftZ;
+    }
   }
 }
 
@@ -393,42 +396,108 @@ export function keepClose(follower: Dancer, leader: Dancer): boolean {
 }
 
 /**
- * The visitor asked the leader to lead the partner's turn: +1 counterclockwise seen from above
- * (her left), -1 clockwise; `frame` counts the steps since the request; `hands`: his hands (left,
- * right; [2 × 3]) where they were at the request, in his root space.
+ * One figure the leader leads: her turn to her left (way +1, counterclockwise seen from above) or
+ * to her right (-1), from duet frame `start` to `end` (both danced); `asked` when the visitor asked
+ * for it; `hands`: his hands (left, right; [2 × 3]) in his root space when his plan for it began.
  */
-export interface TurnRequest {
-  direction: number;
-  frame: number;
-  hands: Float64Array;
+export interface Led {
+  way: number;
+  start: number;
+  end: number;
+  asked: boolean;
+  hands: Float64Array | null;
 }
 
-/** Full turns the partner is planned to have made `seconds` after a request (smoothstep). */
-export function plannedTurn(seconds: number): number {
-  const u = Math.min(1, Math.max(0, (seconds - TURN_START) / TURN_SECONDS));
+/**
+ * The figures of a duet: those danced and planned, in time order, and whether the leader leads his
+ * own (`own`; the page's ?figures=0 turns them off) with `rng` (uniform in [0, 1)) drawing when and
+ * which.
+ */
+export class Figures {
+  led: Led[] = [];
+  /** spans()'s array, reused: the page's step allocates nothing. */
+  private readonly spanned: number[] = [];
+
+  constructor(public own: boolean, public rng: () => number) {}
+
+  /** The figure danced at `frame`, or null. */
+  at(frame: number): Led | null {
+    return this.led.find((f) => f.start <= frame && frame <= f.end) ?? null;
+  }
+
+  /** (way, start, end) of every figure, flat, in the frames of a track whose NOW is `frame` (a
+   *  shared array, overwritten by the next call). */
+  spans(frame: number): number[] {
+    const out = this.spanned;
+    out.length = 0;
+    for (const f of this.led) out.push(f.way, f.start - frame + NOW, f.end - frame + NOW);
+    return out;
+  }
+}
+
+/** Frames from `atFrame` until the count reaches `beat` (the count runs on one step a frame). */
+export function framesToBeat(duet: Duet, atFrame: number, beat: number): number {
+  const now = duet.beat + (atFrame - duet.frame) * beatsPerStep(duet.tempo);
+  return atFrame + Math.max(0, Math.ceil((beat - now) / beatsPerStep(duet.tempo) - 1e-9));
+}
+
+/** A figure of `way` starting at the first whole beat of the count at or after `frame`. */
+export function figureFrom(duet: Duet, frame: number, way: number, asked: boolean): Led {
+  const per = beatsPerStep(duet.tempo);
+  const beat = duet.beat + (frame - duet.frame) * per;
+  const start = framesToBeat(duet, frame, Math.ceil(beat - 1e-9));
+  return { way: way >= 0 ? 1 : -1, start, end: start + Math.round(FIGURE_BEATS / per), asked, hands: null };
+}
+
+/**
+ * The visitor asks the leader to lead her turn (+1 to her left, -1 to her right): it starts on the
+ * next beat, or after the figure running ends; it takes the place of a figure not begun.
+ */
+export function askTurn(duet: Duet, direction: number): void {
+  const f = duet.figures;
+  f.led = f.led.filter((x) => x.start <= duet.frame);
+  const after = Math.max(duet.frame, ...f.led.map((x) => x.end + 1));
+  f.led.push(figureFrom(duet, after, direction, true));
+}
+
+/**
+ * Each step: forget figures out of the past second, and with `own`, plan his next figure
+ * OWN_GAP_BEATS after the last (or after the start) once none is running or planned.
+ */
+export function planFigures(duet: Duet): void {
+  const f = duet.figures;
+  if (f.led.some((x) => x.end < duet.frame - HISTORY)) f.led = f.led.filter((x) => x.end >= duet.frame - HISTORY);
+  if (!f.own || f.led.some((x) => x.end >= duet.frame)) return;
+  const last = f.led.length ? Math.max(...f.led.map((x) => x.end + 1)) : duet.frame;
+  // Two uniform draws, in this order (as Python's): the wait, then the way.
+  const gap = OWN_GAP_BEATS[0] + (OWN_GAP_BEATS[1] - OWN_GAP_BEATS[0]) * f.rng();
+  const way = f.rng() < 0.5 ? 1 : -1;
+  const start = framesToBeat(duet, last, duet.beat + (last - duet.frame) * beatsPerStep(duet.tempo) + gap);
+  f.led.push(figureFrom(duet, Math.max(start, duet.frame + 1), way, false));
+}
+
+/** How much of her turn is planned done at `frame`, 0 to 1 (smoothstep over the figure). */
+export function figureShare(led: Led, frame: number): number {
+  const u = Math.min(1, Math.max(0, (frame - led.start) / Math.max(led.end - led.start, 1)));
   return u * u * (3 - 2 * u);
 }
 
-const figureKeys = new Float64Array(KEYS);
-
-/**
- * The leader's figure keys [KEYS] for a request (null: nobody asks): how far the partner is to
- * turn from now to each future key, in full turns, signed by the direction. A shared scratch array.
- */
-export function figureInput(request: TurnRequest | null): Float64Array | null {
-  if (!request) return null;
-  const now = request.frame / FPS;
-  for (let k = 0; k < KEYS; k++) {
-    figureKeys[k] = request.direction * (plannedTurn(now + FUTURE_OFFSETS[k] / FPS) - plannedTurn(now));
-  }
-  return figureKeys;
+/** How far his lead hand is raised for `led` at `frame`, 0 to 1 (smoothsteps up and down). */
+export function raised(led: Led, frame: number): number {
+  const up = Math.min(1, Math.max(0, (frame - led.start) / (RAISE[0] * FPS)));
+  const down = Math.min(1, Math.max(0, (frame - led.end) / (RAISE[1] * FPS)));
+  return up * up * (3 - 2 * up) * (1 - down * down * (3 - 2 * down));
 }
 
-/** How far his lead hand is raised `seconds` after a request, 0 to 1 (smoothsteps up and down). */
-export function raised(seconds: number): number {
-  const up = Math.min(1, Math.max(0, (seconds - RAISE[0]) / (RAISE[1] - RAISE[0])));
-  const down = Math.min(1, Math.max(0, (seconds - RAISE[2]) / (RAISE[3] - RAISE[2])));
-  return up * up * (3 - 2 * up) * (1 - down * down * (3 - 2 * down));
+/**
+ * The figure his hands plan is for: the one danced now or beginning within the next second, else
+ * one whose raise is coming down. A figure that follows another at once takes the plan over as
+ * soon as the one before ends.
+ */
+export function planning(duet: Duet): Led | null {
+  const lowering = Math.trunc(RAISE[1] * FPS);
+  const near = duet.figures.led.filter((x) => x.start - HISTORY <= duet.frame && duet.frame <= x.end + lowering);
+  return near.find((x) => x.end >= duet.frame) ?? near[0] ?? null;
 }
 
 const HANDS_MOVES = KEYS * HANDS.length * 3;
@@ -446,19 +515,20 @@ function handsInRootSpace(leader: Dancer, out: Float64Array): void {
 }
 
 /**
- * The leader's hands plan [KEYS × 2 × 3] for a request (null: nobody asks): from where his hands
+ * The leader's hands plan [KEYS × 2 × 3] for the figure he plans (null: none): from where his hands
  * are now to where the raise puts them at each future key, in his root space. A shared scratch array.
  */
-export function handsInput(request: TurnRequest | null, leader: Dancer): Float64Array | null {
-  if (!request) return null;
-  const now = request.frame / FPS;
-  const lead = request.direction > 0 ? 0 : 1;
-  handsInRootSpace(leader, handsNow);
+export function handsInput(duet: Duet): Float64Array | null {
+  const led = planning(duet);
+  if (!led) return null;
+  handsInRootSpace(duet.leader, handsNow);
+  led.hands ??= Float64Array.from(handsNow);
+  const lead = led.way > 0 ? 0 : 1;
   for (let k = 0; k < KEYS; k++) {
-    const u = raised(now + FUTURE_OFFSETS[k] / FPS);
+    const u = raised(led, duet.frame + FUTURE_OFFSETS[k]);
     for (let h = 0; h < HANDS.length; h++) {
       for (let c = 0; c < 3; c++) {
-        const from = request.hands[3 * h + c];
+        const from = led.hands[3 * h + c];
         let to = from;
         if (h === lead) {
           const top = c === 0 ? (lead === 0 ? 1 : -1) * LEAD_HAND_RAISED[0] : LEAD_HAND_RAISED[c];
@@ -471,13 +541,6 @@ export function handsInput(request: TurnRequest | null, leader: Dancer): Float64
   return handsMoves;
 }
 
-/** Ask the leader to lead the partner's turn now (a request still running starts anew). */
-export function askTurn(duet: Duet, direction: number): void {
-  const hands = new Float64Array(HANDS.length * 3);
-  handsInRootSpace(duet.leader, hands);
-  duet.request = { direction: direction >= 0 ? 1 : -1, frame: 0, hands };
-}
-
 export interface Duet {
   leader: Dancer;
   /** One, or two in compare mode; the leader reacts to the first. */
@@ -485,8 +548,8 @@ export interface Duet {
   startPose: { leader: StartPose; follower: StartPose };
   steering: Steering;
   frame: number;
-  /** A turn the visitor asked the leader to lead, while it runs; null otherwise. */
-  request: TurnRequest | null;
+  /** The figures led: the visitor's and his own (Figures). */
+  figures: Figures;
   /**
    * The music both dancers hear (web/mirror/music.ts): its tempo (beats a minute) and the count now
    * (beats since it started). finishStep moves the count on by one step of the tempo; the page sets
@@ -531,9 +594,12 @@ function isStartPose(value: unknown): value is StartPose {
 
 /**
  * Both partners standing still, 0.8 m apart and facing each other (leader at the origin facing +Z),
- * the music at `tempo` beats a minute (null: the manifest's) and its count at 0.
+ * the music at `tempo` beats a minute (null: the manifest's) and its count at 0; with `figures` the
+ * leader leads figures of his own, drawn by `random` (uniform in [0, 1): the page's seeded one).
  */
-export function startDuet(manifest: DuetManifest, followerCount = 1, tempo: number | null = null): Duet {
+export function startDuet(
+  manifest: DuetManifest, followerCount = 1, tempo: number | null = null, figures = true, random: () => number = createUniform(0),
+): Duet {
   const bpm = tempo ?? manifestTempo(manifest);
   if (!Number.isFinite(bpm) || bpm <= 0) throw new Error(`tempo must be a positive number of beats a minute, got ${tempo}`);
   const offsets = manifest.skeleton.offsets;
@@ -545,22 +611,26 @@ export function startDuet(manifest: DuetManifest, followerCount = 1, tempo: numb
   const leader = startDancer(offsets.leader.flat(), startPose.leader, 0, 0, 0);
   const followers = Array.from({ length: followerCount }, () =>
     startDancer(offsets.follower.flat(), startPose.follower, 0, START_DISTANCE, Math.PI));
-  const duet: Duet = { leader, followers, startPose, steering: new Steering(), frame: 0, request: null, tempo: bpm, beat: 0 };
+  const duet: Duet = {
+    leader, followers, startPose, steering: new Steering(), frame: 0, figures: new Figures(figures, random), tempo: bpm, beat: 0,
+  };
   setAnchor(duet);
   return duet;
 }
 
+const figureNow = new Float64Array(FIGURE_SIZE);
+
 /**
- * Both models' inputs at NOW: the leader's (partner = first follower) and each follower's. The
- * followers' never hold the request: they read the leader.
+ * Both models' inputs at NOW: the leader's (partner = first follower) and each follower's. All read
+ * the figure being led (what her hand feels); only his hands plan says where his hands go.
  */
 export function stepInputs(duet: Duet, leaderOut: Out | null, followerOuts: Out[]): void {
+  figureBlock(duet.figures.spans(duet.frame), NOW, figureNow, 0);
   const heard = musicInput(duet);
   if (leaderOut) {
-    leaderInput(duet.followers[0].track, duet.leader.track, NOW, leaderOut, 0, figureInput(duet.request),
-      handsInput(duet.request, duet.leader), heard);
+    leaderInput(duet.followers[0].track, duet.leader.track, NOW, leaderOut, 0, figureNow, handsInput(duet), heard);
   }
-  duet.followers.forEach((f, i) => followerInput(duet.leader.track, f.track, NOW, followerOuts[i], 0, heard));
+  duet.followers.forEach((f, i) => followerInput(duet.leader.track, f.track, NOW, followerOuts[i], 0, figureNow, heard));
 }
 
 const heardNow = new Float64Array(MUSIC_SIZE);
@@ -609,11 +679,6 @@ export function finishStep(
       fromRootSpacePoints(intentionLocal, 0, KEYS * KEY_JOINTS.length, f.rootX, f.rootZ, f.heading, f.intention, 0);
     }
   });
-  // After both dancers, as Python's finish_step: the request's clock, ended after REQUEST_SECONDS.
-  if (duet.request) {
-    duet.request.frame += 1;
-    if (duet.request.frame >= REQUEST_SECONDS * FPS) duet.request = null;
-  }
   duet.frame += 1;
   duet.beat += beatsPerStep(duet.tempo);
 }

@@ -1,6 +1,10 @@
 // The count for people learning: "1 2 3 · 5 6 7 ·" under the title, the count the dance is on
 // lit. Salsa steps on 1-2-3 and 5-6-7 and holds on 4 and 8 (shown as dots). It shows the count
-// of the step on screen, the music's while it plays.
+// of the step on screen, the music's while it plays. After it, the figure the leader leads:
+// "her turn ←" (to her left) or "her turn →" (to her right), faint from when it is planned and lit
+// while it is danced, so a visitor sees a turn coming on the count; on a phone only the arrow.
+
+import type { FigureView } from '../engine/types';
 
 const MARKS = ['1', '2', '3', '·', '5', '6', '7', '·'];
 
@@ -9,10 +13,19 @@ export function countOf(beat: number): number {
   return ((Math.floor(beat + 1e-6) % 8) + 8) % 8;
 }
 
+/** The arrow of a figure's way: her left (+1) ←, her right (-1) →. */
+export function figureArrow(way: number): string {
+  return way > 0 ? '←' : '→';
+}
+
 export class CountDisplay {
   readonly element: HTMLElement;
   private readonly marks: HTMLElement[];
+  private readonly figure: HTMLElement;
+  private readonly arrow: Text;
   private lit = -1;
+  /** The figure shown (by identity: the simulation's view is the same object while unchanged). */
+  private shown: FigureView | null = null;
 
   constructor(parent: HTMLElement) {
     this.element = document.createElement('div');
@@ -24,14 +37,29 @@ export class CountDisplay {
       this.element.append(span);
       return span;
     });
+    // Its place is kept while no figure is planned (hidden, not removed): the line never moves.
+    this.figure = document.createElement('span');
+    this.figure.className = 'count-figure';
+    const word = document.createElement('span');
+    word.className = 'count-figure-word';
+    word.textContent = 'her turn ';
+    this.arrow = document.createTextNode(figureArrow(1));
+    this.figure.append(word, this.arrow);
+    this.element.append(this.figure);
     parent.append(this.element);
   }
 
-  show(beat: number): void {
+  show(beat: number, figure: FigureView | null = null): void {
     const n = countOf(beat);
-    if (n === this.lit) return;
-    this.marks[this.lit]?.classList.remove('on');
-    this.marks[n].classList.add('on');
-    this.lit = n;
+    if (n !== this.lit) {
+      this.marks[this.lit]?.classList.remove('on');
+      this.marks[n].classList.add('on');
+      this.lit = n;
+    }
+    if (figure === this.shown) return;
+    this.shown = figure;
+    this.figure.classList.toggle('planned', figure !== null);
+    this.figure.classList.toggle('on', figure !== null && !figure.coming);
+    if (figure) this.arrow.data = figureArrow(figure.way);
   }
 }

@@ -6,7 +6,7 @@
 // never changes the dance.
 
 import './style.css';
-import type { CreateSimulation, DancerView, DuetHook, FollowerChoice, Manifest, Simulation } from '../engine/types';
+import type { CreateSimulation, DancerView, DuetHook, FigureHook, FigureView, FollowerChoice, Manifest, Simulation } from '../engine/types';
 import type { Policy } from '../engine/policy';
 import { DuetError, checkBrowserSupport, installGlobalErrorHandlers, showError } from './errors';
 import { loadManifest } from '../engine/manifest';
@@ -88,12 +88,19 @@ const hook: DuetHook = {
   modelBytes: 0,
   firstFrameMs: null,
   hold: 0,
+  figure: null,
   bootTimings,
   recovered: restartsSoFar(),
 };
 window.duet = hook;
 
 installGlobalErrorHandlers();
+
+/** The hook's figure for the simulation's: only one being danced (a coming one is not yet). */
+function figureHook(figure: FigureView | null): FigureHook | null {
+  if (!figure || figure.coming) return null;
+  return { name: 'her_turn', way: figure.way > 0 ? 'left' : 'right', asked: figure.asked };
+}
 
 function publish(target: DuetHook['leader'], view: DancerView): void {
   target.root[0] = view.root[0];
@@ -164,6 +171,8 @@ class Page {
   private cameraPlace = '';
   private cameraStill = 0;
   private cameraCheck = 0;
+  /** The simulation's figure the hook's was made from (it keeps its object while unchanged). */
+  private hookedFigure: FigureView | null = null;
 
   // Set once the runtime has loaded.
   private createSimulation: CreateSimulation | null = null;
@@ -300,6 +309,9 @@ class Page {
       onGhosts: () => this.exclusive(() => this.refreshGhosts()).catch(this.fail),
       onTempo: (bpm) => this.music.setTempo(bpm),
       onMusic: (on) => this.music.setEnabled(on),
+      onFigures: (on) => this.exclusive(() => {
+        if (this.simulation) this.simulation.ownFigures = on;
+      }).catch(this.fail),
       onReset: () => this.reset(),
       onResetView: () => this.resetView(),
       onShare: () => this.share(),
@@ -352,6 +364,11 @@ class Page {
     hook.hold = hands ? Math.max(hands[0], hands[1]) : 0;
     timed = simulation;
     hook.turnAsked = simulation.turnAsked;
+    const figure = simulation.figure;
+    if (figure !== this.hookedFigure) {
+      this.hookedFigure = figure;
+      hook.figure = figureHook(figure);
+    }
     // Copied into the hook's own pair: no array made per frame.
     const anchor = simulation.anchor;
     hook.anchor ??= [0, 0];
@@ -361,8 +378,9 @@ class Page {
   }
 
   /**
-   * Ask the leader to lead the partner's turn (T, Shift+T, the turn buttons): his model reads
-   * the request; she only reads him. A leader dancing a file leads nothing, and says so.
+   * Ask the leader to lead her turn (T, Shift+T, the turn buttons): on the next beat, or after the
+   * figure running, both dancers read it (the figure block: what the joined hands carry), her body
+   * and timing are her network's. A leader dancing a file leads nothing, and says so.
    */
   private askTurn(direction: number): boolean {
     const simulation = this.simulation;
@@ -463,7 +481,9 @@ class Page {
     return this.exclusive(async () => {
       this.hud.setStatus('loading the dancers…');
       const [leaderPolicy, ...followerPolicies] = await Promise.all([this.policy('leader'), ...FOLLOWER_MODELS[choice].map((n) => this.policy(n))]);
-      this.simulation = this.createSimulation!({ manifest: this.manifest, leader: leaderPolicy, followers: followerPolicies, seed: this.settings.seed });
+      this.simulation = this.createSimulation!({
+        manifest: this.manifest, leader: leaderPolicy, followers: followerPolicies, seed: this.settings.seed, figures: this.settings.figures,
+      });
       this.applyLeaderFile(); // a new simulation keeps the leader's file
       hook.model = choice;
       this.compare.setActive(this.stage, choice === 'compare');
@@ -568,7 +588,7 @@ class Page {
       if (performance.now() - began > Math.max(MIN_STEP_BUDGET_MS, this.drawMs)) break;
     }
     if (steps > 0) this.recordPanel.update();
-    if (steps > 0 && this.simulation) this.count.show(this.simulation.beat);
+    if (steps > 0 && this.simulation) this.count.show(this.simulation.beat, this.simulation.figure);
     this.steppedMs += performance.now() - began;
   }
 

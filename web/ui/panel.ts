@@ -19,6 +19,8 @@ export interface PanelOptions {
   /** The music's tempo changed (beats a minute), or it was muted / switched on. */
   onTempo(bpm: number): void;
   onMusic(on: boolean): void;
+  /** The leader's own figures were switched on or off. */
+  onFigures(on: boolean): void;
   onReset(): void;
   onResetView(): void;
   onShare(): void;
@@ -56,6 +58,7 @@ export const CONTROLS = {
   temperature: ['variety', 'Low: the partner always makes its most likely move; high: it picks more varied, sometimes wilder moves.'],
   tempo: ['tempo', `The music’s beats a minute (${LIMITS.tempo[0]}-${LIMITS.tempo[1]}); both dancers hear it and dance on its count.`],
   music: ['music', 'Plays the salsa band (from your first key or tap); off, the dance keeps its count in silence.'],
+  figures: ['his own turns', 'On: your dancer also leads her turn now and then by himself, every few bars; off: only the turns you ask for (T, Shift+T). The count shows the turn coming.'],
   ghosts: ['possible reactions', `Up to ${LIMITS.ghosts[1]} faint partners, one colour each: copies of her that branched off within the last second and dance on with moves of their own.`],
   trajectories: ['floor paths', "Each dancer's path on the floor, a second ahead."],
   intentions: ['show what the partner expects', "Purple lines: where the partner expects your head, hands and feet to go over the next second."],
@@ -82,6 +85,7 @@ export const BRIEF: readonly (readonly [string, string])[] = [
   ['drag · wheel · 2 fingers', 'Move the camera; a double tap brings both dancers back.'],
   ['pause (Space)', 'Holds the dance, or lets it go on.'],
   ['R- · L-hand turn (T, Shift+T)', 'He raises that hand and turns, leading her turn that way; she mostly follows the way.'],
+  ['his own turns', 'He leads some himself too; off: only yours.'],
   ['● clip · corners', `Save a ${CLIP_SECONDS} s video · full screen.`],
   ['partner', 'Reads your intention, a baseline that does not, or both side by side.'],
   ['variety', 'Low: her likeliest move; high: wilder ones.'],
@@ -118,6 +122,7 @@ export class Panel {
     this.gui.add(settings, 'temperature', ...LIMITS.temperature, 0.05).name(label('temperature'));
     this.gui.add(settings, 'tempo', ...LIMITS.tempo, 1).name(label('tempo')).onChange((bpm: number) => options.onTempo(bpm));
     this.gui.add(settings, 'music').name(label('music')).onChange((on: boolean) => options.onMusic(on));
+    this.gui.add(settings, 'figures').name(label('figures')).onChange((on: boolean) => options.onFigures(on));
     this.gui.add(settings, 'ghosts', ...LIMITS.ghosts, 1).name(label('ghosts')).onChange((k: number) => options.onGhosts(k));
     this.gui.add(settings, 'trajectories').name(label('trajectories'));
     this.gui.add(settings, 'intentions').name(label('intentions'));

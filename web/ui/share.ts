@@ -1,5 +1,5 @@
 // Settings <-> URL query, so a link reproduces what someone saw: follower model, temperature,
-// sampling seed, camera, and the view options. Every value from the URL is parsed, validated and
+// sampling seed, camera, the music, the leader's own figures, and the view options. Every value from the URL is parsed, validated and
 // clamped here; nothing from it ever reaches the page as markup. The page writes the settings into
 // its own address as they change (addressQuery), so the address bar is always such a link.
 
@@ -20,6 +20,8 @@ export interface Settings {
   tempo: number;
   /** Whether the page plays the music (muted: the dance keeps its silent count). */
   music: boolean;
+  /** Whether the leader leads figures of his own (off: only the turns the visitor asks for). */
+  figures: boolean;
   trajectories: boolean;
   intentions: boolean;
   /** The thin bones over the shaded bodies. */
@@ -41,7 +43,7 @@ export const LIMITS = {
 } as const;
 
 /** The query keys the settings own; addressQuery replaces these and keeps any other. */
-const KEYS = ['model', 'temperature', 'seed', 'camera', 'ghosts', 'speed', 'tempo', 'music', 'trajectories', 'intentions', 'skeleton'];
+const KEYS = ['model', 'temperature', 'seed', 'camera', 'ghosts', 'speed', 'tempo', 'music', 'figures', 'trajectories', 'intentions', 'skeleton'];
 
 const MODELS: readonly FollowerChoice[] = ['ours', 'ccm', 'compare'];
 
@@ -55,6 +57,7 @@ export function defaultSettings(defaultTemperature: number, defaultTempo: number
     speed: 1,
     tempo: clamp(defaultTempo, LIMITS.tempo),
     music: true,
+    figures: true,
     trajectories: true,
     intentions: false,
     skeleton: false,
@@ -73,6 +76,7 @@ export function readSettings(search: string, defaults: Settings): Settings {
   settings.speed = readNumber(query.get('speed'), LIMITS.speed, settings.speed);
   settings.tempo = readNumber(query.get('tempo'), LIMITS.tempo, settings.tempo);
   settings.music = readBoolean(query.get('music'), settings.music);
+  settings.figures = readBoolean(query.get('figures'), settings.figures);
   settings.trajectories = readBoolean(query.get('trajectories'), settings.trajectories);
   settings.intentions = readBoolean(query.get('intentions'), settings.intentions);
   settings.skeleton = readBoolean(query.get('skeleton'), settings.skeleton);
@@ -95,6 +99,7 @@ export function writeSettings(settings: Settings, camera: CameraOrbit | null, de
   if (settings.speed !== 1) query.set('speed', round(settings.speed, 2));
   if (settings.tempo !== defaultTempo) query.set('tempo', round(settings.tempo, 1));
   if (!settings.music) query.set('music', '0');
+  if (!settings.figures) query.set('figures', '0');
   if (!settings.trajectories) query.set('trajectories', '0');
   if (settings.intentions) query.set('intentions', '1');
   if (settings.skeleton) query.set('skeleton', '1');

@@ -1,9 +1,11 @@
 // "Lead a turn": the two buttons beside pause (a phone has no T key). Each asks the leader model
-// to lead the partner's turn now (Simulation.askTurn): he raises his right hand over her (T) or
-// his left (Shift+T), and turns with her that way (rollout lead_plan). The follower is never
-// told: she turns only if she reads it in his motion, and most of her turns after a request go the
-// asked way (78 %: docs/results.md, "Which way she turns"), so the buttons name the hand and her
-// way. On a phone the word "hand" folds away (one row of buttons: style.css).
+// to lead her turn on the next beat, or after the figure running (Simulation.askTurn): he raises
+// his right hand over her (T) or his left (Shift+T), and turns with her that way (rollout
+// leadPlan). She is told only what her hand would feel (the figure being led, which both dancers
+// read): her body and timing are her network's, and most of her turns after a request go the asked
+// way (78 %: docs/results.md, "Which way she turns"), so the buttons name the hand and her way.
+// A button stays marked while the turn it asked for is planned or danced. On a phone the word
+// "hand" folds away (one row of buttons: style.css).
 
 /** [direction for Simulation.askTurn, hand letter, hand, key]. */
 const TURNS = [
