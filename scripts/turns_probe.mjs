@@ -1,42 +1,45 @@
-// Leading a turn in the page: for each seed, the duet dances 4 s with nobody steering, then the
-// leader is asked to lead a turn (askTurn, +1 counterclockwise seen from above on odd seeds, −1 on
-// even ones), and the follower's facing is recorded at every simulation step (1/30 s) for 2.5 s;
-// the same seed without any request is the control. A turn counts when her facing has changed by
-// 300° or more in the asked direction within those 2.5 s. Prints a table and the totals.
+// Leading a turn in the page, counted as `python -m training.evaluation.lead` counts it: for each
+// seed the duet dances with nobody steering and without his own figures (?figures=0), and is asked
+// for her turn 3 s and 10 s into the dance (her right, then her left, on even seeds: T then Shift+T;
+// the other order on odd ones); every step is recorded to 4 s after the second request, and the
+// same seed never asked is the control. A request works when she completes a turn (figures.turns
+// on her facing: 300° within 2.5 s, tests/e2e/turns.mjs `followerTurns`) within REQUEST_SECONDS of
+// dance after it; the control's same windows say how often she turns unasked. Also counted: his
+// higher hand above 1.6 m within those seconds. Prints a row per request and the totals.
 //
-// Run: node scripts/turns_probe.mjs [seeds, default 1-10] (dev server, headless Chromium, 1280×800)
-// Environment: DUET_TURN_SPEED=1..4 runs the page's speed setting (default 2: the steps, and so the
-// dance, are the same at any speed; only the wall time differs). DUET_TURN_JSON=path writes every
-// step's facing there. DUET_TURN_FLIP=1 asks the other way (−1 on odd seeds, +1 on even ones).
-// The page is reached through tests/e2e/turns.mjs (see there for how askTurn is called).
+// Run: node scripts/turns_probe.mjs [seeds, default 0-19] (dev server, headless Chromium, 1280×800)
+// Environment: DUET_TURN_SPEED=1..4 runs the page's speed setting (default 1, so that the probe is
+// armed before the first request at 3 s; the steps, and so the dance, are the same at any speed;
+// only the wall time differs). DUET_TURN_JSON=path writes the rows.
 
-import { readFileSync, writeFileSync } from 'node:fs';
-import { join } from 'node:path';
-import { ROOT, launch, startServer, waitReady } from '../tests/e2e/harness.mjs';
-import { FPS, Reloaded, armProbe, followerTurn, leaderDivergence, leaderHand, readProbe, unwrap } from '../tests/e2e/turns.mjs';
+import { writeFileSync } from 'node:fs';
+import { QUICK, launch, startServer, waitReady } from '../tests/e2e/harness.mjs';
+import { FPS, Reloaded, armProbe, followerTurns, leaderHand, readProbe } from '../tests/e2e/turns.mjs';
 
-const SEEDS = (process.argv[2] ?? '1,2,3,4,5,6,7,8,9,10').split(',').map(Number);
-const SPEED = Number(process.env.DUET_TURN_SPEED ?? 2);
-const FLIP = process.env.DUET_TURN_FLIP === '1';
-const ASK_AT = 4 * FPS; // 4 s of dancing
-const WINDOW = Math.round(2.5 * FPS); // 2.5 s after the request
-const READY_MS = 180_000;
-
-/** The models' fingerprints (they may be re-exported while this runs: printed before and after). */
-const fingerprints = () => Object.entries(JSON.parse(readFileSync(join(ROOT, 'public/models/manifest.json'), 'utf8')).models).map(([name, m]) => `${name} ${m.fingerprint}`).join(', ');
-const modelsBefore = fingerprints();
-console.log(`models: ${modelsBefore}; speed ${SPEED}`);
+const SEEDS = (process.argv[2] ?? Array.from({ length: 20 }, (_, i) => i).join(',')).split(',').map(Number);
+const SPEED = Number(process.env.DUET_TURN_SPEED ?? 1);
+const ASK_AT = [3 * FPS, 10 * FPS]; // lead.WARM_UP and REQUEST_EVERY
+const REQUEST_SECONDS = 4; // lead.REQUEST_SECONDS
+const WINDOW = REQUEST_SECONDS * FPS;
+const UNTIL = ASK_AT[ASK_AT.length - 1] + WINDOW;
+const HAND_RAISED = 1.6; // m (figures.HAND_RAISED)
+const READY_MS = 300_000;
 
 const server = await startServer({ mode: 'dev' });
-const browser = await launch({ viewport: { width: 1280, height: 800 } });
+const browser = await launch({ viewport: { width: 1280, height: 800 }, ...QUICK });
 const { page, consoleErrors } = browser;
 page.setDefaultTimeout(READY_MS);
 
-/** One run of a seed: `direction` 0 asks nothing. Run again when the page reloaded under it. */
-async function run(seed, direction) {
+/** One run of a seed, asked (`asks`) or not ([]); run again when the page reloaded under it. */
+async function run(seed, asks) {
   for (let attempt = 1; ; attempt++) {
     try {
-      return await runOnce(seed, direction);
+      await page.goto(`${server.url}?seed=${seed}&speed=${SPEED}&figures=0`);
+      await waitReady(page, READY_MS);
+      await armProbe(page, { asks, until: UNTIL });
+      const probe = await readProbe(page, READY_MS);
+      if (probe.steps[0]?.frame > ASK_AT[0]) throw new Error(`seed ${seed}: the recording began at step ${probe.steps[0].frame}`);
+      return probe;
     } catch (error) {
       if (!(error instanceof Reloaded) || attempt >= 4) throw error;
       console.log(`seed ${seed}: the page reloaded (someone edited it); again`);
@@ -44,74 +47,46 @@ async function run(seed, direction) {
   }
 }
 
-async function runOnce(seed, direction) {
-  // figures=0: he leads only the turn asked for, so the control leads none.
-  await page.goto(`${server.url}?seed=${seed}&speed=${SPEED}&figures=0`);
-  await waitReady(page, READY_MS);
-  await armProbe(page, { askAt: ASK_AT, direction, until: ASK_AT + WINDOW });
-  const probe = await readProbe(page, READY_MS);
-  const first = probe.steps[0]?.frame;
-  if (first === undefined || first > ASK_AT) throw new Error(`seed ${seed}: the recording began at step ${first}, after the request's step ${ASK_AT}`);
-  return probe;
-}
-
 const rows = [];
-const dump = {};
 try {
   // Warm the dev server (first compile) so the measured pages do not reload.
   await page.goto(`${server.url}?seed=1`).catch(() => undefined);
   await waitReady(page, READY_MS).catch(() => undefined);
   for (const seed of SEEDS) {
-    const direction = (seed % 2 === 1 ? 1 : -1) * (FLIP ? -1 : 1);
-    const asked = await run(seed, direction);
-    const control = await run(seed, 0);
-    const a = followerTurn(asked.steps, ASK_AT, direction);
-    const c = followerTurn(control.steps, ASK_AT, direction);
-    const cAny = Math.max(followerTurn(control.steps, ASK_AT, 1).best, followerTurn(control.steps, ASK_AT, -1).best);
-    const divergence = leaderDivergence(asked, control);
-    const before = Math.max(0, ...divergence.filter((d) => d.frame <= ASK_AT).map((d) => d.distance));
-    const firstApart = divergence.find((d) => d.frame > ASK_AT && d.distance > 0.05);
-    const within1s = Math.max(0, ...divergence.filter((d) => d.frame > ASK_AT && d.frame <= ASK_AT + FPS).map((d) => d.distance));
-    const askedSteps = asked.steps.filter((s) => s.frame > ASK_AT);
-    const leadingFor = askedSteps.filter((s) => s.turnAsked !== 0).length / FPS;
-    // His higher hand, highest within the 2.5 s, asked and not (a raised hand leads her turn).
-    const hand = Math.max(...leaderHand(asked.steps, ASK_AT));
-    const handUnasked = Math.max(...leaderHand(control.steps, ASK_AT));
-    const aAny = Math.max(a.best, followerTurn(asked.steps, ASK_AT, -direction).best);
-    rows.push({ seed, direction, a, c, aAny, cAny, before, within1s, hand, handUnasked, firstApart: firstApart ? (firstApart.frame - ASK_AT) / FPS : null, took: asked.took, leadingFor });
-    const headingDeltas = (probe) => {
-      const h = unwrap(probe.steps.filter((s) => s.frame >= ASK_AT).map((s) => s.followerHeading));
-      return h.map((v) => ((v - h[0]) * 180) / Math.PI);
-    };
-    dump[seed] = { direction, asked: a.deltas, control: c.deltas, askedHeading: headingDeltas(asked), controlHeading: headingDeltas(control), divergence, figure: asked.steps.map((s) => [s.frame, s.turnAsked, ...s.figure.map((v) => +v.toFixed(3))]) };
-    const r = rows[rows.length - 1];
-    console.log(
-      `seed ${seed} dir ${direction > 0 ? '+1 ccw' : '-1 cw '}: asked ${a.turned ? `yes ${a.at.toFixed(2)} s` : 'no'} (best ${a.best.toFixed(0)}°, net ${a.net.toFixed(0)}°), ` +
-        `unasked ${c.turned ? `yes ${c.at.toFixed(2)} s` : 'no'} (best ${c.best.toFixed(0)}° that way, ${cAny.toFixed(0)}° any way, net ${c.net.toFixed(0)}°); ` +
-        `leader apart before ${r.before.toFixed(4)} m, within 1 s ${within1s.toFixed(2)} m, > 5 cm after ${r.firstApart ?? '-'} s; ` +
-        `his hand up to ${hand.toFixed(2)} m (unasked ${handUnasked.toFixed(2)} m); took ${asked.took} via ${asked.via}, request held ${leadingFor.toFixed(2)} s`,
-    );
+    const ways = seed % 2 === 0 ? [-1, 1] : [1, -1];
+    const asks = ASK_AT.map((at, i) => ({ at, direction: ways[i] }));
+    const asked = await run(seed, asks);
+    const control = await run(seed, []);
+    for (const { at, direction } of asks) {
+      const a = followerTurns(asked.steps, at, WINDOW);
+      const c = followerTurns(control.steps, at, WINDOW);
+      const hand = Math.max(...leaderHand(asked.steps, at).slice(0, WINDOW + 1));
+      const handUnasked = Math.max(...leaderHand(control.steps, at).slice(0, WINDOW + 1));
+      const row = {
+        seed, at: at / FPS, direction, turned: a.length > 0, thatWay: a.some(([, d]) => d === direction), first: a[0]?.[0] ?? null,
+        turnedUnasked: c.length > 0, hand, handUnasked, took: asks.every((x) => asked.asks.find((y) => y.at === x.at)?.took),
+      };
+      rows.push(row);
+      console.log(
+        `seed ${seed} at ${row.at} s, her ${direction > 0 ? 'left ' : 'right'}: asked ${row.thatWay ? `the asked way, ${row.first.toFixed(2)} s` : row.turned ? 'the other way' : 'no turn'}, ` +
+          `unasked ${row.turnedUnasked ? 'turned' : 'no turn'}; his hand up to ${hand.toFixed(2)} m (unasked ${handUnasked.toFixed(2)} m)`,
+      );
+    }
   }
 } finally {
   await browser.close();
   await server.stop();
 }
 
-const yn = (t) => (t.turned ? `yes, ${t.at.toFixed(2)} s` : 'no');
-console.log('\n| seed | direction | turned asked | asked: most / net that way | asked, most either way | turned unasked | unasked: most / net that way | unasked, most either way | his hand highest, asked / unasked |');
-console.log('|---|---|---|---|---|---|---|---|---|');
-for (const r of rows) {
-  const d = r.direction;
-  console.log(
-    `| ${r.seed} | ${d > 0 ? '+1 (ccw)' : '−1 (cw)'} | ${yn(r.a)} | ${r.a.best.toFixed(0)}° / ${(d * r.a.net).toFixed(0)}° | ${r.aAny.toFixed(0)}° | ${yn(r.c)} | ${r.c.best.toFixed(0)}° / ${(d * r.c.net).toFixed(0)}° | ${r.cAny.toFixed(0)}° | ${r.hand.toFixed(2)} / ${r.handUnasked.toFixed(2)} m |`,
-  );
-}
-const askedTurned = rows.filter((r) => r.a.turned).length;
-const unaskedTurned = rows.filter((r) => r.c.turned).length;
-console.log(`\nasked: turned ${askedTurned} of ${rows.length}; unasked: turned ${unaskedTurned} of ${rows.length} (≥ 300° in the asked direction within 2.5 s)`);
-console.log(`either direction: asked ${rows.filter((r) => r.aAny >= 300).length} of ${rows.length}, unasked ${rows.filter((r) => r.cAny >= 300).length} of ${rows.length}`);
-console.log(`his hand above 1.6 m: asked ${rows.filter((r) => r.hand > 1.6).length} of ${rows.length}, unasked ${rows.filter((r) => r.handUnasked > 1.6).length} of ${rows.length}`);
-const modelsAfter = fingerprints();
-if (modelsAfter !== modelsBefore) console.log(`the models changed during the run: now ${modelsAfter}`);
+const share = (f) => `${Math.round((100 * rows.filter(f).length) / rows.length)} %`;
+const way = (d) => {
+  const r = rows.filter((x) => x.direction === d);
+  return `${r.filter((x) => x.thatWay).length} of ${r.length}`;
+};
+console.log(`\n${rows.length} requests over ${SEEDS.length} seeds, within ${REQUEST_SECONDS} s of dance (figures.turns on her facing):`);
+console.log(`- she turned: ${share((r) => r.turned)} asked, ${share((r) => r.turnedUnasked)} of the same windows never asked`);
+console.log(`- the asked way: ${share((r) => r.thatWay)} (to her right ${way(-1)}, to her left ${way(1)}); of her turns after a request, ${Math.round((100 * rows.filter((r) => r.thatWay).length) / Math.max(1, rows.filter((r) => r.turned).length))} % the asked way`);
+console.log(`- his hand above ${HAND_RAISED} m: ${share((r) => r.hand > HAND_RAISED)} asked, ${share((r) => r.handUnasked > HAND_RAISED)} unasked`);
+console.log(`- every request taken: ${rows.every((r) => r.took)}`);
 if (consoleErrors.length) console.log('console errors:', consoleErrors);
-if (process.env.DUET_TURN_JSON) writeFileSync(process.env.DUET_TURN_JSON, JSON.stringify(dump));
+if (process.env.DUET_TURN_JSON) writeFileSync(process.env.DUET_TURN_JSON, JSON.stringify(rows));

@@ -22,25 +22,34 @@ export const J = { hip: 0, head: 4, lShldr: 5, lHand: 7, rShldr: 8, rHand: 10, l
 /**
  * In the page: install the step wrapper (once) and arm a recording: `askAt` steps after the page
  * started dancing (window.duet.frame, not reset by R), ask a turn in `direction` (0: ask nothing),
- * and keep every step's joints of both dancers until `until` steps. Resolves when installed.
+ * or each of `asks` ([{at, direction}]), and keep every step's joints of both dancers until `until`
+ * steps. Resolves when installed.
  */
-export function armProbe(page, { askAt, direction, until }) {
+export function armProbe(page, { askAt, direction, until, asks }) {
+  const planned = asks ?? (direction ? [{ at: askAt, direction }] : []);
   return page.evaluate(
-    async ({ askAt, direction, until }) => {
+    async ({ planned, until }) => {
       const module = await import('/web/engine/simulation.ts');
       const proto = module.DuetSimulation.prototype;
       if (!proto.__turnProbe) {
+        // Where the leader's input holds the figure block and the hands plan, from the page's own
+        // layout table (web/mirror/features.ts): figure 660-763, hands plan from 764.
+        const features = await import('/web/mirror/features.ts');
+        const blocks = features.blockSlices(features.LEADER_INPUT_LAYOUT);
+        const [figureAt, figureEnd, plannedAt] = [blocks.figure.start, blocks.figure.end, blocks.hands_plan.start];
         const step = proto.step;
         proto.step = async function (steer, temperature) {
           const probe = window.__turnProbe;
           window.__turnSim = this;
-          if (probe && !probe.asked && probe.direction !== 0 && window.duet.frame === probe.askAt) {
+          for (const ask of probe?.asks ?? []) {
+            if (ask.done || window.duet.frame !== ask.at) continue;
             // The page's own way when it has one (window.duet.askTurn, what T and the turn buttons
             // call), else the simulation's.
             const hook = window.duet.askTurn;
             probe.via = hook ? 'window.duet.askTurn' : 'simulation.askTurn';
-            probe.took = hook ? hook(probe.direction) : this.askTurn(probe.direction);
-            probe.asked = true;
+            ask.took = hook ? hook(ask.direction) : this.askTurn(ask.direction);
+            probe.took = ask.took;
+            ask.done = probe.asked = true;
           }
           await step.call(this, steer, temperature);
           // window.duet.frame is incremented right after step() returns: this state is step frame + 1.
@@ -52,13 +61,14 @@ export function armProbe(page, { askAt, direction, until }) {
               leaderHeading: this.leader.heading,
               followerHeading: this.followers[0].heading,
               turnAsked: this.turnAsked,
-              // The figure danced on this step or coming ({way, asked, coming}: Simulation.figure).
+              // The figure danced on this step or coming ({name, way, asked, coming}: Simulation.figure).
               led: this.figure ? { ...this.figure } : null,
-              // The figure block both dancers read this step (the leader's inputs 660-711: per key
-              // t-30..t+30, per way (her left, her right), inside and progress), and the first
-              // numbers of his hands plan (712: shown, then the left hand's first move).
-              figure: Array.from(this.leaderPolicy?.input?.slice(660, 712) ?? []),
-              handsPlan: Array.from(this.leaderPolicy?.input?.slice(712, 716) ?? []),
+              // The figure block both dancers read this step (the leader's inputs 660-763, 104
+              // numbers: per key t-30..t+30, per kind (features FIGURE_KINDS: her turn to her left,
+              // to her right, his turn to his left, to his right), inside and progress), and the first
+              // numbers of his hands plan (764: shown, then the left hand's first move).
+              figure: Array.from(this.leaderPolicy?.input?.slice(figureAt, figureEnd) ?? []),
+              handsPlan: Array.from(this.leaderPolicy?.input?.slice(plannedAt, plannedAt + 4) ?? []),
               steerActive: steer.active,
               t: performance.now(),
             });
@@ -66,10 +76,10 @@ export function armProbe(page, { askAt, direction, until }) {
         };
         proto.__turnProbe = true;
       }
-      window.__turnProbe = { askAt, direction, until, asked: false, took: null, steps: [] };
+      window.__turnProbe = { asks: planned.map((a) => ({ ...a, done: false, took: null })), until, asked: false, took: null, steps: [] };
       return true;
     },
-    { askAt, direction, until },
+    { planned, until },
   );
 }
 
@@ -119,6 +129,42 @@ export function unwrap(angles) {
  * the facing change in degrees at every later step (unwrapped, + counterclockwise), the largest in
  * `direction`, and the first time (s after the request) it reaches `full` degrees that way.
  */
+/**
+ * The turn rule of training/evaluation/figures.py `turns`, on an unwrapped facing (radians, one a
+ * step): [index, direction ±1] at each index where the facing has changed by `degrees` from some
+ * index at most `seconds` before it (and after the previous turn). The page's tests and `lead` in
+ * Python count her turns with it, on the same facing.
+ */
+export function turns(angle, degrees = 300, seconds = 2.5) {
+  const span = Math.round(seconds * FPS);
+  const need = (degrees * Math.PI) / 180;
+  const out = [];
+  let anchor = 0;
+  for (let t = 1; t < angle.length; t++) {
+    let best = 0;
+    for (let k = Math.max(anchor, t - span); k < t; k++) {
+      const change = angle[t] - angle[k];
+      if (Math.abs(change) > Math.abs(best)) best = change;
+    }
+    if (Math.abs(best) >= need) {
+      out.push([t, Math.sign(best)]);
+      anchor = t;
+    }
+  }
+  return out;
+}
+
+/**
+ * Her turns over the recorded steps from the state the request was made in (step `from`) to step
+ * `from + frames`, as `lead` counts them after a request (figures.turns on her facing from that
+ * state on): [[seconds after the request, direction], ...].
+ */
+export function followerTurns(steps, from, frames) {
+  const window_ = steps.filter((s) => s.frame >= from && s.frame <= from + frames);
+  const angle = unwrap(window_.map((s) => facing(s.follower)));
+  return turns(angle).map(([i, d]) => [(window_[i].frame - from) / FPS, d]);
+}
+
 export function followerTurn(steps, from, direction, full = 300) {
   const window_ = steps.filter((s) => s.frame >= from);
   const angles = unwrap(window_.map((s) => facing(s.follower)));

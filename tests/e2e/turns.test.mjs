@@ -7,7 +7,7 @@
 //
 // Asserts, from the page's own simulation:
 // - the page takes the request and holds it while it is planned and danced (turnAsked: from the
-//   next beat, FIGURE_BEATS long), then lets it go; his own figures are off (?figures=0);
+//   next beat, FIGURE_BEATS.her_turn long), then lets it go; his own figures are off (?figures=0);
 // - the two runs are the same dance up to the request (so what differs after it is the request's
 //   doing), and the leader's pose differs by more than 1 cm within 1 s after it;
 // - the request raises his hand: his higher hand goes above LEAD_HAND m within 2.5 s (the lead a
@@ -26,7 +26,7 @@
 import { after, before, describe, test } from 'node:test';
 import assert from 'node:assert/strict';
 import { QUICK, WAIT_MS, launch, saveScreen, startServer, waitReady } from './harness.mjs';
-import { FPS, J, Reloaded, armProbe, captureLedTurn, followerTurn, leaderDivergence, leaderHand, poseDistance, readProbe } from './turns.mjs';
+import { FPS, J, Reloaded, armProbe, captureLedTurn, followerTurn, followerTurns, leaderDivergence, leaderHand, poseDistance, readProbe } from './turns.mjs';
 
 const SEED = Number(process.env.DUET_TURN_SEED ?? 8);
 const DIRECTION = Number(process.env.DUET_TURN_DIRECTION ?? -1); // −1 clockwise seen from above: her right (T); +1 her left (Shift+T)
@@ -166,7 +166,7 @@ describe(`leading a turn (seed ${SEED})`, () => {
     const { states, variances } = asked.shot;
     assert.equal(states.length, FRAMES);
     // window.duet.figure names the asked turn while it is danced: from the next beat (within 11
-    // steps at 170 beats a minute) for FIGURE_BEATS (38 steps); none once it is over (?figures=0).
+    // steps at 170 beats a minute) for FIGURE_BEATS.her_turn (38 steps); none once it is over (?figures=0).
     const herTurn = { name: 'her_turn', way: DIRECTION > 0 ? 'left' : 'right', asked: true };
     states.forEach((state, k) => {
       assert.equal(state.error, null);
@@ -204,23 +204,22 @@ describe(`leading a turn (seed ${SEED})`, () => {
   });
 });
 
-// Leading a turn in several seeds: a turn asked after 4 s in each of SEEDS (askTurn, what T and
-// Shift+T call), her left on odd seeds and her right on even ones as in scripts/turns_probe.mjs,
-// and her facing recorded for 2.5 s. She is still not told: her network reads his motion. The dance
-// of a seed is the same on every run. With the shipped models she turned 300 degrees or more
-// (either way) within 2.5 s in 7 of these 16 (seeds 2, 6, 8, 12-15; the asked way in 2, 6, 8, 12,
-// 14 and 15); Python's lead turns after 52 % of 500 requests (docs/results.md, "Leading a
-// turn"). Asserted: at least MIN_TURNED of the 16. A follower who turns after half the requests
-// fails that by chance once in a hundred models (3 or fewer of 16); one who turns after a fifth
-// fails it six times in ten. And every request is taken without an error.
-const MIN_TURNED = 4;
+// Leading a turn in several seeds: her turn asked after 4 s in each of SEEDS (askTurn, what T and
+// Shift+T call), her left on odd seeds and her right on even ones, his own figures off, and her
+// facing recorded for REQUEST_SECONDS. Counted as `lead` counts in Python (turns.mjs
+// `followerTurns`: figures.turns, 300 degrees within 2.5 s). She gets no command: both dancers
+// read the figure being led, and her guard prefers her network's samples that turn its way.
+// Asserted: she completes a turn the asked way after at least MIN_TURNED of the 16 (docs/results.md,
+// "Leading a turn", has the page's and Python's shares), and every request is taken without an error.
+const MIN_TURNED = 5;
 const SEEDS = Array.from({ length: 16 }, (_, i) => i + 1);
-const WINDOW = Math.round(2.5 * FPS);
+const REQUEST_SECONDS = 4;
+const WINDOW = REQUEST_SECONDS * FPS;
 /** The seeds' runs take no picture: drawn at half resolution (QUICK). */
 const SEEDS_VIEW = { ...DESKTOP, launch: { ...DESKTOP.launch, ...QUICK }, file: null };
 
 describe(`leading a turn in ${SEEDS.length} seeds`, () => {
-  test('she turns within 2.5 s of T in some of them', async () => {
+  test(`she turns the asked way within ${REQUEST_SECONDS} s of T or Shift+T in most of them`, async () => {
     const rows = [];
     for (const seed of SEEDS) {
       const direction = seed % 2 === 1 ? 1 : -1;
@@ -228,12 +227,12 @@ describe(`leading a turn in ${SEEDS.length} seeds`, () => {
       assert.deepEqual(consoleErrors, [], `seed ${seed}: console errors`);
       assert.equal(probe.took, true, `seed ${seed}: the request was refused (${probe.via})`);
       assert.ok(probe.steps[0].frame <= ASK_AT, `seed ${seed}: the recording began after the request`);
-      const most = Math.max(followerTurn(probe.steps, ASK_AT, 1).best, followerTurn(probe.steps, ASK_AT, -1).best);
-      rows.push({ seed, most, thatWay: followerTurn(probe.steps, ASK_AT, direction).turned });
+      const found = followerTurns(probe.steps, ASK_AT, WINDOW);
+      rows.push({ seed, found, thatWay: found.some(([, d]) => d === direction) });
     }
-    const turned = rows.filter((r) => r.most >= 300);
-    console.log(`led turns: ${rows.map((r) => `seed ${r.seed} ${r.most.toFixed(0)}°${r.thatWay ? ' (the asked way)' : ''}`).join(', ')}; ` +
-      `she turned in ${turned.length} of ${rows.length}`);
-    assert.ok(turned.length >= MIN_TURNED, `she turned 300° within 2.5 s of the request in only ${turned.length} of ${rows.length} seeds`);
+    const turned = rows.filter((r) => r.thatWay);
+    console.log(`led turns: ${rows.map((r) => `seed ${r.seed} ${r.found.length ? r.found.map(([t, d]) => `${d > 0 ? 'left' : 'right'} at ${t.toFixed(2)} s`).join(' ') : 'none'}${r.thatWay ? ' (the asked way)' : ''}`).join(', ')}; ` +
+      `she turned the asked way in ${turned.length} of ${rows.length}`);
+    assert.ok(turned.length >= MIN_TURNED, `she turned the asked way within ${REQUEST_SECONDS} s of the request in only ${turned.length} of ${rows.length} seeds`);
   });
 });

@@ -343,7 +343,7 @@ def features_fixture(rng: np.random.Generator, lead: Track, follow: Track) -> di
             "OUTPUT_LAYOUT": feat.OUTPUT_LAYOUT, "INTENTION_LAYOUT": feat.INTENTION_LAYOUT,
             "CONTACT_HEIGHT": feat.CONTACT_HEIGHT, "CONTACT_SPEED": feat.CONTACT_SPEED,
             "LEADER_INPUT_SIZE": feat.LEADER_INPUT_SIZE, "FIGURE_SIZE": feat.FIGURE_SIZE,
-            "FIGURE_WAYS": list(feat.FIGURE_WAYS), "FIGURE_OFFSETS": feat.FIGURE_OFFSETS.tolist(),
+            "FIGURE_KINDS": [list(k) for k in feat.FIGURE_KINDS], "FIGURE_OFFSETS": feat.FIGURE_OFFSETS.tolist(),
             "followerSlices": {k: [v.start, v.stop] for k, v in feat.block_slices(feat.FOLLOWER_INPUT_LAYOUT).items()},
         },
         "rootSpace": {
@@ -386,25 +386,35 @@ def features_fixture(rng: np.random.Generator, lead: Track, follow: Track) -> di
     }
 
 
-# Her turns to her left (+1) and right (-1) in the features fixture's frames (t = 30, 31): one ended
-# 10 frames ago, one running, one beginning 12 frames on; the running and the coming overlap.
-LED_SPANS = np.array([(1, -5, 20), (-1, 14, 40), (1, 43, 70)])
+# The figure kinds (features.FIGURE_KINDS): her turn to her left, to her right, his turn to his
+# left, to his right.
+HER_LEFT, HER_RIGHT, HIS_LEFT, HIS_RIGHT = (feat.FIGURE_KINDS.index(k) for k in (
+    ("her_turn", 1), ("her_turn", -1), ("his_turn", 1), ("his_turn", -1)))
+
+# Figures of every kind in the features fixture's frames (t = 30, 31): her turn to her left ended
+# 10 frames ago, his to his right running, her turn to her right beginning 12 frames on and his to
+# his left within it, ending at the last key of t = 31.
+LED_SPANS = np.array([(HER_LEFT, -5, 20), (HIS_RIGHT, 14, 40), (HER_RIGHT, 43, 70), (HIS_LEFT, 50, 61)])
 
 
 def figure_block_cases(frames: np.ndarray) -> list[dict]:
-    """features.figure_block at the fixture's frames: no figure, and spans that start or end on a
-    key, overlap (the same way: the later one's progress; both ways: each its own), last one frame
-    or none (start == end), or lie beyond the block's reach (t-30, t+30)."""
+    """features.figure_block at the fixture's frames: no figure, and spans of each kind that start
+    or end on a key, overlap (the same kind: the later one's progress; other kinds: each its own),
+    last one frame or none (start == end), or lie beyond the block's reach (t-30, t+30)."""
     cases = [
         None,
         [],
-        [(1, 30, 60)],                             # begins now at t = 30, a frame ago at t = 31
-        [(-1, 0, 30)],                             # began at the block's first key, ends now
-        [(1, 10, 40), (1, 35, 50)],                # the same way, overlapping: the later one's progress
-        [(1, 10, 40), (-1, 35, 50)],               # both ways at once
-        [(-1, 45, 45), (1, 20, 21)],               # a one-frame figure, and one of two frames
-        [(1, -40, -1), (-1, 62, 90)],              # out of reach at t = 30 (the past key -1 is t-31)
-        [(-1, 5, 61), (1, 61, 95), (-1, 70, 80)],  # the last key's edge at t = 31
+        [(HER_LEFT, 30, 60)],                      # begins now at t = 30, a frame ago at t = 31
+        [(HER_RIGHT, 0, 30)],                      # began at the block's first key, ends now
+        [(HIS_LEFT, 30, 50)],
+        [(HIS_RIGHT, 12, 33)],
+        [(HER_LEFT, 10, 40), (HER_LEFT, 35, 50)],  # the same kind, overlapping: the later one's progress
+        [(HIS_RIGHT, 10, 40), (HIS_RIGHT, 35, 50)],
+        [(HER_LEFT, 10, 40), (HER_RIGHT, 35, 50)],  # both ways of her turn at once
+        [(HER_LEFT, 10, 40), (HIS_LEFT, 20, 40), (HER_RIGHT, 35, 50), (HIS_RIGHT, 38, 58)],  # every kind at once
+        [(HER_RIGHT, 45, 45), (HIS_LEFT, 20, 21)],   # a one-frame figure, and one of two frames
+        [(HER_LEFT, -40, -1), (HIS_RIGHT, 62, 90)],  # out of reach at t = 30 (the past key -1 is t-31)
+        [(HIS_RIGHT, 5, 61), (HER_LEFT, 61, 95), (HER_RIGHT, 70, 80)],  # the last key's edge at t = 31
     ]
     return [{"figures": None if c is None else [list(map(int, f)) for f in c],
              "expected": out7(feat.figure_block(None if c is None else np.array(c).reshape(-1, 3), frames))}
@@ -511,7 +521,71 @@ def on_count_cases(rng: np.random.Generator, outputs: np.ndarray, ranges: dict, 
                      for m in (-9.0, 0.0, 0.05, 9.0) for h in (0.0, 1.0)},
             "spin": out7(spin), "keeps": keeps,
             "bestKept": {f"{m}/{k}": OC.nearest_count(footwork, back, target, standing, m, 1.0, np.array(keeps[f"{k}"]))
-                         for m in (-9.0, 0.0, 0.05, 9.0) for k in (0.0, 0.7, 1.5)}}
+                         for m in (-9.0, 0.0, 0.05, 9.0) for k in (0.0, 0.7, 1.5)},
+            **figure_choice_cases(outputs)}
+
+
+# The figures figure_choice_cases reads, at frame FIGURE_T: (name, spans) where a span of each kind
+# runs now, begins at the first and the last key within FIGURE_AHEAD, begins a key beyond it, ended
+# just before now; her turn and his at once; both ways of her turn at once.
+FIGURE_T = 30
+_AHEAD = OC.FIGURE_AHEAD * feat.KEY_STEP
+FIGURE_LABELS = {"her_left": HER_LEFT, "her_right": HER_RIGHT, "his_left": HIS_LEFT, "his_right": HIS_RIGHT}
+
+
+def _figure_spans() -> list[tuple[str, list[tuple[int, int, int]]]]:
+    spans: list[tuple[str, list[tuple[int, int, int]]]] = [("none", [])]
+    for label, kind in FIGURE_LABELS.items():
+        t = FIGURE_T
+        spans += [(f"{label}/now", [(kind, t - 10, t + 20)]), (f"{label}/next", [(kind, t + feat.KEY_STEP, t + 40)]),
+                  (f"{label}/ahead", [(kind, t + _AHEAD, t + 40)]),
+                  (f"{label}/beyond", [(kind, t + _AHEAD + 1, t + 40)]), (f"{label}/past", [(kind, t - 25, t - 1)])]
+    return spans + [("her and his", [(HER_RIGHT, FIGURE_T - 5, FIGURE_T + 20), (HIS_LEFT, FIGURE_T + 3, FIGURE_T + 30)]),
+                    ("her both ways", [(HER_RIGHT, FIGURE_T - 5, FIGURE_T + 20), (HER_LEFT, FIGURE_T + 8, FIGURE_T + 30)])]
+
+
+def figure_choice_cases(outputs: np.ndarray) -> dict:
+    """on_count.figure_way on inputs of each role (zeros but for the figure block, at FIGURE_IN: the
+    fixture holds the block alone) whose figure block holds each kind now, coming within and beyond
+    FIGURE_AHEAD, past, none, and two at once; and OnCount.prefers with figure_turn on 8 candidates
+    whose planned paths turn various amounts, from inputs with and without a figure, turning or not,
+    and with turn_start alone."""
+    ways = {}
+    inputs = {}
+    for role, size in (("leader", feat.LEADER_INPUT_SIZE), ("follower", feat.INPUT_SIZE)):
+        rows = []
+        inputs[role] = {}
+        for name, spans in _figure_spans():
+            block = np.round(feat.figure_block(np.array(spans, np.int64).reshape(-1, 3), np.array([FIGURE_T]))[0], 6)
+            x = np.zeros(size)
+            x[OC.FIGURE_IN[role]:OC.FIGURE_IN[role] + feat.FIGURE_SIZE] = block
+            inputs[role][name] = x
+            rows.append({"name": name, "figure": exact(block), "way": OC.figure_way(x, role)})
+        ways[role] = rows
+    # 8 candidates (the upright fixture's bodies twice), their planned paths turning these degrees.
+    degrees = (300.0, 185.0, 90.0, 0.0, -60.0, -179.0, -200.0, -400.0)
+    figured = np.tile(outputs, (2, 1))
+    future = feat.block_slices(feat.OUTPUT_LAYOUT)["trajectory_future"]
+    for i, d in enumerate(degrees):
+        keys = figured[i, future].reshape(feat.KEYS, 4)
+        h = np.radians(d) * np.arange(1, feat.KEYS + 1) / feat.KEYS
+        keys[:, 2], keys[:, 3] = 0.8 * np.sin(h), 0.8 * np.cos(h)
+        figured[i, future] = keys.ravel()
+    figured = np.round(figured, 6)
+    chosen = []
+    for role in ("leader", "follower"):
+        for figure_turn, turn_start in ((OC.FIGURE_TURN, None), (90.0, None), (None, 120.0), (OC.FIGURE_TURN, 120.0)):
+            for name in ("none", "her_left/now", "her_right/ahead", "his_left/next", "his_right/now",
+                         "her_left/beyond", "her and his", None):
+                for turning in (False, True):
+                    chooser = OC.OnCount(role, 8, 1.0, turn_start=turn_start, figure_turn=figure_turn)
+                    chooser.turning = turning
+                    got = chooser.prefers(figured, None if name is None else inputs[role][name])
+                    chosen.append({"role": role, "figureTurn": figure_turn, "turnStart": turn_start, "figure": name,
+                                   "turning": turning, "prefers": None if got is None else got.tolist()})
+    return {"figureIn": OC.FIGURE_IN, "figureAhead": OC.FIGURE_AHEAD, "figureTurn": OC.FIGURE_TURN,
+            "figureWays": ways, "figured": exact(figured), "figuredTurn": out7(OC.planned_turn(figured)),
+            "figurePrefers": chosen}
 
 
 class Draws:
@@ -528,18 +602,21 @@ class Draws:
 
 
 def led_state(figures: ro.Figures) -> list[list]:
-    """Every figure of a duet as [way, start, end, asked]."""
-    return [[x.way, x.start, x.end, x.asked] for x in figures.led]
+    """Every figure of a duet as [name, way, start, end, asked]."""
+    return [[x.name, x.way, x.start, x.end, x.asked] for x in figures.led]
 
 
 # The schedule fixture: a duet's clock alone (no models), the visitor's asks at some frames, his
-# own figures switched off for a while; (frame, direction) before that frame's step.
+# own figures switched off for a while; (frame, direction) before that frame's step. His own, drawn
+# from SCHEDULE_DRAWS (a seed whose draws give every kind): his turn to his left (44-64), to his
+# right (191-211, taken over by an ask; 408-428), her turn to her right (250-284).
 SCHEDULE_FRAMES = 420
+SCHEDULE_DRAWS = SEED + 39
 SCHEDULE_ASKS = [
-    (40, -1),     # his own figure runs (24-58): the ask follows it (63)
-    (41, 1),      # asked again before that began: the second takes the place of the first
-    (95, -1),     # the asked figure runs (63-97): this one follows it
-    (190, 1),     # his own is planned (221), not begun: the ask takes its place, on the next beat
+    (50, -1),     # his own turn runs (44-64): the ask follows it, on the next beat (73)
+    (51, 1),      # asked again before that began: the second takes the place of the first
+    (80, -1),     # the asked figure runs (73-107): this one follows it (113)
+    (180, 1),     # his own turn is planned (191), not begun: the ask takes its place, on the next beat (181)
     (300, -1),    # his own are off: on the next beat (309)
     (301, -1),    # and again before it began
 ]
@@ -550,7 +627,7 @@ def figures_fixture(manifest: dict) -> dict:
     """The figures of a duet (rollout.Figures) over SCHEDULE_FRAMES steps of its clock at a tempo
     between beats, his own drawn from a fixed list: each step the visitor's asks, then plan_figures
     (as step() and the page run it), then what is danced; and the count helpers on their own."""
-    draws = Draws(np.round(np.random.default_rng(SEED + 4).random(40), 6))
+    draws = Draws(np.round(np.random.default_rng(SCHEDULE_DRAWS).random(40), 6))
     duet = ro.start_duet(manifest, tempo=183.0)
     duet.beat = 0.61
     duet.figures = ro.Figures(own=True, rng=draws)
@@ -572,16 +649,20 @@ def figures_fixture(manifest: dict) -> dict:
     clock.frame, clock.beat = 7, 2.95
     to_beat = [{"frame": f, "beat": b, "expected": ro.frames_to_beat(clock, f, b)}
                for f, b in ((7, 3.0), (7, 2.9), (7, 2.95), (7, 4.0), (12, 4.0), (3, 3.0))]
-    figure_from = [{"frame": f, "way": w, "asked": a, "expected": led_state(ro.Figures(led=[ro.figure_from(clock, f, w, a)]))[0]}
-                   for f, w, a in ((7, 1, True), (8, -1, False), (10, 0, True), (40, -3, False))]
-    led = ro.Led(-1, 20, 56)
+    figure_from = [{"frame": f, "name": n, "way": w, "asked": a,
+                    "expected": led_state(ro.Figures(led=[ro.figure_from(clock, f, n, w, a)]))[0]}
+                   for f, n, w, a in ((7, "her_turn", 1, True), (8, "her_turn", -1, False), (10, "her_turn", 0, True),
+                                      (40, "her_turn", -3, False), (7, "his_turn", 1, False), (12, "his_turn", -1, False),
+                                      (40, "his_turn", 2, True))]
+    led = ro.Led("her_turn", -1, 20, 56)
     share = [{"frame": f, "share": ro.figure_share(led, f), "raised": ro.raised(led, f)}
              for f in (0, 19, 20, 21, 26, 32, 38, 50, 56, 57, 64, 71, 72, 100)]
     return {"tempo": 183.0, "beat": 0.61, "draws": draws.numbers, "drawn": draws.used, "asks": SCHEDULE_ASKS,
             "ownOff": list(SCHEDULE_OWN_OFF), "steps": steps,
-            "FIGURE_BEATS": ro.FIGURE_BEATS, "OWN_GAP_BEATS": list(ro.OWN_GAP_BEATS), "RAISE": list(ro.RAISE),
+            "FIGURE_BEATS": ro.FIGURE_BEATS, "OWN_GAP_BEATS": list(ro.OWN_GAP_BEATS), "HIS_SHARE": ro.HIS_SHARE,
+            "RAISE": list(ro.RAISE),
             "clock": {"tempo": 171.0, "frame": 7, "beat": 2.95, "framesToBeat": to_beat, "figureFrom": figure_from},
-            "led": [led.way, led.start, led.end], "share": share}
+            "led": [led.name, led.way, led.start, led.end], "share": share}
 
 
 def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_offsets, follow_offsets) -> dict:
@@ -606,9 +687,10 @@ def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_o
         return o.astype(np.float32).astype(np.float64)
 
     # The music at another tempo than the default, its count between beats: each step reads both.
-    # His own figure is planned at the first step (her turn to her left, 1.2 beats on), and taken
-    # over by the visitor's ask before the second (to her right, on the next beat).
-    step_draws = Draws([0.02, 0.3])
+    # His own figure is planned at the first step (his turn to his left, 1.25 beats on: the draws are
+    # the wait, whose turn and its way), and taken over by the visitor's ask before the second (her
+    # turn to her right, on the next beat).
+    step_draws = Draws([0.1, 0.2, 0.3])
     duet = ro.Duet(ro.Dancer(lead_offsets, window(lead)), ro.Dancer(follow_offsets, window(follow)), start_pose,
                    tempo=176.5, beat=0.3, figures=ro.Figures(own=True, rng=step_draws))
     duet.steering.velocity = np.array([0.3, -0.2])
@@ -627,7 +709,7 @@ def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_o
         before_velocity = duet.steering.velocity.copy()
         ro.plan_figures(duet)   # as step(): first
         ro.steer_plan(duet.leader, duet.steering, np.array(stick, float))
-        ro.lead_plan(duet)   # a figure is near from the first step: the plan bent her way
+        ro.lead_plan(duet)   # a figure is near from the first step: the plan bent his way, then hers
         planned_root, planned_heading = duet.leader.track.root.copy(), duet.leader.track.heading.copy()
         xl, xf = ro.step_inputs(duet)
         ol, of = plausible(lead, 30 + i % 2), plausible(follow, 30 + i % 2)
@@ -725,34 +807,41 @@ HANDS_FRAMES = (5, 10, 11, 25, 40, 46, 52, 70, 76, 80, 91, 92)
 
 def hands_input_cases(offsets, track: Track, hands: np.ndarray) -> list[dict]:
     """rollout.hands_input for the leader standing at frame 30 of the procedural track, a figure of
-    each way (his hands when its plan began given, or taken now: None) at HANDS_FRAMES, and two
-    figures at once (the plan is for the first near one)."""
+    each kind (his hands when its plan began given, or taken now: None; his own turn has no plan)
+    at HANDS_FRAMES, and two figures at once (the plan is for the first near her turn)."""
     out = []
-    for way, given in ((1, hands[0]), (-1, hands[1]), (-1, None)):
+    for name, way, given in (("her_turn", 1, hands[0]), ("her_turn", -1, hands[1]), ("her_turn", -1, None),
+                             ("his_turn", 1, None), ("his_turn", -1, hands[1])):
         for frame in HANDS_FRAMES:
             duet = ro.Duet(ro.Dancer(offsets, track), ro.Dancer(offsets, track), {}, frame=frame)
-            led = ro.Led(way, *HANDS_FIGURE, hands=None if given is None else given.copy())
+            led = ro.Led(name, way, *HANDS_FIGURE, hands=None if given is None else given.copy())
             duet.figures.led = [led]
             moves = ro.hands_input(duet)
-            out.append({"way": way, "frame": frame, "hands": None if given is None else exact(given),
+            out.append({"name": name, "way": way, "frame": frame, "hands": None if given is None else exact(given),
                         "moves": None if moves is None else out7(moves),
                         "handsAfter": None if led.hands is None else out7(led.hands)})
-    duet = ro.Duet(ro.Dancer(offsets, track), ro.Dancer(offsets, track), {}, frame=70)
-    duet.figures.led = [ro.Led(1, 20, 56, hands=hands[0].copy()), ro.Led(-1, 60, 96, hands=hands[1].copy())]
-    out.append({"two": [[1, 20, 56], [-1, 60, 96]], "hands": [exact(hands[0]), exact(hands[1])], "frame": 70,
-                "moves": out7(ro.hands_input(duet))})
+    for two in ([("her_turn", 1, 20, 56), ("her_turn", -1, 60, 96)],
+                [("his_turn", 1, 50, 70), ("her_turn", -1, 60, 96)],   # his own turn first: the plan is for hers
+                [("her_turn", 1, 20, 56), ("his_turn", -1, 60, 96)]):  # hers lowering while his runs
+        duet = ro.Duet(ro.Dancer(offsets, track), ro.Dancer(offsets, track), {}, frame=70)
+        duet.figures.led = [ro.Led(n, w, a, b, hands=h.copy()) for (n, w, a, b), h in zip(two, hands)]
+        out.append({"two": [list(x) for x in two], "hands": [exact(hands[0]), exact(hands[1])], "frame": 70,
+                    "moves": out7(ro.hands_input(duet))})
     return out
 
 
 def lead_plan_cases(offsets, track: Track) -> list[dict]:
     """rollout.lead_plan on the leader's planned path (the procedural track's frames 31-60) for a
-    figure of each way and for two at once, at frames before, in and after them."""
+    figure of each kind and for two at once (her turn and his), at frames before, in and after them."""
     out = []
-    for spans in ([(1, *HANDS_FIGURE)], [(-1, *HANDS_FIGURE)], [(1, 20, 56), (-1, 60, 96)]):
+    for spans in ([("her_turn", 1, *HANDS_FIGURE)], [("her_turn", -1, *HANDS_FIGURE)],
+                  [("his_turn", 1, *HANDS_FIGURE)], [("his_turn", -1, 40, 60)],
+                  [("her_turn", 1, 20, 56), ("her_turn", -1, 60, 96)],
+                  [("his_turn", -1, 20, 40), ("her_turn", 1, 50, 86)]):
         for frame in (0, 15, 30, 45, 58, 70, 76, 90):
             leader = ro.Dancer(offsets, Track(track.positions, track.rotations, track.root.copy(), track.heading.copy()))
             duet = ro.Duet(leader, leader, {}, frame=frame)
-            duet.figures.led = [ro.Led(w, a, b) for w, a, b in spans]
+            duet.figures.led = [ro.Led(n, w, a, b) for n, w, a, b in spans]
             ro.lead_plan(duet)
             out.append({"figures": [list(x) for x in spans], "frame": frame,
                         "root": out7(leader.track.root), "heading": out7(leader.track.heading)})

@@ -185,7 +185,7 @@ def test_manifest(exported, data3):
         assert len(sp["hip"]) == 3 and 0.7 < sp["hip"][1] < 1.3
         assert np.array(sp["forward"]).shape == (17, 3) and np.array(sp["up"]).shape == (17, 3)
     lay = m["layout"]
-    assert (lay["input"], lay["output"], lay["intention"]) == (713, 323, 90)
+    assert (lay["input"], lay["output"], lay["intention"]) == (817, 323, 90)
     assert [tuple(b) for b in lay["followerInput"]] == feat.FOLLOWER_INPUT_LAYOUT
     assert [tuple(b) for b in lay["leaderInput"]] == feat.LEADER_INPUT_LAYOUT
     assert [tuple(b) for b in lay["outputBlocks"]] == feat.OUTPUT_LAYOUT

@@ -19,15 +19,18 @@ from training.mirror.skeleton import FPS, HANDS
 
 def test_the_figure_block_reads_each_figure_over_the_past_and_next_second():
     assert np.all(feat.figure_block(None, np.arange(3)) == 0)
-    # Her turn to her left from frame 100 to 140, to her right from 150 to 170.
-    figures = np.array([(1, 100, 140), (-1, 150, 170)])
-    block = feat.figure_block(figures, np.array([90, 120, 160])).reshape(3, len(feat.FIGURE_OFFSETS), 2, 2)
+    # Her turn to her left from frame 100 to 140, his turn to his right from 150 to 170.
+    kinds = feat.FIGURE_KINDS
+    her, his = kinds.index(("her_turn", 1)), kinds.index(("his_turn", -1))
+    figures = np.array([(her, 100, 140), (his, 150, 170)])
+    block = feat.figure_block(figures, np.array([90, 120, 160])).reshape(3, len(feat.FIGURE_OFFSETS), len(kinds), 2)
     t = np.array([90, 120, 160])[:, None] + feat.FIGURE_OFFSETS[None]
     left = (t >= 100) & (t <= 140)
     right = (t >= 150) & (t <= 170)
-    assert np.array_equal(block[..., 0, 0], left) and np.array_equal(block[..., 1, 0], right)
-    assert np.allclose(block[..., 0, 1], np.where(left, (t - 100) / 40, 0))
-    assert np.allclose(block[..., 1, 1], np.where(right, (t - 150) / 20, 0))
+    assert np.array_equal(block[..., her, 0], left) and np.array_equal(block[..., his, 0], right)
+    assert np.allclose(block[..., her, 1], np.where(left, (t - 100) / 40, 0))
+    assert np.allclose(block[..., his, 1], np.where(right, (t - 150) / 20, 0))
+    assert block.sum() == block[..., [her, his], :].sum()      # the other kinds stay 0
     # His control stands where her partner's planned path stands; the hands plan is his alone.
     assert feat.LEADER_INPUT_SIZE == feat.INPUT_SIZE + feat.HANDS_PLAN_SIZE
 
@@ -54,11 +57,12 @@ def test_a_figure_asked_for_starts_on_the_next_beat_and_both_dancers_read_it():
     start_beat = duet.beat + (led.start - duet.frame) * per
     assert led.way == 1 and led.asked and 0 <= led.start - duet.frame <= 1 / per + 1
     assert start_beat == pytest.approx(round(start_beat), abs=per)        # on a beat of the count
-    assert (led.end - led.start) * per == pytest.approx(ro.FIGURE_BEATS, abs=per)
+    assert led.name == "her_turn" and (led.end - led.start) * per == pytest.approx(ro.FIGURE_BEATS["her_turn"], abs=per)
     x_leader, x_follower = ro.step_inputs(duet)
     fl = x_leader[feat.block_slices(feat.LEADER_INPUT_LAYOUT)["figure"]]
     ff = x_follower[feat.block_slices(feat.FOLLOWER_INPUT_LAYOUT)["figure"]]
-    assert np.array_equal(fl, ff) and fl.reshape(-1, 2, 2)[-1, 0, 0] == 1   # coming within the second, her left
+    her_left = feat.FIGURE_KINDS.index(("her_turn", 1))
+    assert np.array_equal(fl, ff) and fl.reshape(-1, len(feat.FIGURE_KINDS), 2)[-1, her_left, 0] == 1   # coming within the second
     # Asked again before it begins, the new way takes its place.
     ro.ask_turn(duet, -1)
     assert [(f.way, f.asked) for f in duet.figures.led] == [(-1, True)]
@@ -72,16 +76,17 @@ def test_a_figure_asked_for_starts_on_the_next_beat_and_both_dancers_read_it():
 
 def test_nobody_asking_he_leads_his_own_figures_at_the_recorded_rate():
     duet = manifest_duet(figures=True, seed=5)
-    starts, ways = set(), []
+    seen = {}
     for _ in range(30 * 600):     # ten minutes
         run_steps(duet, 1)
         for f in duet.figures.led:
-            if f.start not in starts:
-                starts.add(f.start)
-                ways.append(f.way)
-    per_minute = len(starts) / 10
-    assert 14 < per_minute < 20                      # the recorded couples: 16.9 a minute at 163-187 bpm
-    assert 0.35 < np.mean(np.array(ways) > 0) < 0.65
+            seen[f.start] = f
+    her = [f for f in seen.values() if f.name == "her_turn"]
+    his = [f for f in seen.values() if f.name == "his_turn"]
+    # The recorded couples, at 163-187 beats a minute: 16.9 of her turns a minute and 6.3 of his.
+    assert 13 < len(her) / 10 < 21 and 3.5 < len(his) / 10 < 9
+    assert 0.35 < np.mean([f.way > 0 for f in seen.values()]) < 0.65
+    assert not any(f.asked for f in seen.values())
     assert not manifest_duet(figures=False).figures.own
 
 
@@ -329,3 +334,18 @@ def test_page_figures_measures_a_dump_as_figures_measures_the_recording(data3, t
     assert "at least 5 s" in capsys.readouterr().err
     assert page_figures.main([str(tmp_path / "none.json"), "--data", str(data3)]) == 2
     assert "figures_probe.mjs" in capsys.readouterr().err
+
+
+def test_his_own_turn_turns_his_planned_path_a_full_turn_without_a_side_step():
+    duet = manifest_duet(figures=False)
+    led = ro.figure_from(duet, 0, "his_turn", -1, False)
+    duet.figures.led = [led]
+    duet.frame = led.start
+    t = duet.leader.track
+    root, heading = t.root.copy(), t.heading.copy()
+    ro.lead_plan(duet)
+    keys = ro.NOW + FUTURE_OFFSETS
+    share = np.array([ro.figure_share(led, led.start + o) for o in FUTURE_OFFSETS])
+    assert np.allclose(t.heading[keys] - heading[keys], -2 * np.pi * share)
+    assert np.array_equal(t.root, root)
+    assert ro.hands_input(duet) is None                    # his own turn raises no lead hand

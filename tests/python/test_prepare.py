@@ -177,12 +177,12 @@ def check_real_data(r, out):
     total = sum(expect.values())
     assert 5900 < total < 6100
     assert f"total dancer frames at 30 fps (per dancer): {total}" in r.stdout
-    for text in ("follower input I (713)", "leader input I (757)", "output O (323)", "intention (90)",
+    for text in ("follower input I (817)", "leader input I (854)", "output O (323)", "intention (90)",
                  "partner_trajectory_past 24", "self_pose 204", "control 24", "contacts 2"):
         assert text in r.stdout, text
     # The arrays on disk agree with the summary.
     with np.load(out / "validation.npz") as z:
-        assert z["follower_input"].shape == (samples["validation"], 713)
+        assert z["follower_input"].shape == (samples["validation"], 817)
         assert z["leader_output"].shape == (samples["validation"], 323)
         assert z["follower_intention"].shape == (samples["validation"], 90)
         assert list(z["takes"]) == sorted(README_FRAMES)
@@ -190,7 +190,7 @@ def check_real_data(r, out):
     with np.load(out / "stats.npz") as z:
         for role in ("follower", "leader"):
             std = z[f"{role}_input_std"]
-            assert std.shape == ({"follower": 713, "leader": 757}[role],) and np.isfinite(std).all()
+            assert std.shape == ({"follower": 817, "leader": 854}[role],) and np.isfinite(std).all()
             assert std.min() >= 1e-2 - 1e-9
             assert z[f"{role}_output_mean"].shape == (323,)
 

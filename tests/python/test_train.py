@@ -139,7 +139,7 @@ def test_mismatched_feature_sizes(tmp_path, capsys):
     rc, _, err = run_main(capsys, "--model", "follower", "--smoke", "--prepared", data, "--runs", tmp_path / "out")
     assert rc == 2
     line = error_line(err)
-    assert "follower input has 600 features" in line and "expects 713" in line and "re-run training.data.prepare" in line
+    assert "follower input has 600 features" in line and "expects 817" in line and "re-run training.data.prepare" in line
 
 
 @pytest.mark.parametrize("damage", ["truncated", "foreign"])

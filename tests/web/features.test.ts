@@ -25,7 +25,9 @@ describe('constants and layouts', () => {
     expect(F.INTENTION_LAYOUT).toEqual(c.INTENTION_LAYOUT);
     expect([F.CONTACT_HEIGHT, F.CONTACT_SPEED]).toEqual([c.CONTACT_HEIGHT, c.CONTACT_SPEED]);
     expect([F.LEADER_INPUT_SIZE, F.FIGURE_SIZE]).toEqual([c.LEADER_INPUT_SIZE, c.FIGURE_SIZE]);
-    expect([...F.FIGURE_WAYS]).toEqual(c.FIGURE_WAYS);
+    expect(F.FIGURE_KINDS.map((k) => [...k])).toEqual(c.FIGURE_KINDS);
+    expect(F.FIGURE_KINDS.map(([n, w]) => F.figureKind(n, w))).toEqual([0, 1, 2, 3]);
+    expect([F.INPUT_SIZE, F.LEADER_INPUT_SIZE, F.FIGURE_SIZE]).toEqual([817, 854, 104]);
     expect([...F.FIGURE_OFFSETS]).toEqual(c.FIGURE_OFFSETS);
   });
 
@@ -108,14 +110,19 @@ describe('blocks', () => {
 });
 
 describe('figureBlock', () => {
-  it('reads each figure\'s way, inside and progress at every key of the past and next second', () => {
+  it('reads each figure\'s kind, inside and progress at every key of the past and next second', () => {
     for (const [n, c] of (data.figureBlocks as { figures: number[][] | null; expected: number[] }[]).entries()) {
       const flat = c.figures === null ? null : c.figures.flat();
       const out = perFrame(F.FIGURE_SIZE, (t, o, at) => F.figureBlock(flat, t, o, at));
       expectClose(out, c.expected, `figure block, case ${n} ${JSON.stringify(c.figures)}`);
     }
   });
-  it('overwrites what was there, and writes nothing beyond its 52 numbers', () => {
+  it('a kind that is no index into FIGURE_KINDS is an error', () => {
+    const out = new Float64Array(F.FIGURE_SIZE);
+    for (const kind of [-1, 4, 0.5]) expect(() => F.figureBlock([kind, 30, 40], 30, out)).toThrow(/FIGURE_KINDS/);
+    expect(() => F.figureKind('her_turn', 0)).toThrow();
+  });
+  it('overwrites what was there, and writes nothing beyond its 104 numbers', () => {
     const out = new Float64Array(F.FIGURE_SIZE + 4).fill(7);
     F.figureBlock(null, 30, out, 2);
     expect([...out.subarray(0, 2), ...out.subarray(F.FIGURE_SIZE + 2)]).toEqual([7, 7, 7, 7]);

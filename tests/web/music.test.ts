@@ -5,7 +5,7 @@ import { describe, expect, it } from 'vitest';
 import * as M from '../../web/mirror/music';
 import * as F from '../../web/mirror/features';
 import { expectClose, fixture } from './fixture';
-import { countOf } from '../../web/ui/count';
+import { countOf, figureMark, figureWords } from '../../web/ui/count';
 
 const data = fixture('features');
 const music = data.music;
@@ -52,5 +52,10 @@ describe('music block', () => {
 describe('the count display', () => {
   it('puts beat 0 on the 1 and wraps every 8 beats, below 0 too', () => {
     expect([0, 0.99, 1, 3.5, 7.99, 8, 16.2, -0.5, -8].map(countOf)).toEqual([0, 0, 1, 3, 7, 0, 0, 7, 0]);
+  });
+  it('names the figure coming: her turn with an arrow, his own with a circling one (a phone shows the mark alone)', () => {
+    const shown = F.FIGURE_KINDS.map(([name, way]) => figureWords(name) + figureMark(name, way));
+    expect(shown).toEqual(['her turn ←', 'her turn →', 'his turn ↺', 'his turn ↻']);
+    expect(new Set(F.FIGURE_KINDS.map(([name, way]) => figureMark(name, way))).size).toBe(4);
   });
 });

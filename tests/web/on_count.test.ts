@@ -1,12 +1,16 @@
 // web/mirror/on_count.ts against training/mirror/on_count.py: each dancer's footwork and count read
 // from its input, the footwork its next step aims at over three steps (the mean carried between
 // them), each sample's drawn steps, footwork and hips, and the choice among samples where all, some
-// and none of them stand, a sample's hips weighed and not.
+// and none of them stand, a sample's hips weighed and not; the figure being led read from the input
+// (figureWay) and the candidates it prefers (OnCount.prefers with figureTurn).
 
 import { describe, expect, it } from 'vitest';
-import { OUTPUT_SIZE } from '../../web/mirror/features';
+import { FIGURE_SIZE, INPUT_SIZE, LEADER_INPUT_SIZE, OUTPUT_SIZE } from '../../web/mirror/features';
 import { uprightBody } from '../../web/mirror/guard';
-import { OnCount, TURNING, countNext, drawnFootwork, drawnSteps, footworkNow, hipsTurnBack, keepsSpin, nearestCount, plannedTurn, startsTurn, turnNow, turnRate } from '../../web/mirror/on_count';
+import {
+  FIGURE_AHEAD, FIGURE_IN, FIGURE_TURN, OWN_TURN, OnCount, TURNING, countNext, figureWay, drawnFootwork, drawnSteps, footworkNow, hipsTurnBack, keepsSpin, nearestCount, plannedTurn, startsTurn, turnNow,
+  turnRate,
+} from '../../web/mirror/on_count';
 import { expectClose, fixture } from './fixture';
 
 const data = fixture('rollout').onCount;
@@ -134,5 +138,68 @@ describe('nearestCount', () => {
     expect(data.bestPreferred['-9.0/180.0']).toBe(0);
     expect(data.bestPreferred['-9.0/400.0']).toBe(data.best['-9.0/1.0']);
     expect(() => new OnCount('follower', 8, 1, 1, null, 0)).toThrow(/turnStart/);
+  });
+});
+
+describe('the figure being led, read by the choice', () => {
+  const SIZE = { leader: LEADER_INPUT_SIZE, follower: INPUT_SIZE } as const;
+  /** An input of the role's size, zeros but for the case's figure block (as Python built it). */
+  const inputOf = (role: 'leader' | 'follower', figure: number[]) => {
+    const x = new Float32Array(SIZE[role]);
+    x.set(figure, FIGURE_IN[role]);
+    return x;
+  };
+  const cases = (role: 'leader' | 'follower') => data.figureWays[role] as { name: string; figure: number[]; way: number | null }[];
+
+  it('holds the figure where Python does, with the same constants', () => {
+    expect(FIGURE_IN).toEqual(data.figureIn);
+    expect(FIGURE_AHEAD).toBe(data.figureAhead);
+    expect(FIGURE_TURN).toBe(data.figureTurn);
+    expect(OWN_TURN).toEqual({ leader: 'his_turn', follower: 'her_turn' });
+    for (const role of ['leader', 'follower'] as const) for (const c of cases(role)) expect(c.figure).toHaveLength(FIGURE_SIZE);
+  });
+
+  for (const role of ['leader', 'follower'] as const) {
+    it(`reads the ${role}'s own turn now and within FIGURE_AHEAD, as Python does`, () => {
+      for (const c of cases(role)) expect(figureWay(inputOf(role, c.figure), role), `${role} ${c.name}`).toBe(c.way);
+    });
+  }
+
+  it('pins each kind now, coming and beyond, for both roles', () => {
+    const way = (role: 'leader' | 'follower', name: string) => cases(role).find((c) => c.name === name)!.way;
+    for (const role of ['leader', 'follower'] as const) {
+      expect(way(role, 'none'), role).toBeNull();
+      for (const kind of ['her_left', 'her_right', 'his_left', 'his_right']) {
+        const own = kind.startsWith(role === 'leader' ? 'his' : 'her');
+        const expected = own ? (kind.endsWith('left') ? 1 : -1) : 0;
+        for (const when of ['now', 'next', 'ahead']) expect(way(role, `${kind}/${when}`), `${role} ${kind}/${when}`).toBe(expected);
+        for (const when of ['beyond', 'past']) expect(way(role, `${kind}/${when}`), `${role} ${kind}/${when}`).toBeNull();
+      }
+    }
+    // her turn and his at once: each dancer reads its own
+    expect(way('leader', 'her and his')).toBe(1);
+    expect(way('follower', 'her and his')).toBe(-1);
+  });
+
+  it('prefers the candidates the figure asks for, outside a turn, as Python does', () => {
+    const figured = Float64Array.from(data.figured);
+    const k = data.figuredTurn.length;
+    expectClose(Array.from({ length: k }, (_, i) => plannedTurn(figured, i * OUTPUT_SIZE)), data.figuredTurn, 'planned turns');
+    const byName = (role: 'leader' | 'follower', name: string) => inputOf(role, cases(role).find((c) => c.name === name)!.figure);
+    const prefers = new Array<boolean>(k).fill(false);
+    const seen = new Set<string>();
+    for (const c of data.figurePrefers as { role: 'leader' | 'follower'; figureTurn: number | null; turnStart: number | null; figure: string | null; turning: boolean; prefers: boolean[] | null }[]) {
+      const chooser = new OnCount(c.role, 8, 1, 1, null, c.turnStart, c.figureTurn);
+      chooser.turning = c.turning;
+      const label = `${c.role} figureTurn ${c.figureTurn} turnStart ${c.turnStart} figure ${c.figure}${c.turning ? ' turning' : ''}`;
+      prefers.fill(false);
+      const got = chooser.prefers(figured, k, OUTPUT_SIZE, prefers, c.figure === null ? null : byName(c.role, c.figure));
+      expect(got, label).toBe(c.prefers !== null);
+      if (c.prefers !== null) expect(prefers, label).toEqual(c.prefers);
+      seen.add(JSON.stringify(c.prefers));
+    }
+    // the cases differ: none preferred, those turning little, each way's turns, turnStart's
+    expect(seen.size).toBeGreaterThanOrEqual(6);
+    expect(() => new OnCount('follower', 8, 1, 1, null, null, 0)).toThrow(/figureTurn/);
   });
 });

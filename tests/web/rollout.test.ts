@@ -1,10 +1,11 @@
 // web/mirror/rollout.ts against training/mirror/rollout.py: start pose, and four steps of the duet loop from the
 // procedural dancers (his own figure planned, a visitor's ask, steering, both inputs, outputs applied,
 // intention, and absurd outputs that reset a dancer: NaN, a root jump, a joint too far); the figures'
-// schedule on the count over 420 steps (his own drawn from a fixed list), their hands plan and bent path.
+// schedule on the count over 420 steps (his own, her turns and his, drawn from a fixed list), their hands
+// plan and bent path.
 
 import { describe, expect, it } from 'vitest';
-import { INPUT_SIZE, LEADER_INPUT_SIZE } from '../../web/mirror/features';
+import { type FigureName, INPUT_SIZE, LEADER_INPUT_SIZE } from '../../web/mirror/features';
 import * as R from '../../web/mirror/rollout';
 import { beatsPerStep } from '../../web/mirror/music';
 import { type Json, expectClose, fixture, trackOf } from './fixture';
@@ -19,8 +20,8 @@ function draws(numbers: number[]): { rng: () => number; used: () => number } {
   return { rng: () => numbers[used++], used: () => used };
 }
 
-/** Every figure as Python's fixture writes it: [way, start, end, asked]. */
-const ledState = (figures: R.Figures) => figures.led.map((x) => [x.way, x.start, x.end, x.asked]);
+/** Every figure as Python's fixture writes it: [name, way, start, end, asked]. */
+const ledState = (figures: R.Figures) => figures.led.map((x) => [x.name, x.way, x.start, x.end, x.asked]);
 
 /** A leader standing at frame 30 of the procedural track (his track: its frames 0..60). */
 function standingLeader(): R.Dancer {
@@ -40,8 +41,8 @@ function duetAt(frame: number, led: R.Led[], leader = standingLeader()): R.Duet 
   return { leader, followers: [leader], startPose: data.startPose, steering: new R.Steering(), frame, figures, tempo: 170, beat: 0 };
 }
 
-const led = (way: number, start: number, end: number, hands: number[] | null = null): R.Led =>
-  ({ way, start, end, asked: false, hands: hands === null ? null : Float64Array.from(hands) });
+const led = (name: FigureName, way: number, start: number, end: number, hands: number[] | null = null): R.Led =>
+  ({ name, way, start, end, asked: false, hands: hands === null ? null : Float64Array.from(hands) });
 
 function expectDancer(d: R.Dancer, expected: Json, label: string): void {
   const t = d.track;
@@ -162,7 +163,7 @@ describe('the figures', () => {
   const f = data.figures;
 
   it('constants match Python', () => {
-    expect([R.FIGURE_BEATS, [...R.OWN_GAP_BEATS], [...R.RAISE]]).toEqual([f.FIGURE_BEATS, f.OWN_GAP_BEATS, f.RAISE]);
+    expect([R.FIGURE_BEATS, [...R.OWN_GAP_BEATS], R.HIS_SHARE, [...R.RAISE]]).toEqual([f.FIGURE_BEATS, f.OWN_GAP_BEATS, f.HIS_SHARE, f.RAISE]);
   });
 
   it('framesToBeat and figureFrom keep to the count', () => {
@@ -172,16 +173,16 @@ describe('the figures', () => {
     clock.beat = c.beat;
     for (const t of c.framesToBeat) expect(R.framesToBeat(clock, t.frame, t.beat), `to beat ${t.beat} from ${t.frame}`).toBe(t.expected);
     for (const t of c.figureFrom) {
-      const x = R.figureFrom(clock, t.frame, t.way, t.asked);
-      expect([x.way, x.start, x.end, x.asked], `from ${t.frame}, way ${t.way}`).toEqual(t.expected);
+      const x = R.figureFrom(clock, t.frame, t.name, t.way, t.asked);
+      expect([x.name, x.way, x.start, x.end, x.asked], `${t.name} from ${t.frame}, way ${t.way}`).toEqual(t.expected);
     }
   });
 
   it('figureShare and raised over a figure', () => {
-    const [way, start, end] = f.led;
+    const [name, way, start, end] = f.led;
     for (const c of f.share) {
-      expect(R.figureShare(led(way, start, end), c.frame), `share at ${c.frame}`).toBeCloseTo(c.share, 12);
-      expect(R.raised(led(way, start, end), c.frame), `raised at ${c.frame}`).toBeCloseTo(c.raised, 12);
+      expect(R.figureShare(led(name, way, start, end), c.frame), `share at ${c.frame}`).toBeCloseTo(c.share, 12);
+      expect(R.raised(led(name, way, start, end), c.frame), `raised at ${c.frame}`).toBeCloseTo(c.raised, 12);
     }
   });
 
@@ -203,16 +204,19 @@ describe('the figures', () => {
       duet.beat += beatsPerStep(duet.tempo);
     });
     expect(d.used()).toBe(f.drawn);
+    // Every kind was led: her turn and his, each way.
+    const kinds = new Set((f.steps as { led: [string, number][] }[]).flatMap((s) => s.led.map(([n, w]) => `${n} ${w}`)));
+    expect([...kinds].sort()).toEqual(['her_turn -1', 'her_turn 1', 'his_turn -1', 'his_turn 1']);
   });
 
   it('handsInput raises his lead hand for a figure near, and lowers it after', () => {
     for (const c of data.handsInputs as Json[]) {
       const figures = c.two
-        ? (c.two as number[][]).map(([w, a, b], i) => led(w, a, b, c.hands[i]))
-        : [led(c.way, 40, 76, c.hands)];
+        ? (c.two as [FigureName, number, number, number][]).map(([n, w, a, b], i) => led(n, w, a, b, c.hands[i]))
+        : [led(c.name, c.way, 40, 76, c.hands)];
       const duet = duetAt(c.frame, figures);
       const moves = R.handsInput(duet);
-      const label = `hands plan, way ${c.way ?? 'two'} at ${c.frame}`;
+      const label = `hands plan, ${c.two ? JSON.stringify(c.two) : `${c.name} way ${c.way}`} at ${c.frame}`;
       if (c.moves === null) expect(moves, label).toBeNull();
       else expectClose(moves!, c.moves, label);
       if (!c.two) {
@@ -224,7 +228,7 @@ describe('the figures', () => {
 
   it('leadPlan bends his planned path for every figure near', () => {
     for (const c of data.leadPlans as Json[]) {
-      const duet = duetAt(c.frame, (c.figures as number[][]).map(([w, a, b]) => led(w, a, b)));
+      const duet = duetAt(c.frame, (c.figures as [FigureName, number, number, number][]).map(([n, w, a, b]) => led(n, w, a, b)));
       R.leadPlan(duet);
       const label = `bent path, ${JSON.stringify(c.figures)} at ${c.frame}`;
       expectClose(duet.leader.track.root, c.root, label);

@@ -2,13 +2,14 @@
 // space, compare mode, ghosts that leave the real state alone, resets on absurd output, leader
 // playback from a recording, foot locking on the drawn pose only, step timing.
 
-import { describe, expect, it } from 'vitest';
-import { FOLLOWER_INPUT_LAYOUT, INPUT_SIZE, LEADER_INPUT_LAYOUT, LEADER_INPUT_SIZE, OUTPUT_LAYOUT, OUTPUT_SIZE, Track, blockSlices } from '../../web/mirror/features';
-import { ANCHOR_FREE, ANCHOR_RATE, NOW } from '../../web/mirror/rollout';
+import { describe, expect, it, vi } from 'vitest';
+import { FIGURE_KINDS, FOLLOWER_INPUT_LAYOUT, INPUT_SIZE, LEADER_INPUT_LAYOUT, LEADER_INPUT_SIZE, OUTPUT_LAYOUT, OUTPUT_SIZE, Track, blockSlices, figureKind } from '../../web/mirror/features';
+import { ANCHOR_FREE, ANCHOR_RATE, NOW, figureFrom } from '../../web/mirror/rollout';
 import { type DuetSimulation, createSimulation } from '../../web/engine/simulation';
 import type { Motion } from '../../web/mirror/skeleton';
 import type { Manifest, StepPolicy } from '../../web/engine/types';
 import { ANKLE_FLOOR } from '../../web/mirror/footik';
+import { OnCount } from '../../web/mirror/on_count';
 import { fixture, trackOf } from './fixture';
 
 const data = fixture('rollout');
@@ -229,6 +230,36 @@ describe('createSimulation', () => {
     expect(plain.follow[0].batchSizes).toEqual([]);
   });
 
+  it('onCount.figureTurn: every dancer\'s chooser reads the figure in its own input; absent or 0, none does', async () => {
+    const ranges = { hip_low: 0.7, head_above_hip_low: 0.4, feet_wide: 1.07, angle_high: [2.5, 0.59] };
+    const counted = {
+      leaderTemperature: 0.5, guard: { samples: 4, margin: 0.05 }, leaderGuard: { samples: 4, margin: 0.05 },
+      onCount: { samples: 3, strength: 1, figureTurn: 180 }, plausibility: ranges,
+    };
+    const calls: { role: string; figureTurn: number | null; input: ArrayLike<number> | null | undefined }[] = [];
+    const spy = vi.spyOn(OnCount.prototype, 'prefers').mockImplementation(function (this: OnCount, ...args) {
+      calls.push({ role: this.role, figureTurn: this.figureTurn, input: args[4] });
+      return false;
+    });
+    try {
+      // a compare-mode duet: the leader and two followers, each with its chooser
+      const { sim, lead, follow } = simulation([{ role: 'follower' }, { role: 'follower' }], { role: 'leader' }, counted);
+      await sim.step(steer, 1);
+      expect(calls.map((c) => [c.role, c.figureTurn])).toEqual([['leader', 180], ['follower', 180], ['follower', 180]]);
+      expect(calls[0].input).toBe(lead.input);
+      expect(calls[1].input).toBe(follow[0].input);
+      expect(calls[2].input).toBe(follow[1].input);
+      for (const figureTurn of [undefined, 0]) {
+        calls.length = 0;
+        const older = simulation([{ role: 'follower' }], { role: 'leader' }, { ...counted, onCount: { samples: 3, strength: 1, figureTurn } });
+        await older.sim.step(steer, 1);
+        expect(calls.map((c) => c.figureTurn), `figureTurn ${figureTurn}`).toEqual([null, null]);
+      }
+    } finally {
+      spy.mockRestore();
+    }
+  });
+
   it('with keepPlan, a request draws his samples at once and keeps the standing one whose lead hand is nearest the plan', async () => {
     const ranges = { hip_low: 0.7, head_above_hip_low: 0.4, feet_wide: 1.07, angle_high: [2.5, 0.59] };
     const keep = { leaderTemperature: 0.5, leaderGuard: { samples: 4, margin: 0.05, keepPlan: true }, plausibility: ranges };
@@ -406,7 +437,7 @@ describe('figures', () => {
     const s = sim as DuetSimulation;
     let felt = 0;
     let danced = 0;
-    const ways = new Set<number>();
+    const kinds = new Set<string>();
     for (let i = 0; i < 300; i++) {
       await sim.step(steer, 0.5);
       const block = leaderFigure(lead);
@@ -416,8 +447,10 @@ describe('figures', () => {
       const figure = sim.figure;
       if (figure && !figure.coming) {
         danced++;
-        ways.add(figure.way);
+        kinds.add(`${figure.name} ${figure.way}`);
         expect(figure.asked).toBe(false);
+        // Both read it, as its kind, inside now (key 6).
+        expect(block[2 * (6 * FIGURE_KINDS.length + figureKind(figure.name, figure.way))], `step ${i}: ${figure.name} read`).toBe(1);
         expect(sim.turnAsked).toBe(0);
       }
       if (i === 150) {
@@ -427,16 +460,17 @@ describe('figures', () => {
         expect(followerFigure(rows, INPUT_SIZE)).toEqual(followerFigure(rows, 0));
       }
     }
-    expect(felt).toBeGreaterThan(60); // 10 s: a figure every 10 beats or so, each felt from a second before
+    expect(felt).toBeGreaterThan(60); // 10 s: a figure every 7 beats or so, each felt from a second before
     expect(danced).toBeGreaterThan(30);
+    expect(kinds.size).toBeGreaterThan(1);
     expect(s.duet.figures.led.every((x) => !x.asked)).toBe(true);
     // The same seed draws the same figures; reset() draws them anew from it.
     const again = simulation([{ role: 'follower' }]);
     for (let i = 0; i < 120; i++) await again.sim.step(steer, 0.5);
-    const first = (again.sim as DuetSimulation).duet.figures.led.map((x) => [x.way, x.start, x.end]);
+    const first = (again.sim as DuetSimulation).duet.figures.led.map((x) => [x.name, x.way, x.start, x.end]);
     again.sim.reset();
     for (let i = 0; i < 120; i++) await again.sim.step(steer, 0.5);
-    expect((again.sim as DuetSimulation).duet.figures.led.map((x) => [x.way, x.start, x.end])).toEqual(first);
+    expect((again.sim as DuetSimulation).duet.figures.led.map((x) => [x.name, x.way, x.start, x.end])).toEqual(first);
   });
 
   it('?figures=0: only the turns asked for; switched off, his own not begun yet go at once, switched on they come again', async () => {
@@ -457,13 +491,38 @@ describe('figures', () => {
     expect(sim.figure).toBeNull();
   });
 
+  it('his own turn: read as its kind, no hands plan for it, no turn asked; switched off before it begins, it goes', async () => {
+    const { sim, lead } = simulation([{ role: 'follower' }], { role: 'leader' }, {}, false);
+    const s = sim as DuetSimulation;
+    for (let i = 0; i < 10; i++) await sim.step(steer, 0.5);
+    s.duet.figures.led.push(figureFrom(s.duet, s.duet.frame, 'his_turn', 1, false));
+    expect(sim.figure).toMatchObject({ name: 'his_turn', way: 1, asked: false, coming: true });
+    expect(sim.turnAsked).toBe(0);
+    let dancing = 0;
+    for (let i = 0; i < 60; i++) {
+      await sim.step(steer, 0.5);
+      if (sim.figure && !sim.figure.coming) {
+        dancing++;
+        expect(sim.figure).toMatchObject({ name: 'his_turn', way: 1, asked: false });
+        expect(lead.input[blockSlices(LEADER_INPUT_LAYOUT).hands_plan.start]).toBe(0);
+        expect(leaderFigure(lead)[2 * (6 * FIGURE_KINDS.length + figureKind('his_turn', 1))]).toBe(1);
+        expect(sim.turnAsked).toBe(0);
+      }
+    }
+    // FIGURE_BEATS.his_turn at the manifest's tempo (170): 20 steps danced.
+    expect(dancing).toBe(Math.round(2 / (170 / 60 / 30)) + 1);
+    s.duet.figures.led.push(figureFrom(s.duet, s.duet.frame + 5, 'his_turn', -1, false));
+    sim.ownFigures = false;
+    expect(s.duet.figures.led.filter((x) => x.name === 'his_turn' && x.end >= s.duet.frame)).toEqual([]);
+  });
+
   it('askTurn: on the next beat, turnAsked from the ask until the figure ends, danced as asked', async () => {
     const { sim, lead } = simulation([{ role: 'follower' }], { role: 'leader' }, {}, false);
     for (let i = 0; i < 10; i++) await sim.step(steer, 0.5);
     expect(sim.turnAsked).toBe(0);
     expect(sim.askTurn(-1)).toBe(true);
     expect(sim.turnAsked).toBe(-1);
-    expect(sim.figure).toMatchObject({ way: -1, asked: true, coming: true });
+    expect(sim.figure).toMatchObject({ name: 'her_turn', way: -1, asked: true, coming: true });
     let steps = 0;
     let dancing = 0;
     while (sim.turnAsked !== 0) {
@@ -471,10 +530,10 @@ describe('figures', () => {
       steps++;
       if (sim.figure && !sim.figure.coming) {
         dancing++;
-        expect(sim.figure).toMatchObject({ way: -1, asked: true });
-        // A hands plan is shown, and both read her turn to her right (FIGURE_WAYS[1]) inside now (key 6).
+        expect(sim.figure).toMatchObject({ name: 'her_turn', way: -1, asked: true });
+        // A hands plan is shown, and both read her turn to her right inside now (key 6).
         expect(lead.input[blockSlices(LEADER_INPUT_LAYOUT).hands_plan.start]).toBe(1);
-        expect(leaderFigure(lead)[2 * (6 * 2 + 1)]).toBe(1);
+        expect(leaderFigure(lead)[2 * (6 * FIGURE_KINDS.length + figureKind('her_turn', -1))]).toBe(1);
       }
       expect(steps).toBeLessThan(100);
     }

@@ -32,6 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from ..evaluation.figures import HAND_RAISED, TURN_DEGREES, TURN_SECONDS, facing, turns
+from ..mirror.features import FIGURE_KINDS
 from ..mirror.skeleton import FPS, HANDS
 from .folders import default_data
 
@@ -113,9 +114,10 @@ def figures_of(lead_positions: np.ndarray, follow_positions: np.ndarray) -> list
 
 
 def figure_spans(lead_positions: np.ndarray, follow_positions: np.ndarray) -> np.ndarray:
-    """[M, 3] int (way, start, end) of every her_turn of one couple: the figures both networks read
-    (features.figure_block), labelled from the recording for training and evaluation."""
-    spans = [(f.way, f.start, f.end) for f in figures_of(lead_positions, follow_positions) if f.name == "her_turn"]
+    """[M, 3] int (kind, start, end) of every figure of one couple, kind an index into
+    features.FIGURE_KINDS: the figures both networks read (features.figure_block), labelled from
+    the recording for training and evaluation."""
+    spans = [(FIGURE_KINDS.index((f.name, f.way)), f.start, f.end) for f in figures_of(lead_positions, follow_positions)]
     return np.array(spans, dtype=np.int64).reshape(-1, 3)
 
 

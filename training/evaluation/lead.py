@@ -97,7 +97,7 @@ def lead_seen(detector: C.Detector | None, body: np.ndarray | None, direction: i
 def request_frames(frames: int) -> set[int]:
     """The frames of a duet of `frames` at which a request is made (one every REQUEST_EVERY seconds
     after WARM_UP, each with REQUEST_SECONDS left to be danced)."""
-    return set(range(int(WARM_UP * FPS), frames - int(REQUEST_SECONDS * FPS), int(REQUEST_EVERY * FPS)))
+    return set(range(int(WARM_UP * FPS), frames - int(REQUEST_SECONDS * FPS) + 1, int(REQUEST_EVERY * FPS)))
 
 
 def one_duet(manifest, leader, follower, temperature: float, seed: int, seconds: float,
@@ -264,7 +264,7 @@ def write_markdown(path: Path, res: dict) -> None:
          "## Requests", "",
          f"{s['requests']} requests, one every {REQUEST_EVERY:g} s after {WARM_UP:g} s; each danced "
          f"{REQUEST_SECONDS:g} s asked and, from the same moment with the same random stream, unasked.", "",
-         "| follower completes a turn within 2.5 s | share |", "|---|---|",
+         f"| follower completes a turn (300° within 2.5 s) within {REQUEST_SECONDS:g} s | share |", "|---|---|",
          f"| asked | {100 * s['turned']:.0f} % (the asked direction: {100 * s['turned_that_way']:.0f} %) |",
          f"| the same moments, unasked | {100 * s['turned_unasked']:.0f} % |",
          f"| ratio asked / unasked | {s['turned'] / s['turned_unasked']:.1f}× |" if s["turned_unasked"] else
@@ -274,7 +274,7 @@ def write_markdown(path: Path, res: dict) -> None:
             f"{s['his_turn']:+.0f} degrees the asked way ({s['his_turn_unasked']:+.0f} over the same moments unasked; "
             f"the recorded leader around her turns: `python -m training.evaluation.recorded_leads`).", ""]
            if s.get("his_turn") is not None else []),
-         f"His hand above {HAND_RAISED:g} m within 2.5 s: {100 * s['hand_raised']:.0f} % of the requests, "
+         f"His hand above {HAND_RAISED:g} m within {REQUEST_SECONDS:g} s: {100 * s['hand_raised']:.0f} % of the requests, "
          f"{100 * s['hand_raised_unasked']:.0f} % of the same moments unasked.", "",
          *([f"Her reading of his hand, unasked: she turns in {100 * s['turned_unasked_hand_up']:.0f} % of the moments "
             f"his hand went up and in {100 * s['turned_unasked_hand_down']:.0f} % of the others "

@@ -49,6 +49,10 @@ def add_options(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--on-count-hips", type=float, default=None, metavar="W",
                     help="m/s added to the footwork's miss of a candidate whose hips turn back; 0: the hips left alone, "
                          "and a turn's step the network's own (default: the manifest's onCount.hips)")
+    ap.add_argument("--on-count-figure", type=float, default=None, metavar="DEG",
+                    help="outside a turn, prefer the candidates that turn DEG degrees or more the way of the dancer's own "
+                         "turn the figure says runs, none while no figure runs (on_count.FIGURE_TURN); 0: off "
+                         "(default: the manifest's onCount.figureTurn)")
     ap.add_argument("--leader-guard", type=int, default=None, metavar="K",
                     help="the leader's upright guard with K samples (0: off; default: the manifest's "
                          "leaderGuard, acting at its margin)")
@@ -98,6 +102,10 @@ def resolve(args, manifest: dict) -> str | None:
         args.on_count_strength = float(on_count.get("strength", ON_COUNT_STRENGTH))
     if getattr(args, "on_count_hips", None) is None:
         args.on_count_hips = float(on_count.get("hips", ON_COUNT_HIPS))
+    if getattr(args, "on_count_figure", None) is None:
+        args.on_count_figure = float(on_count.get("figureTurn", 0.0))
+    if not args.on_count_figure >= 0:
+        return f"--on-count-figure {args.on_count_figure:g}: 0 (off) or more degrees"
     if args.on_count < 0 or args.on_count == 1:
         return f"--on-count {args.on_count}: 0 (off) or at least 2 samples to choose from"
     if not 0 <= args.on_count_strength <= 1:
@@ -158,7 +166,7 @@ def on_count_for(role: str, args) -> OnCount | None:
     if not samples:
         return None
     return OnCount(role, samples, getattr(args, "on_count_strength", ON_COUNT_STRENGTH),
-                   getattr(args, "on_count_hips", ON_COUNT_HIPS))
+                   getattr(args, "on_count_hips", ON_COUNT_HIPS), figure_turn=getattr(args, "on_count_figure", 0.0) or None)
 
 
 def restart_count(policy) -> None:

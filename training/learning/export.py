@@ -195,7 +195,8 @@ def write_manifest(out: Path, models: dict[str, StepModel], data: str, prepared:
                         **({"keepPlan": True} if LEADER_KEEP_PLAN else {})},
         # Both guards choose, every step, the sample whose footwork follows the count
         # (training/mirror/on_count.py, web/mirror/on_count.ts).
-        "onCount": {"samples": on_count.SAMPLES, "strength": on_count.STRENGTH, "hips": on_count.HIPS},
+        "onCount": {"samples": on_count.SAMPLES, "strength": on_count.STRENGTH, "hips": on_count.HIPS,
+                    "figureTurn": on_count.FIGURE_TURN},
         # The training dancers' range (evaluation.plausibility): soak counts a collapse against it
         # and training.evaluation.seeds judges every steered frame against it.
         "plausibility": plausibility_ranges(prepared),

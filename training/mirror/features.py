@@ -28,11 +28,12 @@ KEY_JOINTS_SIZE = KEYS * N_KEY_JOINTS * 3    # 90
 POSE_SIZE = N_JOINTS * 12                    # 204
 ROOT_UPDATE_SIZE = 3
 CONTACTS_SIZE = 2
-# The figure being led (figure_block): her turn to her left (way +1) or to her right (-1), read at
-# each key of the past second, now, and each key of the next second, as (inside, progress).
-FIGURE_WAYS = (1, -1)
+# The figure being led (figure_block), one of FIGURE_KINDS: her turn or his, to the dancer's left
+# (way +1, counterclockwise seen from above) or right (-1), read at each key of the past second,
+# now, and each key of the next second, as (inside, progress).
+FIGURE_KINDS = (("her_turn", 1), ("her_turn", -1), ("his_turn", 1), ("his_turn", -1))
 FIGURE_OFFSETS = np.arange(-KEYS, KEYS + 1) * KEY_STEP                 # t-30 ... t ... t+30
-FIGURE_SIZE = len(FIGURE_OFFSETS) * len(FIGURE_WAYS) * 2               # 52
+FIGURE_SIZE = len(FIGURE_OFFSETS) * len(FIGURE_KINDS) * 2              # 104
 HANDS_PLAN_SIZE = 1 + KEYS * len(HANDS) * 3  # 37: shown, then where each hand is to go at each key
 
 # (name, size) in order; docs/features.md explains each block.
@@ -54,8 +55,8 @@ OUTPUT_LAYOUT = [
     ("key_joints_future", KEY_JOINTS_SIZE), ("pose", POSE_SIZE), ("contacts", CONTACTS_SIZE),
 ]
 INTENTION_LAYOUT = [("partner_key_joints_future", KEY_JOINTS_SIZE)]
-INPUT_SIZE = sum(s for _, s in FOLLOWER_INPUT_LAYOUT)     # 765: the follower's input
-LEADER_INPUT_SIZE = sum(s for _, s in LEADER_INPUT_LAYOUT)  # 802: the same blocks, control, figure, hands plan, music
+INPUT_SIZE = sum(s for _, s in FOLLOWER_INPUT_LAYOUT)     # 817: the follower's input
+LEADER_INPUT_SIZE = sum(s for _, s in LEADER_INPUT_LAYOUT)  # 854: the same blocks, control, figure, hands plan, music
 OUTPUT_SIZE = sum(s for _, s in OUTPUT_LAYOUT)            # 323
 INTENTION_SIZE = KEY_JOINTS_SIZE                          # 90
 INPUT_SIZES = {"follower": INPUT_SIZE, "leader": LEADER_INPUT_SIZE}
@@ -200,8 +201,8 @@ def music_of(partner: Track, me: Track, frames: np.ndarray, music: np.ndarray | 
 
 def follower_input(partner: Track, me: Track, frames: np.ndarray, figure: np.ndarray | None = None,
                    music: np.ndarray | None = None) -> np.ndarray:
-    """Input I [N, 765] for the follower at `frames` (partner = leader, whose future is steered),
-    then the figure being led (figure_block's [N, 52]; None: none) and the music last
+    """Input I [N, 817] for the follower at `frames` (partner = leader, whose future is steered),
+    then the figure being led (figure_block's [N, 104]; None: none) and the music last
     (music_block's [N, 53]; None: the count the tracks carry)."""
     root, heading = me.root[frames], me.heading[frames]
     return np.concatenate([
@@ -218,21 +219,21 @@ def follower_input(partner: Track, me: Track, frames: np.ndarray, figure: np.nda
 
 
 def figure_block(figures: np.ndarray | None, frames: np.ndarray) -> np.ndarray:
-    """The figure being led [N, 52], which both dancers read: at each of FIGURE_OFFSETS from each
-    frame (the past second, now, the next second), for each of FIGURE_WAYS, `inside` (1 while a
-    figure of that way runs) and `progress` (0 at its start to 1 at its end; 0 outside).
+    """The figure being led [N, 104], which both dancers read: at each of FIGURE_OFFSETS from each
+    frame (the past second, now, the next second), for each of FIGURE_KINDS, `inside` (1 while a
+    figure of that kind runs) and `progress` (0 at its start to 1 at its end; 0 outside).
 
-    `figures` [M, 3] holds (way, start, end) per figure, in the frames of `frames` (a figure runs
-    from its start to its end frame, both included); None or empty: no figure. In training they
-    are the recorded couple's (training/data/led_figures.py: her turns, from his preparation to her
-    finish); at run time the visitor's and the leader's own (rollout.Figures). A salsa lead reaches
-    the follower through the joined hands, which a capture of positions does not hold: this block
-    stands for what her hand feels and his hand does. It asks nothing of her body or timing."""
+    `figures` [M, 3] holds (kind, start, end) per figure, kind an index into FIGURE_KINDS, start
+    and end in the frames of `frames` (both danced); None or empty: no figure. In training they
+    are the recorded couple's (training/data/led_figures.py: her turns from his preparation to her
+    finish, his own turns); at run time the visitor's and the leader's own (rollout.Figures). A
+    salsa lead reaches the follower through the joined hands, which a capture of positions does
+    not hold: this block stands for what her hand feels and his hand does. It asks nothing of her
+    body or timing."""
     frames = np.asarray(frames)
-    out = np.zeros((len(frames), len(FIGURE_OFFSETS), len(FIGURE_WAYS), 2))
+    out = np.zeros((len(frames), len(FIGURE_OFFSETS), len(FIGURE_KINDS), 2))
     t = frames[:, None] + FIGURE_OFFSETS[None]
-    for way, start, end in (np.zeros((0, 3)) if figures is None else np.asarray(figures)):
-        w = FIGURE_WAYS.index(1 if way > 0 else -1)
+    for w, start, end in (np.zeros((0, 3), np.int64) if figures is None else np.asarray(figures, np.int64)):
         inside = (t >= start) & (t <= end)
         out[..., w, 0] = np.maximum(out[..., w, 0], inside)
         out[..., w, 1] = np.where(inside, (t - start) / max(end - start, 1), out[..., w, 1])
@@ -264,8 +265,8 @@ def hands_moves(me: Track, frames: np.ndarray) -> np.ndarray:
 
 def leader_input(partner: Track, me: Track, frames: np.ndarray, figure: np.ndarray | None = None,
                  hands_plan: np.ndarray | None = None, music: np.ndarray | None = None) -> np.ndarray:
-    """Input I [N, 802] for the leader (partner = follower, control = own future trajectory, then
-    the figure being led: figure_block's [N, 52], and the hands plan: hands_plan_block's [N, 37],
+    """Input I [N, 854] for the leader (partner = follower, control = own future trajectory, then
+    the figure being led: figure_block's [N, 104], and the hands plan: hands_plan_block's [N, 37],
     none when not given; the music last, as the follower's)."""
     root, heading = me.root[frames], me.heading[frames]
     return np.concatenate([

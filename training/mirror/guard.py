@@ -258,7 +258,7 @@ class UprightGuard:
             steps = drawn_steps(many["output"], joints, x, self.on_count.role)
             best = nearest_count(drawn_footwork(steps), hips_turn_back(steps, x, self.on_count.role), target, standing,
                                  self.margin, self.on_count.hips, self.on_count.keeps(many["output"]),
-                                 self.on_count.prefers(many["output"]))
+                                 self.on_count.prefers(many["output"], x))
             if best >= 0:
                 return {k: v[best:best + 1] for k, v in many.items()}
             self.guarded += 1

@@ -38,16 +38,19 @@ ANCHOR_FREE = 0.75         # m around the anchor where a leader nobody steers is
 LEASH_DISTANCE = 2.0       # m: beyond this a follower is drawn toward its leader ...
 LEASH_RATE = 0.1           # ... closing this share of the excess every frame
 START_DISTANCE = 0.8       # m between the partners at the start and after a reset
-# The figures both dancers read (features.figure_block, rollout.Figures): her turn, one way or the
-# other, from his preparation to her finish, FIGURE_BEATS long. The recorded her turns last a
-# median 3.3 beats (10-90 %: 2.0-8.2; training/data/led_figures.py), 16.9 a minute, and start
-# anywhere in the two-beat group (4 7 6 9 7 9 4 10 per quarter beat): a figure asked for starts on
-# the next whole beat (under 0.4 s of waiting at 170 beats a minute), or when the figure running
-# ends. Nobody asking, the leader leads figures of his own (Figures.own): after each figure he waits
-# OWN_GAP_BEATS (drawn uniformly) and leads the next, either way alike (27 left / 29 right in the
-# recording), so a figure begins every 10 beats on average, as the recorded 16.9 a minute at 170.
-FIGURE_BEATS = 3.5
-OWN_GAP_BEATS = (1.0, 12.0)
+# The figures both dancers read (features.figure_block, rollout.Figures): her turn, from his
+# preparation to her finish, or his own turn, one way or the other, FIGURE_BEATS long. In the
+# recording (training/data/led_figures.py) her turns last a median 3.3 beats (10-90 %: 2.0-8.2),
+# 16.9 a minute, his 2.0 beats, 6.3 a minute, and both start anywhere in the two-beat group (her
+# turns 4 7 6 9 7 9 4 10 per quarter beat): a figure the visitor asks for (her turn) starts on the
+# next whole beat (under 0.4 s of waiting at 170 beats a minute), or when the figure running ends.
+# Nobody asking, the leader leads figures of his own (Figures.own): after each figure he waits
+# OWN_GAP_BEATS (drawn uniformly) and leads the next, his own turn in HIS_SHARE of them, either way
+# alike: a figure every 7.2 beats on average (the wait for a beat included), as the recorded 23 a
+# minute at 170 (16.9 hers, 6.3 his; plan_figures alone for an hour: 16.9 and 6.6).
+FIGURE_BEATS = {"her_turn": 3.5, "his_turn": 2.0}
+OWN_GAP_BEATS = (0.5, 6.5)
+HIS_SHARE = 0.27
 # A figure also becomes his hands plan (features.hands_plan_block): his lead hand (the left for
 # her turn to the left, +1, the right for -1) rises above his head and comes down again, the other
 # stays where it was. In the recording (training.evaluation.recorded_leads) his higher hand peaks
@@ -207,9 +210,11 @@ def steer_plan(leader: Dancer, steering: Steering, stick: np.ndarray) -> None:
 
 @dataclass
 class Led:
-    """One figure the leader leads: her turn to her left (way +1, counterclockwise seen from above)
-    or to her right (-1), from duet frame `start` to `end` (both danced); `asked` when the visitor
-    asked for it; `hands`: his hands (left, right) in his root space when his plan for it began."""
+    """One figure the leader leads: `name` her_turn or his_turn, to the dancer's left (way +1,
+    counterclockwise seen from above) or right (-1), from duet frame `start` to `end` (both
+    danced); `asked` when the visitor asked for it; `hands`: his hands (left, right) in his root
+    space when his plan for it began."""
+    name: str
     way: int
     start: int
     end: int
@@ -230,9 +235,10 @@ class Figures:
         return next((f for f in self.led if f.start <= frame <= f.end), None)
 
     def spans(self, frame: int) -> np.ndarray:
-        """[M, 3] (way, start, end) of every figure, in the frames of a track whose NOW is `frame`."""
-        return np.array([(f.way, f.start - frame + NOW, f.end - frame + NOW) for f in self.led],
-                        dtype=np.int64).reshape(-1, 3)
+        """[M, 3] (kind, start, end) of every figure (features.figure_block), in the frames of a
+        track whose NOW is `frame`."""
+        return np.array([(feat.FIGURE_KINDS.index((f.name, f.way)), f.start - frame + NOW, f.end - frame + NOW)
+                         for f in self.led], dtype=np.int64).reshape(-1, 3)
 
 
 def frames_to_beat(duet: "Duet", at_frame: int, beat: float) -> int:
@@ -241,12 +247,12 @@ def frames_to_beat(duet: "Duet", at_frame: int, beat: float) -> int:
     return at_frame + max(0, int(np.ceil((beat - now) / music.beats_per_step(duet.tempo) - 1e-9)))
 
 
-def figure_from(duet: "Duet", frame: int, way: int, asked: bool) -> Led:
-    """A figure of `way` starting at the first whole beat of the count at or after `frame`."""
+def figure_from(duet: "Duet", frame: int, name: str, way: int, asked: bool) -> Led:
+    """A figure `name` of `way` starting at the first whole beat of the count at or after `frame`."""
     per = music.beats_per_step(duet.tempo)
     beat = duet.beat + (frame - duet.frame) * per
     start = frames_to_beat(duet, frame, np.ceil(beat - 1e-9))
-    return Led(1 if way >= 0 else -1, start, start + int(round(FIGURE_BEATS / per)), asked)
+    return Led(name, 1 if way >= 0 else -1, start, start + int(round(FIGURE_BEATS[name] / per)), asked)
 
 
 def ask_turn(duet: "Duet", direction: int) -> None:
@@ -255,7 +261,7 @@ def ask_turn(duet: "Duet", direction: int) -> None:
     f = duet.figures
     f.led = [x for x in f.led if x.start <= duet.frame]
     after = max([duet.frame] + [x.end + 1 for x in f.led])
-    f.led.append(figure_from(duet, after, direction, True))
+    f.led.append(figure_from(duet, after, "her_turn", direction, True))
 
 
 def plan_figures(duet: "Duet") -> None:
@@ -266,15 +272,17 @@ def plan_figures(duet: "Duet") -> None:
     if not f.own or any(x.end >= duet.frame for x in f.led):
         return
     last = max([x.end + 1 for x in f.led], default=duet.frame)
-    # Two uniform draws, in this order (the page's mirror draws the same): the wait, then the way.
+    # Three uniform draws, in this order (the page's mirror draws the same): the wait, whose turn,
+    # and its way.
     gap = OWN_GAP_BEATS[0] + (OWN_GAP_BEATS[1] - OWN_GAP_BEATS[0]) * f.rng.random()
+    name = "his_turn" if f.rng.random() < HIS_SHARE else "her_turn"
     way = 1 if f.rng.random() < 0.5 else -1
     start = frames_to_beat(duet, last, duet.beat + (last - duet.frame) * music.beats_per_step(duet.tempo) + gap)
-    f.led.append(figure_from(duet, max(start, duet.frame + 1), way, False))
+    f.led.append(figure_from(duet, max(start, duet.frame + 1), name, way, False))
 
 
 def figure_share(led: Led, frame: float) -> float:
-    """How much of her turn is planned done at `frame`, 0 to 1 (smoothstep over the figure)."""
+    """How much of the figure's turn is planned done at `frame`, 0 to 1 (smoothstep over it)."""
     u = min(1.0, max(0.0, (frame - led.start) / max(led.end - led.start, 1)))
     return u * u * (3 - 2 * u)
 
@@ -290,7 +298,8 @@ def planning(duet: "Duet") -> Led | None:
     """The figure his hands plan is for: the one danced now or beginning within the next second,
     else one whose raise is coming down. A figure that follows another at once takes the plan
     over as soon as the one before ends."""
-    near = [x for x in duet.figures.led if x.start - HISTORY <= duet.frame <= x.end + int(RAISE[1] * FPS)]
+    near = [x for x in duet.figures.led if x.name == "her_turn"
+            and x.start - HISTORY <= duet.frame <= x.end + int(RAISE[1] * FPS)]
     return next((x for x in near if x.end >= duet.frame), near[0] if near else None)
 
 
@@ -313,18 +322,20 @@ def hands_input(duet: "Duet") -> np.ndarray | None:
 
 
 def lead_plan(duet: "Duet") -> None:
-    """While a figure is danced or about to be, bend the leader's planned path (after steer_plan)
-    so that it leads her turn's way: from now to each future key it turns LEAD_TURN degrees and
-    moves LEAD_SIDE metres to his other side, times the share of her turn planned between them."""
+    """While a figure is danced or about to be, bend the leader's planned path (after steer_plan):
+    for her turn it turns LEAD_TURN degrees her way and moves LEAD_SIDE metres to his other side,
+    for his own turn it turns a full turn his way, from now to each future key times the share of
+    the turn planned between them."""
     t = duet.leader.track
     h = t.heading[NOW]
     his_left = np.array([np.cos(h), -np.sin(h)])   # his root space's +x on the floor (x, z)
     for led in duet.figures.led:
+        turn, side = (np.radians(LEAD_TURN), LEAD_SIDE) if led.name == "her_turn" else (2 * np.pi, 0.0)
         for off in FUTURE_OFFSETS:
             share = figure_share(led, duet.frame + off) - figure_share(led, duet.frame)
             if share:
-                t.heading[NOW + off] += led.way * np.radians(LEAD_TURN) * share
-                t.root[NOW + off] -= led.way * LEAD_SIDE * share * his_left
+                t.heading[NOW + off] += led.way * turn * share
+                t.root[NOW + off] -= led.way * side * share * his_left
 
 
 def shift_dancer(d: Dancer, shift: np.ndarray) -> None:

@@ -95,7 +95,7 @@ export class DuetSimulation implements Simulation {
   private turnBack: boolean[] = [];
   /** Which of the chooser's samples keep her spin (on_count.ts OnCount.keeps), while she spins. */
   private keeps: boolean[] = [];
-  /** Which of them start a turn (OnCount.prefers), outside her spins. */
+  /** Which of them the figure being led asks for (OnCount.prefers, from the dancer's input), outside a turn. */
   private prefers: boolean[] = [];
   private readonly body = new Float64Array(3 * N_JOINTS);
   private readonly steps = new Float64Array(3 * STEPPED.length);
@@ -134,8 +134,12 @@ export class DuetSimulation implements Simulation {
     const lg = manifest.leaderGuard;
     this.leaderGuard = lg && lg.samples >= 2 && manifest.plausibility ? { settings: lg, ranges: manifest.plausibility } : null;
     const oc = manifest.onCount && manifest.onCount.samples >= 2 ? manifest.onCount : null;
-    this.leaderOnCount = oc && this.leaderGuard ? new OnCount('leader', oc.samples, oc.strength, oc.hips) : null;
-    this.followerOnCount = followers.map(() => (oc && this.uprightGuard ? new OnCount('follower', oc.samples, oc.strength, oc.hips) : null));
+    // The figure being led read by the choice (on_count.ts figureWay): figureTurn's degrees asked of a
+    // candidate; absent (older exports) or 0: off.
+    const figureTurn = oc?.figureTurn || null;
+    this.leaderOnCount = oc && this.leaderGuard ? new OnCount('leader', oc.samples, oc.strength, oc.hips, null, null, figureTurn) : null;
+    this.followerOnCount = followers.map(() =>
+      (oc && this.uprightGuard ? new OnCount('follower', oc.samples, oc.strength, oc.hips, null, null, figureTurn) : null));
     this.own = options.figures ?? true;
     this.duet = this.startDuet(null);
     this.shownBeat = this.duet.beat;
@@ -201,18 +205,18 @@ export class DuetSimulation implements Simulation {
     const view = this.figureView;
     if (!led) return (this.figureView = null);
     const coming = led.start > shown;
-    if (view && view.way === led.way && view.asked === led.asked && view.coming === coming) return view;
-    return (this.figureView = { way: led.way, asked: led.asked, coming });
+    if (view && view.name === led.name && view.way === led.way && view.asked === led.asked && view.coming === coming) return view;
+    return (this.figureView = { name: led.name, way: led.way, asked: led.asked, coming });
   }
 
   get anchor(): ArrayLike<number> {
     return this.duet.steering.anchor;
   }
 
-  /** The way of a figure the visitor asked for, planned or being danced (0: none). */
+  /** The way of her turn the visitor asked for, planned or being danced (0: none). */
   get turnAsked(): number {
     const shown = this.duet.frame - 1;
-    return this.duet.figures.led.find((x) => x.asked && x.end >= shown)?.way ?? 0;
+    return this.duet.figures.led.find((x) => x.asked && x.name === 'her_turn' && x.end >= shown)?.way ?? 0;
   }
 
   /** The count of the last step taken (the one on screen); duet.beat is the next step's. */
@@ -324,7 +328,8 @@ export class DuetSimulation implements Simulation {
 
   /** The standing candidate of the chooser's draws whose drawn footwork is nearest the target (none
    *  while the dancer turns), a candidate whose hips turn back passed over unless the others miss by
-   *  onCount.hips more (on_count.ts nearestCount); -1 when none stands. Each body is drawn once for both judgements,
+   *  onCount.hips more, the candidates the figure in the dancer's input asks for preferred (on_count.ts
+   *  nearestCount, OnCount.prefers); -1 when none stands. Each body is drawn once for both judgements,
    *  into arrays kept between steps. */
   private nearestOnCount(
     onCount: OnCount, output: ArrayLike<number>, input: ArrayLike<number>, target: number | null, ranges: Ranges,
@@ -345,7 +350,7 @@ export class DuetSimulation implements Simulation {
       this.turnBack[n] = hipsTurnBack(this.steps, input, onCount.role);
     }
     const spinning = onCount.keeps(output, k, OUTPUT_SIZE, this.keeps);
-    const starting = onCount.prefers(output, k, OUTPUT_SIZE, this.prefers);
+    const starting = onCount.prefers(output, k, OUTPUT_SIZE, this.prefers, input);
     return nearestCount(this.footwork, this.turnBack, k, target, this.standing, margin, onCount.hips,
       spinning ? this.keeps : null, starting ? this.prefers : null);
   }

@@ -2,6 +2,7 @@
 // The shell only ever talks to a `Simulation`; what happens inside one step (features, both
 // models, pose) is the simulation's business.
 
+import type { FigureName } from '../mirror/features';
 import type { GuardSettings, Ranges } from '../mirror/guard';
 import type { OnCountSettings } from '../mirror/on_count';
 import type { Motion } from '../mirror/skeleton';
@@ -40,7 +41,9 @@ export interface DancerView {
 
 /** A figure the leader leads (web/mirror/rollout.ts Led), as the page shows it. */
 export interface FigureView {
-  /** Her turn to her left (+1, counterclockwise seen from above) or to her right (-1). */
+  /** Her turn, or his own. */
+  name: FigureName;
+  /** The turning dancer's left (+1, counterclockwise seen from above) or right (-1). */
   way: number;
   /** Whether the visitor asked for it (else it is one of his own). */
   asked: boolean;
@@ -54,7 +57,7 @@ export interface Simulation {
   /** Ask the leader model to lead her turn (-1 her right, +1 her left) on the next beat, or after
    *  the figure running; false while a file leads. */
   askTurn(direction: number): boolean;
-  /** The way of a turn the visitor asked for, planned or being led: -1, +1, or 0 when none. */
+  /** The way of her turn the visitor asked for, planned or being led: -1, +1, or 0 when none. */
   readonly turnAsked: number;
   /** Whether the leader leads figures of his own (?figures=1); set: from the next step on. */
   ownFigures: boolean;
@@ -184,8 +187,9 @@ export interface Manifest {
   guard?: GuardSettings;
   /** The leader's upright guard, the same with its own margin; absent: no guard. */
   leaderGuard?: GuardSettings;
-  /** Both guards' choice on the count (web/mirror/on_count.ts): samples each step and the pull's
-   *  strength; absent: each dancer takes its one sample. */
+  /** Both guards' choice on the count (web/mirror/on_count.ts): samples each step, the pull's
+   *  strength, the hips' weight and figureTurn (the turn the figure being led asks of a sample;
+   *  absent or 0: the figure not read); absent: each dancer takes its one sample. */
   onCount?: OnCountSettings;
   /** The recording's range (training/evaluation/plausibility.py); the guard judges against it. */
   plausibility?: Ranges;
@@ -210,10 +214,10 @@ export interface DancerHook {
   outline?: [number, number][] | null;
 }
 
-/** A figure in the test hook: its name, her way (left: counterclockwise seen from above), and
- *  whether the visitor asked for it. */
+/** A figure in the test hook: its name (her turn or his), the turning dancer's way (left:
+ *  counterclockwise seen from above), and whether the visitor asked for it. */
 export interface FigureHook {
-  name: 'her_turn';
+  name: FigureName;
   way: 'left' | 'right';
   asked: boolean;
 }
@@ -238,7 +242,7 @@ export interface DuetHook {
   /** Ask the leader to lead her turn, as T does (-1 her right, +1 her left): it starts on the next
    *  beat, or after the figure running; false before the dance starts or while a file leads. */
   askTurn?: (direction: number) => boolean;
-  /** The way of a turn the visitor asked for, planned or being led: -1, +1, or 0 when none. */
+  /** The way of her turn the visitor asked for, planned or being led: -1, +1, or 0 when none. */
   turnAsked?: number;
   /** The figure being danced on the step on screen (asked for or his own), or null. */
   figure?: FigureHook | null;

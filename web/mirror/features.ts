@@ -25,11 +25,20 @@ export const KEY_JOINTS_SIZE = KEYS * N_KEY_JOINTS * 3; // 90
 export const POSE_SIZE = N_JOINTS * 12; // 204
 export const ROOT_UPDATE_SIZE = 3;
 export const CONTACTS_SIZE = 2;
-// The figure being led (figureBlock): her turn to her left (way +1) or to her right (-1), read at
-// each key of the past second, now, and each key of the next second, as (inside, progress).
-export const FIGURE_WAYS: readonly number[] = [1, -1];
+// The figure being led (figureBlock), one of FIGURE_KINDS: her turn or his, to the dancer's left
+// (way +1, counterclockwise seen from above) or right (-1), read at each key of the past second,
+// now, and each key of the next second, as (inside, progress).
+export type FigureName = 'her_turn' | 'his_turn';
+export const FIGURE_KINDS: ReadonlyArray<readonly [FigureName, number]> = [
+  ['her_turn', 1], ['her_turn', -1], ['his_turn', 1], ['his_turn', -1],
+];
+/** The index into FIGURE_KINDS of figure `name` of `way` (Python's FIGURE_KINDS.index((name, way))); allocates nothing. */
+export function figureKind(name: FigureName, way: number): number {
+  for (let k = 0; k < FIGURE_KINDS.length; k++) if (FIGURE_KINDS[k][0] === name && FIGURE_KINDS[k][1] === way) return k;
+  throw new Error(`no figure kind (${name}, ${way})`);
+}
 export const FIGURE_OFFSETS: readonly number[] = Array.from({ length: 2 * KEYS + 1 }, (_, i) => (i - KEYS) * KEY_STEP); // t-30 ... t ... t+30
-export const FIGURE_SIZE = FIGURE_OFFSETS.length * FIGURE_WAYS.length * 2; // 52
+export const FIGURE_SIZE = FIGURE_OFFSETS.length * FIGURE_KINDS.length * 2; // 104
 export const HANDS_PLAN_SIZE = 1 + KEYS * HANDS.length * 3; // 37: shown, then where each hand is to go at each key
 
 export type Layout = ReadonlyArray<readonly [string, number]>;
@@ -54,8 +63,8 @@ export const OUTPUT_LAYOUT: Layout = [
 ];
 export const INTENTION_LAYOUT: Layout = [['partner_key_joints_future', KEY_JOINTS_SIZE]];
 const layoutSize = (layout: Layout) => layout.reduce((sum, [, size]) => sum + size, 0);
-export const INPUT_SIZE = layoutSize(FOLLOWER_INPUT_LAYOUT); // 765: the follower's input
-export const LEADER_INPUT_SIZE = layoutSize(LEADER_INPUT_LAYOUT); // 802: the same blocks, control, figure, hands plan, music
+export const INPUT_SIZE = layoutSize(FOLLOWER_INPUT_LAYOUT); // 817: the follower's input
+export const LEADER_INPUT_SIZE = layoutSize(LEADER_INPUT_LAYOUT); // 854: the same blocks, control, figure, hands plan, music
 export const OUTPUT_SIZE = layoutSize(OUTPUT_LAYOUT); // 323
 export const INTENTION_SIZE = KEY_JOINTS_SIZE; // 90
 export const INPUT_SIZES: Readonly<Record<string, number>> = { follower: INPUT_SIZE, leader: LEADER_INPUT_SIZE };
@@ -351,27 +360,27 @@ const INPUT_BLOCKS: Record<string, InputBlock> = {
 };
 
 /**
- * The figure being led [52] at out[at..], which both dancers read: at each of FIGURE_OFFSETS from
- * frame t (the past second, now, the next second), for each of FIGURE_WAYS, `inside` (1 while a
- * figure of that way runs) and `progress` (0 at its start to 1 at its end; 0 outside).
+ * The figure being led [104] at out[at..], which both dancers read: at each of FIGURE_OFFSETS
+ * from frame t (the past second, now, the next second), for each of FIGURE_KINDS, `inside` (1
+ * while a figure of that kind runs) and `progress` (0 at its start to 1 at its end; 0 outside).
  *
- * `figures` holds (way, start, end) per figure, flat, in the frames of t (a figure runs from its
- * start to its end frame, both included); null or empty: no figure. At run time they are the
+ * `figures` holds (kind, start, end) per figure, flat, kind an index into FIGURE_KINDS, start and
+ * end in the frames of t (both danced); null or empty: no figure. At run time they are the
  * visitor's and the leader's own (rollout.ts Figures). A salsa lead reaches the follower through
  * the joined hands, which a capture of positions does not hold: this block stands for what her
  * hand feels and his hand does. It asks nothing of her body or timing.
  */
 export function figureBlock(figures: ArrayLike<number> | null, t: number, out: Out, at = 0): void {
-  const ways = FIGURE_WAYS.length;
+  const kinds = FIGURE_KINDS.length;
   for (let i = 0; i < FIGURE_SIZE; i++) out[at + i] = 0;
   const n = figures ? figures.length / 3 : 0;
   for (let m = 0; m < n; m++) {
-    const way = figures![3 * m], start = figures![3 * m + 1], end = figures![3 * m + 2];
-    const w = FIGURE_WAYS.indexOf(way > 0 ? 1 : -1);
+    const w = figures![3 * m], start = figures![3 * m + 1], end = figures![3 * m + 2];
+    if (!(Number.isInteger(w) && w >= 0 && w < kinds)) throw new Error(`figure kind ${w} is not an index into FIGURE_KINDS`);
     for (let k = 0; k < FIGURE_OFFSETS.length; k++) {
       const f = t + FIGURE_OFFSETS[k];
       if (f < start || f > end) continue;
-      const o = at + 2 * (k * ways + w);
+      const o = at + 2 * (k * kinds + w);
       out[o] = 1;
       out[o + 1] = (f - start) / Math.max(end - start, 1);
     }
@@ -422,7 +431,7 @@ function copyMusic(music: ArrayLike<number> | null, partner: Track, me: Track, o
   }
 }
 
-/** The figure block given (figureBlock's [52]) over the zeros the layout wrote; null: none. */
+/** The figure block given (figureBlock's [104]) over the zeros the layout wrote; null: none. */
 function copyFigure(figure: ArrayLike<number> | null, out: Out, at: number): void {
   if (figure) for (let i = 0; i < FIGURE_SIZE; i++) out[at + i] = figure[i];
 }
@@ -430,8 +439,8 @@ function copyFigure(figure: ArrayLike<number> | null, out: Out, at: number): voi
 const FOLLOWER_FIGURE_AT = blockSlices(FOLLOWER_INPUT_LAYOUT).figure.start;
 
 /**
- * Input I [765] for the follower at frame t (partner = leader, whose future is steered), then the
- * figure being led (figureBlock's [52]; null: none) and the music last (musicBlock's [53]; null:
+ * Input I [817] for the follower at frame t (partner = leader, whose future is steered), then the
+ * figure being led (figureBlock's [104]; null: none) and the music last (musicBlock's [53]; null:
  * the count the tracks carry).
  */
 export function followerInput(
@@ -447,8 +456,8 @@ const LEADER_FIGURE_AT = blockSlices(LEADER_INPUT_LAYOUT).figure.start;
 const HANDS_PLAN_AT = blockSlices(LEADER_INPUT_LAYOUT).hands_plan.start;
 
 /**
- * Input I [802] for the leader (partner = follower, control = own future trajectory, then the
- * figure being led: figureBlock's [52], and the hands plan: handsPlanBlock of `handsPlan`, none
+ * Input I [854] for the leader (partner = follower, control = own future trajectory, then the
+ * figure being led: figureBlock's [104], and the hands plan: handsPlanBlock of `handsPlan`, none
  * when null; the music last, as the follower's).
  */
 export function leaderInput(

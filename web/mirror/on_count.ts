@@ -11,12 +11,20 @@
 // velocities the network writes beside them, which follow the drawn ankles only loosely. A sample
 // whose hips turn back the way they came has `hips` m/s added to its miss: the networks' own hips
 // turn back far more often than the recorded dancers'. While a dancer turns faster than TURNING (a
-// fast spin), its footwork is left to the network and only its hips are weighed. OnCount's spinKeep
+// fast spin), its footwork is left to the network and only its hips are weighed. Outside a turn the
+// choice also reads the figure being led (the input's figure block, what the hands carry; figureTurn,
+// FIGURE_TURN): while a turn of the dancer's own runs or begins within FIGURE_AHEAD keys (hers for the
+// follower, his own for the leader), the candidates whose planned path turns FIGURE_TURN degrees or
+// more its way are preferred; while no figure runs or comes, those that turn less either way. Read by
+// the networks alone, the figure moved her turns little (on_count.py has the numbers). OnCount's spinKeep
 // and turnStart (keepsSpin, startsTurn) are two choices measured and not shipped, which the page
 // never sets (on_count.py says why they stay). Every candidate is the network's own reaction from
 // the same state: nothing jumps, and nobody's input changes.
 
-import { FOLLOWER_INPUT_LAYOUT, KEY_STEP, KEYS, LEADER_INPUT_LAYOUT, OUTPUT_LAYOUT, POSE_SIZE, blockSlices } from './features';
+import {
+  FIGURE_KINDS, FIGURE_OFFSETS, FOLLOWER_INPUT_LAYOUT, type FigureName, KEY_STEP, KEYS, LEADER_INPUT_LAYOUT, OUTPUT_LAYOUT, POSE_SIZE,
+  blockSlices,
+} from './features';
 import { MUSIC_OFFSETS, MUSIC_SIZE } from './music';
 import { FEET, FPS, N_JOINTS } from './skeleton';
 
@@ -30,13 +38,19 @@ export const TURNING: Readonly<Record<Role, number>> = { leader: 1.5, follower: 
 export const HIPS = 1.0;
 /** m a frame (6 cm/s): a shorter step of the hips stands still, and turns no way. */
 export const STILL = 0.002;
+/** Degrees over the next second: a candidate whose planned path turns this much starts a turn. */
+export const FIGURE_TURN = 120.0;
+/** Future keys (of KEY_STEP frames) within which a figure coming counts as running. */
+export const FIGURE_AHEAD = 2;
 
-/** The manifest's "onCount": samples each step, how far the footwork aimed at swings (0-1), and what
- *  a candidate whose hips turn back adds to its miss (m/s; HIPS when absent). */
+/** The manifest's "onCount": samples each step, how far the footwork aimed at swings (0-1), what
+ *  a candidate whose hips turn back adds to its miss (m/s; HIPS when absent), and the turn (degrees)
+ *  the figure being led asks of a candidate (FIGURE_TURN; absent or 0: the figure is not read). */
 export interface OnCountSettings {
   samples: number;
   strength: number;
   hips?: number;
+  figureTurn?: number;
 }
 
 export type Role = 'leader' | 'follower';
@@ -60,6 +74,14 @@ export const POSITION_IN: Readonly<Record<Role, readonly number[]>> = {
   follower: STEPPED.map((j) => blockSlices(FOLLOWER_INPUT_LAYOUT).self_pose.start + POSE_JOINT * j),
 };
 const ROOT_UPDATE_OUT = blockSlices(OUTPUT_LAYOUT).root_update.start;
+/** Where each role's input holds the figure block (features.ts figureBlock). */
+export const FIGURE_IN: Readonly<Record<Role, number>> = {
+  leader: blockSlices(LEADER_INPUT_LAYOUT).figure.start,
+  follower: blockSlices(FOLLOWER_INPUT_LAYOUT).figure.start,
+};
+/** The figure kinds that are the dancer's own turn: hers for the follower, his own for the leader. */
+export const OWN_TURN: Readonly<Record<Role, FigureName>> = { leader: 'his_turn', follower: 'her_turn' };
+const NOW_FIGURE_KEY = FIGURE_OFFSETS.indexOf(0);
 
 function speedAt(x: ArrayLike<number>, c: number): number {
   return Math.hypot(x[c], x[c + 1], x[c + 2]);
@@ -152,6 +174,22 @@ export function startsTurn(output: ArrayLike<number>, at: number, degrees: numbe
   return Math.abs(plannedTurn(output, at)) >= degrees;
 }
 
+/** The dancer's own turn the input's figure block says runs now or begins within FIGURE_AHEAD keys:
+ *  its way (+1, -1); 0 when another figure runs or comes (her turn, for him); null when none does. */
+export function figureWay(input: ArrayLike<number>, role: Role): number | null {
+  const kinds = FIGURE_KINDS.length;
+  const last = Math.min(NOW_FIGURE_KEY + FIGURE_AHEAD, FIGURE_OFFSETS.length - 1);
+  let any = false;
+  for (let k = 0; k < kinds; k++) {
+    let inside = false;
+    for (let key = NOW_FIGURE_KEY; key <= last; key++) if (input[FIGURE_IN[role] + 2 * (key * kinds + k)] > 0) inside = true;
+    if (!inside) continue;
+    if (FIGURE_KINDS[k][0] === OWN_TURN[role]) return FIGURE_KINDS[k][1];
+    any = true;
+  }
+  return any ? 0 : null;
+}
+
 /** The count at the next step (beats, its fraction only) from the music block ending the input. */
 export function countNext(input: ArrayLike<number>): number {
   const music = input.length - MUSIC_SIZE;
@@ -161,7 +199,9 @@ export function countNext(input: ArrayLike<number>): number {
 
 /** One dancer's footwork mean, kept across steps, and the footwork its next step aims at.
  *  `spinKeep` (null: spins left to the network): while the dancer turns faster than its TURNING, the
- *  footwork is still aimed at, among the candidates that keep the spin. */
+ *  footwork is still aimed at, among the candidates that keep the spin. `figureTurn` (null: the
+ *  figure not read): outside a turn, the candidates the figure being led asks for are preferred
+ *  (prefers). */
 export class OnCount {
   mean: number | null = null;
   /** rad/s (turnNow) while this step's target is a spin's; null otherwise. */
@@ -176,10 +216,12 @@ export class OnCount {
     readonly hips: number = HIPS,
     readonly spinKeep: number | null = null,
     readonly turnStart: number | null = null,
+    readonly figureTurn: number | null = null,
   ) {
     if (samples < 2) throw new Error('choosing on the count needs at least 2 samples');
     if (spinKeep !== null && !(spinKeep >= 0)) throw new Error(`spinKeep must be 0 or more (a share of the turn rate), got ${spinKeep}`);
     if (turnStart !== null && !(turnStart > 0)) throw new Error(`turnStart must be more than 0 degrees, got ${turnStart}`);
+    if (figureTurn !== null && !(figureTurn > 0)) throw new Error(`figureTurn must be more than 0 degrees, got ${figureTurn}`);
   }
 
   /** The footwork the next step aims at, for this step's input (it moves the mean on); null while
@@ -206,10 +248,22 @@ export class OnCount {
     return true;
   }
 
-  /** With turnStart, outside a turn: which of `count` candidates laid one after another in `output`
-   *  start one (startsTurn), written into `prefers`; false (no candidate preferred) otherwise. */
-  prefers(output: ArrayLike<number>, count: number, size: number, prefers: boolean[]): boolean {
-    if (this.turnStart === null || this.turning) return false;
+  /** Outside a turn, which of `count` candidates laid one after another in `output` are preferred,
+   *  written into `prefers`: with figureTurn and the step's `input`, those that turn figureTurn
+   *  degrees or more the way of the dancer's own turn the figure says runs or comes, or, no figure
+   *  running or coming, those that start no turn (figureWay; another figure: none preferred); with
+   *  turnStart, those that start one (startsTurn). Returns false (no candidate preferred) otherwise. */
+  prefers(output: ArrayLike<number>, count: number, size: number, prefers: boolean[], input: ArrayLike<number> | null = null): boolean {
+    if (this.turning) return false;
+    if (this.figureTurn !== null && input !== null) {
+      const way = figureWay(input, this.role);
+      if (way === 0) return false;
+      for (let i = 0; i < count; i++) {
+        prefers[i] = way === null ? !startsTurn(output, i * size, this.figureTurn) : plannedTurn(output, i * size) * way >= this.figureTurn;
+      }
+      return true;
+    }
+    if (this.turnStart === null) return false;
     for (let i = 0; i < count; i++) prefers[i] = startsTurn(output, i * size, this.turnStart);
     return true;
   }
@@ -222,7 +276,7 @@ export class OnCount {
  * (the dancer turns) the footwork is left alone: the first standing one whose hips go on. With
  * `keeps` (OnCount.keeps: the dancer spins), only the standing ones that keep the spin are aimed;
  * when none of them does, the footwork is left alone as without a target. With `prefers`
- * (OnCount.prefers: the candidates that start a turn), only the standing ones among them are aimed
+ * (OnCount.prefers: the candidates the figure or turnStart asks for), only the standing ones among them are aimed
  * when there are any; otherwise all the standing ones, as without it.
  */
 export function nearestCount(

@@ -18,8 +18,8 @@
 // step is Python's step: planFigures, steerPlan, leadPlan, stepInputs, the models, finishStep.
 
 import {
-  FIGURE_SIZE, FUTURE_OFFSETS, HISTORY, INTENTION_SIZE, KEYS, N_JOINTS, OUTPUT_LAYOUT, OUTPUT_SIZE, Track,
-  blockSlices, figureBlock, followerInput, fromRootSpaceDirections, fromRootSpacePoints, leaderInput, toRootSpacePoints, wrapAngle,
+  FIGURE_SIZE, type FigureName, FUTURE_OFFSETS, HISTORY, INTENTION_SIZE, KEYS, N_JOINTS, OUTPUT_LAYOUT, OUTPUT_SIZE, Track,
+  blockSlices, figureBlock, figureKind, followerInput, fromRootSpaceDirections, fromRootSpacePoints, leaderInput, toRootSpacePoints, wrapAngle,
 } from './features';
 import { FEET, FPS, HANDS, KEY_JOINTS, type Out, PARENTS, POSITIONS_SIZE, ROTATIONS_SIZE, forwardKinematicsReduced } from './skeleton';
 import { DEFAULT_TEMPO, MUSIC_SIZE, beatsPerStep, musicBlock } from './music';
@@ -41,15 +41,18 @@ export const ANCHOR_FREE = 0.75; // m around the anchor where a leader nobody st
 export const LEASH_DISTANCE = 2.0; // m: beyond this a follower is drawn toward its leader ...
 export const LEASH_RATE = 0.1; // ... closing this share of the excess every frame
 export const START_DISTANCE = 0.8; // m between the partners at the start and after a reset
-// The figures both dancers read (features figureBlock, Figures): her turn, one way or the other,
-// from his preparation to her finish, FIGURE_BEATS long. The recorded her turns last a median 3.3
-// beats (10-90 %: 2.0-8.2), 16.9 a minute, and start anywhere in the two-beat group: a figure
-// asked for starts on the next whole beat (under 0.4 s of waiting at 170 beats a minute), or when
-// the figure running ends. Nobody asking, the leader leads figures of his own (Figures.own): after
-// each figure he waits OWN_GAP_BEATS (drawn uniformly) and leads the next, either way alike (27
-// left / 29 right in the recording), so a figure begins every 10 beats on average, as recorded.
-export const FIGURE_BEATS = 3.5;
-export const OWN_GAP_BEATS: readonly number[] = [1, 12];
+// The figures both dancers read (features figureBlock, Figures): her turn, from his preparation to
+// her finish, or his own turn, one way or the other, FIGURE_BEATS long. In the recording her turns
+// last a median 3.3 beats (10-90 %: 2.0-8.2), 16.9 a minute, his 2.0 beats, 6.3 a minute, and both
+// start anywhere in the two-beat group: a figure the visitor asks for (her turn) starts on the next
+// whole beat (under 0.4 s of waiting at 170 beats a minute), or when the figure running ends.
+// Nobody asking, the leader leads figures of his own (Figures.own): after each figure he waits
+// OWN_GAP_BEATS (drawn uniformly) and leads the next, his own turn in HIS_SHARE of them, either way
+// alike: a figure every 7.2 beats on average (the wait for a beat included), as the recorded 23 a
+// minute at 170 (16.9 hers, 6.3 his; planFigures alone for an hour: 16.9 and 6.6).
+export const FIGURE_BEATS: Readonly<Record<FigureName, number>> = { her_turn: 3.5, his_turn: 2.0 };
+export const OWN_GAP_BEATS: readonly number[] = [0.5, 6.5];
+export const HIS_SHARE = 0.27;
 // A figure also becomes his hands plan (features handsPlanBlock): his lead hand (the left for
 // her turn to the left, +1, the right for -1) rises above his head and comes down again, the other
 // stays where it was. In the recording (training.evaluation.recorded_leads) his higher hand peaks
@@ -63,8 +66,9 @@ export const OWN_GAP_BEATS: readonly number[] = [1, 12];
 // was, so the plan holds none (docs/results.md, "The hands plan").
 export const LEAD_HAND_RAISED: readonly number[] = [0.02, 1.9, 0.28]; // m, the left hand, root space
 export const RAISE: readonly number[] = [0.4, 0.5]; // s
-// A figure also bends his planned path (leadPlan): it turns LEAD_TURN her way and moves LEAD_SIDE
-// to his other side (his right for her turn to the left), eased as her planned turn. The recorded
+// Her turn also bends his planned path (leadPlan): it turns LEAD_TURN her way and moves LEAD_SIDE
+// to his other side (his right for her turn to the left), eased as her planned turn (his own turn
+// turns his plan a full turn his way). The recorded
 // leader turns with her (over the 2.5 s from 1.7 s before her turn completes, his facing goes her
 // way by a median 38 degrees, quartiles -103 and +205), and she reads the way from his body over
 // the second before her turn. With his plan left as it was she turned the asked way after 32 % of
@@ -321,9 +325,10 @@ export function steerPlan(leader: Dancer, steering: Steering, stickX: number, st
 }
 
 /**
- * While a figure is danced or about to be, bend the leader's planned path (after steerPlan) so
- * that it leads her turn's way: from now to each future key it turns LEAD_TURN degrees and moves
- * LEAD_SIDE metres to his other side, times the share of her turn planned between them.
+ * While a figure is danced or about to be, bend the leader's planned path (after steerPlan): for
+ * her turn it turns LEAD_TURN degrees her way and moves LEAD_SIDE metres to his other side, for his
+ * own turn it turns a full turn his way, from now to each future key times the share of the turn
+ * planned between them.
  */
 export function leadPlan(duet: Duet): void {
   const t = duet.leader.track;
@@ -331,12 +336,15 @@ export function leadPlan(duet: Duet): void {
   const leftX = Math.cos(h); // his root space's +x on the floor
   const leftZ = -Math.sin(h);
   for (const led of duet.figures.led) {
+    const her = led.name === 'her_turn';
+    const turn = her ? (LEAD_TURN * Math.PI) / 180 : 2 * Math.PI;
+    const side = her ? LEAD_SIDE : 0;
     for (const off of FUTURE_OFFSETS) {
       const share = figureShare(led, duet.frame + off) - figureShare(led, duet.frame);
       if (!share) continue;
-      t.heading[NOW + off] += led.way * ((LEAD_TURN * Math.PI) / 180) * share;
-      t.root[2 * (NOW + off)] -= led.way * LEAD_SIDE * share * leftX;
-      t.root[2 * (NOW + off) + 1] -= led.way * LEAD_SIDE * share * leftZ;
+      t.heading[NOW + off] += led.way * turn * share;
+      t.root[2 * (NOW + off)] -= led.way * side * share * leftX;
+      t.root[2 * (NOW + off) + 1] -= led.way * side * share * leftZ;
     }
   }
 }
@@ -396,11 +404,13 @@ export function keepClose(follower: Dancer, leader: Dancer): boolean {
 }
 
 /**
- * One figure the leader leads: her turn to her left (way +1, counterclockwise seen from above) or
- * to her right (-1), from duet frame `start` to `end` (both danced); `asked` when the visitor asked
- * for it; `hands`: his hands (left, right; [2 × 3]) in his root space when his plan for it began.
+ * One figure the leader leads: `name` her_turn or his_turn, to the dancer's left (way +1,
+ * counterclockwise seen from above) or right (-1), from duet frame `start` to `end` (both danced);
+ * `asked` when the visitor asked for it; `hands`: his hands (left, right; [2 × 3]) in his root
+ * space when his plan for it began.
  */
 export interface Led {
+  name: FigureName;
   way: number;
   start: number;
   end: number;
@@ -425,12 +435,12 @@ export class Figures {
     return this.led.find((f) => f.start <= frame && frame <= f.end) ?? null;
   }
 
-  /** (way, start, end) of every figure, flat, in the frames of a track whose NOW is `frame` (a
-   *  shared array, overwritten by the next call). */
+  /** (kind, start, end) of every figure (features figureBlock), flat, in the frames of a track
+   *  whose NOW is `frame` (a shared array, overwritten by the next call). */
   spans(frame: number): number[] {
     const out = this.spanned;
     out.length = 0;
-    for (const f of this.led) out.push(f.way, f.start - frame + NOW, f.end - frame + NOW);
+    for (const f of this.led) out.push(figureKind(f.name, f.way), f.start - frame + NOW, f.end - frame + NOW);
     return out;
   }
 }
@@ -441,12 +451,18 @@ export function framesToBeat(duet: Duet, atFrame: number, beat: number): number 
   return atFrame + Math.max(0, Math.ceil((beat - now) / beatsPerStep(duet.tempo) - 1e-9));
 }
 
-/** A figure of `way` starting at the first whole beat of the count at or after `frame`. */
-export function figureFrom(duet: Duet, frame: number, way: number, asked: boolean): Led {
+/** Python's round(): to the nearest whole number, halves to the even one (Math.round takes them up). */
+function roundHalfEven(x: number): number {
+  const r = Math.round(x);
+  return r - x === 0.5 && r % 2 !== 0 ? r - 1 : r;
+}
+
+/** A figure `name` of `way` starting at the first whole beat of the count at or after `frame`. */
+export function figureFrom(duet: Duet, frame: number, name: FigureName, way: number, asked: boolean): Led {
   const per = beatsPerStep(duet.tempo);
   const beat = duet.beat + (frame - duet.frame) * per;
   const start = framesToBeat(duet, frame, Math.ceil(beat - 1e-9));
-  return { way: way >= 0 ? 1 : -1, start, end: start + Math.round(FIGURE_BEATS / per), asked, hands: null };
+  return { name, way: way >= 0 ? 1 : -1, start, end: start + roundHalfEven(FIGURE_BEATS[name] / per), asked, hands: null };
 }
 
 /**
@@ -457,7 +473,7 @@ export function askTurn(duet: Duet, direction: number): void {
   const f = duet.figures;
   f.led = f.led.filter((x) => x.start <= duet.frame);
   const after = Math.max(duet.frame, ...f.led.map((x) => x.end + 1));
-  f.led.push(figureFrom(duet, after, direction, true));
+  f.led.push(figureFrom(duet, after, 'her_turn', direction, true));
 }
 
 /**
@@ -469,14 +485,15 @@ export function planFigures(duet: Duet): void {
   if (f.led.some((x) => x.end < duet.frame - HISTORY)) f.led = f.led.filter((x) => x.end >= duet.frame - HISTORY);
   if (!f.own || f.led.some((x) => x.end >= duet.frame)) return;
   const last = f.led.length ? Math.max(...f.led.map((x) => x.end + 1)) : duet.frame;
-  // Two uniform draws, in this order (as Python's): the wait, then the way.
+  // Three uniform draws, in this order (as Python's): the wait, whose turn, and its way.
   const gap = OWN_GAP_BEATS[0] + (OWN_GAP_BEATS[1] - OWN_GAP_BEATS[0]) * f.rng();
+  const name: FigureName = f.rng() < HIS_SHARE ? 'his_turn' : 'her_turn';
   const way = f.rng() < 0.5 ? 1 : -1;
   const start = framesToBeat(duet, last, duet.beat + (last - duet.frame) * beatsPerStep(duet.tempo) + gap);
-  f.led.push(figureFrom(duet, Math.max(start, duet.frame + 1), way, false));
+  f.led.push(figureFrom(duet, Math.max(start, duet.frame + 1), name, way, false));
 }
 
-/** How much of her turn is planned done at `frame`, 0 to 1 (smoothstep over the figure). */
+/** How much of the figure's turn is planned done at `frame`, 0 to 1 (smoothstep over it). */
 export function figureShare(led: Led, frame: number): number {
   const u = Math.min(1, Math.max(0, (frame - led.start) / Math.max(led.end - led.start, 1)));
   return u * u * (3 - 2 * u);
@@ -490,13 +507,15 @@ export function raised(led: Led, frame: number): number {
 }
 
 /**
- * The figure his hands plan is for: the one danced now or beginning within the next second, else
- * one whose raise is coming down. A figure that follows another at once takes the plan over as
- * soon as the one before ends.
+ * The figure his hands plan is for (her turns only): the one danced now or beginning within the
+ * next second, else one whose raise is coming down. A figure that follows another at once takes the
+ * plan over as soon as the one before ends.
  */
 export function planning(duet: Duet): Led | null {
   const lowering = Math.trunc(RAISE[1] * FPS);
-  const near = duet.figures.led.filter((x) => x.start - HISTORY <= duet.frame && duet.frame <= x.end + lowering);
+  const near = duet.figures.led.filter(
+    (x) => x.name === 'her_turn' && x.start - HISTORY <= duet.frame && duet.frame <= x.end + lowering,
+  );
   return near.find((x) => x.end >= duet.frame) ?? near[0] ?? null;
 }
 

@@ -99,7 +99,7 @@ installGlobalErrorHandlers();
 /** The hook's figure for the simulation's: only one being danced (a coming one is not yet). */
 function figureHook(figure: FigureView | null): FigureHook | null {
   if (!figure || figure.coming) return null;
-  return { name: 'her_turn', way: figure.way > 0 ? 'left' : 'right', asked: figure.asked };
+  return { name: figure.name, way: figure.way > 0 ? 'left' : 'right', asked: figure.asked };
 }
 
 function publish(target: DuetHook['leader'], view: DancerView): void {

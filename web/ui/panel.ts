@@ -58,7 +58,7 @@ export const CONTROLS = {
   temperature: ['variety', 'Low: the partner always makes its most likely move; high: it picks more varied, sometimes wilder moves.'],
   tempo: ['tempo', `The music’s beats a minute (${LIMITS.tempo[0]}-${LIMITS.tempo[1]}); both dancers hear it and dance on its count.`],
   music: ['music', 'Plays the salsa band (from your first key or tap); off, the dance keeps its count in silence.'],
-  figures: ['his own turns', 'On: your dancer also leads her turn now and then by himself, every few bars; off: only the turns you ask for (T, Shift+T). The count shows the turn coming.'],
+  figures: ['his own turns', 'On: your dancer also leads a turn now and then by himself, hers or his own, every few bars; off: only the turns you ask for (T, Shift+T). The count shows the turn coming.'],
   ghosts: ['possible reactions', `Up to ${LIMITS.ghosts[1]} faint partners, one colour each: copies of her that branched off within the last second and dance on with moves of their own.`],
   trajectories: ['floor paths', "Each dancer's path on the floor, a second ahead."],
   intentions: ['show what the partner expects', "Purple lines: where the partner expects your head, hands and feet to go over the next second."],
