@@ -209,9 +209,11 @@ describe(`leading a turn (seed ${SEED})`, () => {
 // facing recorded for REQUEST_SECONDS. Counted as `lead` counts in Python (turns.mjs
 // `followerTurns`: figures.turns, 300 degrees within 2.5 s). She gets no command: both dancers
 // read the figure being led, and her guard prefers her network's samples that turn its way.
-// Asserted: she completes a turn the asked way after at least MIN_TURNED of the 16 (docs/results.md,
-// "Leading a turn", has the page's and Python's shares), and every request is taken without an error.
-const MIN_TURNED = 5;
+// With the shipped models she turned the asked way within 4 s in 13 of these 16 (Python's `lead`:
+// after 75 % of 40 requests; docs/results.md, "Leading a turn"). Asserted: at least MIN_TURNED of
+// the 16, which a follower who turns the asked way after 60 % of requests misses by chance about
+// twice in a hundred models, and every request taken without an error.
+const MIN_TURNED = 6;
 const SEEDS = Array.from({ length: 16 }, (_, i) => i + 1);
 const REQUEST_SECONDS = 4;
 const WINDOW = REQUEST_SECONDS * FPS;
