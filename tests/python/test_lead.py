@@ -287,7 +287,7 @@ def test_recorded_leads_reads_his_hands_around_her_turns(data3, capsys):
     r = recorded_leads.windows(str(data3))
     up, she = r[:, 0], r[:, 1]
     assert 0 < up.sum() < len(r) and she.mean() == pytest.approx((she[up].sum() + she[~up].sum()) / len(r))
-    assert f"In {len(r)} windows of {lead.REQUEST_SECONDS:g} s" in out
+    assert f"In {len(r)} windows of 2.5 s" in out
     # The recorded couple read as requests: with his hand up against all windows, and a follower
     # who turned after every raise: never below her share with his hand up.
     recorded, every = recorded_leads.request_contrast(r)

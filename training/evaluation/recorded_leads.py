@@ -34,13 +34,14 @@ from ..mirror import features as feat
 from ..mirror.skeleton import FPS, HANDS
 from . import figures as F
 from .figures import HAND_RAISED
-from .lead import REQUEST_SECONDS, winding
+from .lead import winding
 
 WINDOW = (-2.0, 0.5)   # s around the turn's completion
 PEAK = 1.5             # s before completion where the lead's peak is looked for
 WIND = 1.0             # s before completion over which the winding is read
 EVERY = 6              # frames between the windows' starts
 FACING_SPAN = (-1.7, 0.8)   # s around the turn's completion
+REQUEST_SECONDS = 2.5       # s: the windows her turns and his raised hand are read in (`lead` reads 4 s after a request)
 
 
 def couples(data: str):
