@@ -39,8 +39,9 @@ planned path turns FIGURE_TURN degrees or more its way are preferred; while no f
 those that turn less than that either way. It only chooses among the network's own samples, so
 her body and timing stay her network's. Read by the networks alone, the figure moved her turns
 little: with his own figures off she turned in 57 % of 4 s windows never asked and after 60 % of
-requests (`lead --seeds 40`); chosen at 180 degrees, 52 % / 78 %; at 120, 38 % / 78 % (75 % the
-asked way); at 90, 45 % / 68 % (20 seeds each, --on-count-figure DEG).
+requests (`lead --seeds 40`); chosen at 120 degrees, 50 % / 74 % (69 % the asked way; 40 seeds).
+Over seeds 0-19 alone: at 90 degrees 45 % / 68 %, at 120 38 % / 78 %, at 180 52 % / 78 %
+(--on-count-figure DEG); seeds 20-39 at 120 gave 62 % / 70 %, so 20 seeds do not tell them apart.
 
 OnCount's `spin_keep` and `turn_start` (keeps_spin, starts_turn) are two choices measured and not
 shipped: no manifest and no option sets them, and tests/fixtures/features.json pins them in both
