@@ -512,11 +512,15 @@ export function raised(led: Led, frame: number): number {
  * plan over as soon as the one before ends.
  */
 export function planning(duet: Duet): Led | null {
+  // A loop, not filter/find: this runs every step and allocates nothing.
   const lowering = Math.trunc(RAISE[1] * FPS);
-  const near = duet.figures.led.filter(
-    (x) => x.name === 'her_turn' && x.start - HISTORY <= duet.frame && duet.frame <= x.end + lowering,
-  );
-  return near.find((x) => x.end >= duet.frame) ?? near[0] ?? null;
+  let lowered: Led | null = null;
+  for (const x of duet.figures.led) {
+    if (x.name !== 'her_turn' || x.start - HISTORY > duet.frame || duet.frame > x.end + lowering) continue;
+    if (x.end >= duet.frame) return x;
+    lowered ??= x;
+  }
+  return lowered;
 }
 
 const HANDS_MOVES = KEYS * HANDS.length * 3;
