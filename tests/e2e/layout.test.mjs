@@ -15,7 +15,7 @@
 
 import { after, before, describe, test } from 'node:test';
 import assert from 'node:assert/strict';
-import { WAIT_MS, duet, launch, saveScreen, sleep, startServer, waitReady, waitSteps } from './harness.mjs';
+import { QUICK, WAIT_MS, duet, launch, saveScreen, sleep, startServer, waitReady, waitSteps } from './harness.mjs';
 
 /** Pictures a visitor would see, in runs/screens/ (harness.SCREENS; the latest test run's). */
 const shot = async (page, name) => saveScreen(`${name}.png`, await page.screenshot());
@@ -43,21 +43,32 @@ after(async () => {
   await server?.stop();
 });
 
-/** One browser per kind of device, moved through its screen sizes (a launch costs seconds). */
-async function withScreens(phone, run) {
+/**
+ * One browser per kind of device, moved through its screen sizes (a launch costs seconds). What is
+ * checked is layout, in CSS pixels: the browser draws at half resolution (QUICK, a quarter of the
+ * pixels software WebGL fills; 2560x1440 at full resolution is 3.7 million a frame), except on the
+ * screens named in `pictures`, whose pictures are kept: those in a full-resolution browser of
+ * their own.
+ */
+async function withScreens(phone, run, pictures = new Set()) {
   const sizes = SCREENS.filter(([, , p]) => p === phone);
   const [width, height] = sizes[0];
-  const browser = await launch({ viewport: { width, height }, ...(phone ? PHONE : {}) });
+  const browsers = new Map();
+  const browserFor = async (full) => {
+    if (!browsers.has(full)) browsers.set(full, await launch({ viewport: { width, height }, ...(phone ? PHONE : {}), ...(full ? {} : QUICK) }));
+    return browsers.get(full);
+  };
   try {
     for (const [w, h] of sizes) {
+      const browser = await browserFor(pictures.has(`${w}x${h}`));
       await browser.page.setViewportSize({ width: w, height: h });
       await sleep(400); // the resize observers, and a frame or two drawn at the new size
       await standStill(() => panelBox(browser.page));
       await run(browser.page, `${w}x${h}`, w, h);
     }
-    assert.deepEqual(browser.consoleErrors, []);
+    for (const browser of browsers.values()) assert.deepEqual(browser.consoleErrors, []);
   } finally {
-    await browser.close();
+    for (const browser of browsers.values()) await browser.close();
   }
 }
 
@@ -146,11 +157,13 @@ for (const phone of [true, false]) {
         assert.ok((await duet(page)).camera.distance > 9, `${where}: zoomed out`);
         checkLabels(far, `${where}, zoomed out`);
         if (SHOTS.has(where)) await shot(page, `layout-compare-${where}`);
-      });
+      }, SHOTS);
     });
 
-    test('nothing in the panel or the title card is cut off; the panel shows every control', async () => {
-      await withScreens(phone, async (page, where) => {
+    // One page per screen serves three checks (the panel is the same for every partner: the
+    // sheet and the drop hint are checked on the page that shows the longest partner name).
+    test(`nothing in the panel or the title card is cut off; the panel shows every control;${phone ? ' the open sheet shows every control, and the dancers stay in view above it;' : ''} the drop hint is drawn over the panel, and its words fit`, async () => {
+      await withScreens(phone, async (page, where, width, height) => {
         // The longest partner name on the menu ("baseline, no intention") and the recording folder open.
         await page.goto(`${server.url}?seed=1&model=ccm`);
         await waitReady(page);
@@ -173,49 +186,43 @@ for (const phone of [true, false]) {
         assert.deepEqual(seen.cut, [], `${where}: text cut off`);
         assert.ok(seen.scroll <= seen.client + 1, `${where}: the panel needs scrolling (${seen.scroll} px of controls in ${seen.client})`);
         assert.deepEqual(seen.outside, [], `${where}: controls off screen`);
-      });
-    });
-
-    test('the drop hint is drawn over the panel, and its words fit', async () => {
-      await withScreens(phone, async (page, where) => {
-        await page.goto(`${server.url}?seed=1`);
-        await waitReady(page);
-        await openPanel(page);
-        const seen = await page.evaluate(() => {
-          const transfer = new DataTransfer();
-          transfer.items.add(new File(['x'], 'take.bvh'));
-          window.dispatchEvent(new DragEvent('dragenter', { dataTransfer: transfer, bubbles: true }));
-          const hint = document.querySelector('.drop-hint');
-          const z = (e) => Number(getComputedStyle(e).zIndex) || 0;
-          return { shown: hint.checkVisibility(), above: z(hint) > z(document.querySelector('.duet-panel')), fits: hint.scrollWidth <= hint.clientWidth + 1 && hint.scrollHeight <= hint.clientHeight + 1 };
-        });
-        assert.deepEqual(seen, { shown: true, above: true, fits: true }, where);
-      });
+        if (phone && width < height) await sheetLeavesTheDancers(page, where, height);
+        await dropHintOverPanel(page, where);
+      }, phone ? new Set(['390x844']) : new Set());
     });
   });
 }
 
-test('phone: the open settings sheet shows every control, and the dancers stay in view above it', async () => {
-  await withScreens(true, async (page, where, width, height) => {
-    if (width > height) return; // landscape: a drawer at the side (the test above)
-    await page.goto(`${server.url}?seed=1`);
-    await waitReady(page);
-    await openPanel(page);
-    await waitSteps(page, 5);
-    const seen = await page.evaluate(() => {
-      const sheet = document.querySelector('.duet-panel').getBoundingClientRect();
-      const title = document.getElementById('overlay').getBoundingClientRect();
-      const record = [...document.querySelectorAll('.duet-panel button')].find((b) => /record/.test(b.textContent)).getBoundingClientRect();
-      return { sheetTop: sheet.top, titleBottom: title.bottom, recordBottom: record.bottom, leader: window.duet.leader.screen, follower: window.duet.follower.screen };
-    });
-    assert.ok(seen.recordBottom <= height, `${where}: "● record" reachable without scrolling ${JSON.stringify(seen)}`);
-    if (where === '390x844') await shot(page, 'layout-phone-sheet');
-    for (const dancer of ['leader', 'follower']) {
-      const [, y] = seen[dancer];
-      assert.ok(y > seen.titleBottom - 40 && y < seen.sheetTop, `${where}: the ${dancer} (hip at y ${y.toFixed(0)}) between the title card and the sheet ${JSON.stringify(seen)}`);
-    }
+/** The drop hint over the open panel, its words fitting (the panel is open). */
+async function dropHintOverPanel(page, where) {
+  const seen = await page.evaluate(() => {
+    const transfer = new DataTransfer();
+    transfer.items.add(new File(['x'], 'take.bvh'));
+    window.dispatchEvent(new DragEvent('dragenter', { dataTransfer: transfer, bubbles: true }));
+    const hint = document.querySelector('.drop-hint');
+    const z = (e) => Number(getComputedStyle(e).zIndex) || 0;
+    return { shown: hint.checkVisibility(), above: z(hint) > z(document.querySelector('.duet-panel')), fits: hint.scrollWidth <= hint.clientWidth + 1 && hint.scrollHeight <= hint.clientHeight + 1 };
   });
-});
+  assert.deepEqual(seen, { shown: true, above: true, fits: true }, where);
+}
+
+/** A phone held upright, the settings sheet open: every control shown, the dancers above it
+ *  (landscape: a drawer at the side, checked with the panel's controls). */
+async function sheetLeavesTheDancers(page, where, height) {
+  await waitSteps(page, 5);
+  const seen = await page.evaluate(() => {
+    const sheet = document.querySelector('.duet-panel').getBoundingClientRect();
+    const title = document.getElementById('overlay').getBoundingClientRect();
+    const record = [...document.querySelectorAll('.duet-panel button')].find((b) => /record/.test(b.textContent)).getBoundingClientRect();
+    return { sheetTop: sheet.top, titleBottom: title.bottom, recordBottom: record.bottom, leader: window.duet.leader.screen, follower: window.duet.follower.screen };
+  });
+  assert.ok(seen.recordBottom <= height, `${where}: "● record" reachable without scrolling ${JSON.stringify(seen)}`);
+  if (where === '390x844') await shot(page, 'layout-phone-sheet');
+  for (const dancer of ['leader', 'follower']) {
+    const [, y] = seen[dancer];
+    assert.ok(y > seen.titleBottom - 40 && y < seen.sheetTop, `${where}: the ${dancer} (hip at y ${y.toFixed(0)}) between the title card and the sheet ${JSON.stringify(seen)}`);
+  }
+}
 
 for (const [width, height, phone] of [[390, 844, true], [1280, 800, false]]) {
   test(`the help fits one screen at ${width}x${height}, holds the dance while open, and keeps the visitor's pause`, async () => {
