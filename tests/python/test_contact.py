@@ -169,8 +169,11 @@ def test_contact_layer_brings_near_hands_together_and_keeps_bones():
 def test_contact_layer_glides_each_body_over_the_floor():
     """The first step shows each body where its network put it; the shown hips step by a running
     mean of the network's steps: a jump over the floor is shown a HIP_GLIDE share at once and the
-    rest over the next steps, never past it, the whole body together, its height unchanged, planted
-    feet or not; clear() shows it where it is again."""
+    rest over the next steps, never past it, the body above the knees together, its height
+    unchanged, planted feet or not; the free feet go where the network put them, as far as the legs
+    reach (a small glide: exactly there); clear() shows it where it is again."""
+    legs = list(FEET) + [PARENTS[f] for f in FEET]
+    body = [j for j in range(17) if j not in legs]
     layer = ContactLayer()
     lead, follow = standing(0, 0), standing(3, 0)
     a, b = lead.copy(), follow.copy()
@@ -179,8 +182,10 @@ def test_contact_layer_glides_each_body_over_the_floor():
     moved = standing(3, 1.0)
     b = moved.copy()
     layer.apply(lead.copy(), b, [0, 0], [0, 0], 0.0, 0.0)
-    assert np.allclose(b[:, 2] - moved[:, 2], HIP_GLIDE - 1.0)
-    assert np.allclose(b[:, [0, 1]], moved[:, [0, 1]])
+    assert np.allclose(b[body, 2] - moved[body, 2], HIP_GLIDE - 1.0)
+    assert np.allclose(b[body][:, [0, 1]], moved[body][:, [0, 1]])
+    # The free feet reach on toward the network's, further than the glided body carried them.
+    assert np.all(b[FEET, 2] - moved[FEET, 2] > HIP_GLIDE - 1.0 + 0.05)
     shown, step = HIP_GLIDE, HIP_GLIDE
     for contacts in ([0, 0], [1, 0], [1, 1]):
         b = moved.copy()
@@ -192,6 +197,11 @@ def test_contact_layer_glides_each_body_over_the_floor():
     b = moved.copy()
     layer.apply(lead.copy(), b, [0, 0], [0, 0], 0.0, 0.0)
     assert np.allclose(b, moved)
+    near = standing(3, 1.05)                          # a 5 cm step: the hips glide 1.5 cm of it
+    b = near.copy()
+    layer.apply(lead.copy(), b, [0, 0], [0, 0], 0.0, 0.0)
+    assert np.isclose(b[0, 2] - near[0, 2], (HIP_GLIDE - 1.0) * 0.05)
+    assert np.allclose(b[FEET], near[FEET], atol=1e-9)
 
 
 def test_partner_terms_are_zero_on_the_recording_and_bite_on_error(prepared3):

@@ -633,19 +633,20 @@ describe('foot locking (drawn pose only)', () => {
     const bone = (p: ArrayLike<number>, i: number, j: number) => Math.hypot(p[3 * i] - p[3 * j], p[3 * i + 1] - p[3 * j + 1], p[3 * i + 2] - p[3 * j + 2]);
     expect(bone(drawn, 11, 12)).toBeCloseTo(bone(modelled, 11, 12), 5);
     expect(bone(drawn, 12, 13)).toBeCloseTo(bone(modelled, 12, 13), 5);
-    // The right foot has no contact: drawn where the model put it beside the hips, the whole body
-    // trailing the walk by the glide's few millimetres (contact.ts HIP_GLIDE).
-    for (const a of [0, 2]) expect(drawn[16 * 3 + a] - drawn[a]).toBeCloseTo(modelled[16 * 3 + a] - modelled[a], 5);
-    expect(drawn[16 * 3 + 1]).toBeCloseTo(modelled[16 * 3 + 1], 5);
+    // The right foot has no contact: drawn where the model put it on the floor, while the rest of
+    // the body trails the walk by the glide's few millimetres (contact.ts HIP_GLIDE): the feet keep
+    // the model's timing (within the half millimetre the straightened leg falls short by).
+    for (let a = 0; a < 3; a++) expect(drawn[16 * 3 + a]).toBeCloseTo(modelled[16 * 3 + a], 3);
     expect(Math.abs(drawn[2] - modelled[2])).toBeLessThan(0.02);
+    expect(Math.abs(drawn[2] - modelled[2])).toBeGreaterThan(0.001);
     expect(drawn[13 * 3 + 1]).toBeGreaterThanOrEqual(ANKLE_FLOOR - 1e-6);
 
-    // Contact ends: within a few steps the drawn foot is the model's again, beside the hips; the
-    // body, free, glides and trails the walk.
+    // Contact ends: within a few steps the drawn foot is the model's again, where the model put it;
+    // the body, free, glides and trails the walk.
     follow[0].options.contacts = [0, 0];
     for (let i = 0; i < 8; i++) await sim.step(steer, 0.5);
     const shown = sim.followers[0].positions, model = s.duet.followers[0].positions;
-    for (let a = 0; a < 3; a++) expect(shown[13 * 3 + a] - shown[a]).toBeCloseTo(model[13 * 3 + a] - model[a], 6);
+    for (let a = 0; a < 3; a++) expect(shown[13 * 3 + a]).toBeCloseTo(model[13 * 3 + a], 3);
     expect(Math.abs(shown[2] - model[2])).toBeGreaterThan(0.001);
     expect(shown[1]).toBeCloseTo(model[1], 6);
   });

@@ -15,7 +15,8 @@ stays what they made, and every metric can be read with and without this layer):
 First of all, each body's path over the floor glides (HIP_GLIDE): the networks draw a new root
 step each frame, and the follower's hips turned back 3.8x as often a second as the recorded
 follower's (training.evaluation.jitter). The whole body is moved to where its hips' smoothed path
-is; the feet, locked last, stay planted.
+is, except the feet: a free foot stays where the network put it on the floor, a planted one at its
+lock (footik.FootLock, last), and the legs take up the difference.
 """
 from __future__ import annotations
 
@@ -41,11 +42,6 @@ HOLD_RATE = 0.3        # share of the way the hold weight moves up to its target
 RELEASE_RATE = 0.7
 ELBOW_POLE = (0.0, -1.0, 0.0)   # a straight arm bends its elbow downward
 MIN_ELBOW_BEND = 0.6   # radians: the recorded elbows bend at least 0.6-0.7 in 99.5 % of frames
-# The follower's feet lock from a lower contact than the leader's (footik.CONTACT_THRESHOLD): its
-# skate while low fell from 2.08x the recording's to 1.31x (4 steered seeds x 60 s), its legs staying
-# in the recorded range. The leader's feet locked from 0.3 bent its knees and hips out of the range
-# in 12-13 % of its frames (against 4-6 % at 0.5; the recording 7.1 %), so the leader keeps 0.5.
-FOLLOWER_CONTACT = 0.3
 # Each step the shown hips move by a running mean of the network's steps over the floor: they take
 # HIP_GLIDE of the way from the step they last made to the network's new one (horizontal only;
 # height and turning stay the network's). The glide smooths velocity, not place, so the shown hips
@@ -57,9 +53,9 @@ FOLLOWER_CONTACT = 0.3
 # put the hips, and only while no foot was planted: the share it passed on changed with her
 # contacts every frame, and her drawn hips turned back 1.55x / 1.38x as often. Holding this one
 # while a foot is planted gave 1.35x; 0.2 trails a steered walk by 4 frames, 0.5 gave 1.21x
-# (6 seeds each). The foot locks trail the network's own foot (footik.FootLock.apply's glide): her
-# skate in contact stays 1.48x the recording's (1.47x before; 1.88x with the locks as they were,
-# 30 steered seeds x 60 s), her joint angles out of range with the layer 2.2x (2.0x before).
+# (6 seeds each). The glide moves the body, not the feet: a free foot stays where the network put
+# it on the floor and a planted one at its lock (footik.FootLock.apply), so the drawn steps land
+# when the network's do.
 HIP_GLIDE = 0.3
 
 
@@ -150,8 +146,13 @@ class ContactLayer:
     """State kept between steps: both dancers' glides, foot locks and the hand hold."""
 
     def __init__(self):
+        # Both dancers' feet lock from footik.CONTACT_THRESHOLD. The follower's locked from 0.3 once
+        # (her skate while low 1.31x against 2.08x, on networks before the figure block); on the
+        # shipped networks the early lock had slid its full quarter metre by the time her network
+        # planted the foot: her skate in contact 2.54x the recording's against 1.31x from 0.5, her
+        # drawn steps on the beat +0.25 against +0.37 (5 steered seeds x 40 s; docs/music.md).
         self.leader_feet = FootLock(CONTACT_THRESHOLD)
-        self.follower_feet = FootLock(FOLLOWER_CONTACT)
+        self.follower_feet = FootLock(CONTACT_THRESHOLD)
         self.hold = 0.0                 # 0..1: how far the closest hands are drawn together
         self.hands = (0, 0)             # the pair held (indices into HANDS: leader's, follower's)
         self.pushed = 0.0               # m each body was moved apart this step

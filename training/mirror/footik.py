@@ -35,9 +35,8 @@ MIN_KNEE_BEND = 0.2
 MAX_STANCE = 0.9
 # After a contact ends, the lock's pull decays by this factor per step (no pop on release).
 RELEASE_DECAY = 0.5
-# A foot locks while the model's contact for it is above this. The follower's network, sampled at
-# its own variety (1), is unsure of its feet: half of its low frames have contacts of 0.3-0.5, with
-# the foot sliding 4-5 cm a frame, so its layer locks from FOLLOWER_CONTACT (contact.py).
+# A foot locks while the model's contact for it is above this (both dancers; contact.py says why the
+# follower's no longer locks from 0.3).
 CONTACT_THRESHOLD = 0.5
 
 
@@ -102,7 +101,6 @@ class FootLock:
         self.locked = [False, False]
         self.target = np.zeros((2, 3))
         self.weight = np.zeros(2)
-        self.glided = np.zeros((2, 2))   # the body's glide (x, z) when each lock began
 
     def clear(self) -> None:
         """Forget every lock (after a reset or a jump of the dancer)."""
@@ -112,23 +110,26 @@ class FootLock:
     def apply(self, positions: np.ndarray, contacts, heading: float, glide=(0.0, 0.0)) -> None:
         """Lock or release each foot from contacts (left, right) and bend the legs of positions
         [17, 3] (world, in place). heading gives the knee's bend direction for a straight leg.
-        glide (x, z) is how far the contact layer moved the body from where the network put it
-        (contact.HipGlide): a lock trails the network's own foot, so the legs, not the planted
-        foot, take up what the glide moves the body during a contact."""
+
+        glide (x, z) is how far the contact layer's hip glide moved the body from where the network
+        put it (contact.HipGlide). The feet do not glide: a free foot goes where the network put it
+        on the floor, a planted one stays at its lock, and the legs take up the glide. The glide
+        lags the network's steps by about two frames; feet carried along with it landed their
+        steps off the network's beat (her drawn steps on the beat +0.33 with the feet kept where
+        the network put them against +0.25 carried; the network's own +0.46; 5 steered seeds x
+        40 s, docs/music.md)."""
         glide = np.asarray(glide, float)
         for i, foot in enumerate(FEET):
             knee = PARENTS[foot]
             thigh = PARENTS[knee]
-            f = positions[foot].copy()
+            own = positions[foot].copy()          # the network's own foot on the floor
+            own[[0, 2]] -= glide
             t = self.target[i]
             if contacts[i] > self.threshold:
                 if not self.locked[i]:
-                    t[:] = (f[0], max(f[1], ANKLE_FLOOR), f[2])
-                    self.glided[i] = glide
+                    t[:] = (own[0], max(own[1], ANKLE_FLOOR), own[2])
                     self.locked[i] = True
                 else:
-                    own = f.copy()                   # the foot as the glide at the lock's start had it
-                    own[[0, 2]] -= glide - self.glided[i]
                     behind = float(np.linalg.norm(t - own))
                     if behind > MAX_LOCK_DISTANCE:   # slide along, MAX_LOCK_DISTANCE behind the foot
                         t[:] = own + (t - own) * (MAX_LOCK_DISTANCE / behind)
@@ -140,9 +141,9 @@ class FootLock:
                 self.weight[i] = 0.0 if w < 0.01 else w
             w = self.weight[i]
             if w > 0:
-                cap_stance(t, f, positions[FEET[1 - i]])
-            goal = f + (t - f) * w
+                cap_stance(t, own, positions[FEET[1 - i]])
+            goal = own + (t - own) * w
             goal[1] = max(goal[1], ANKLE_FLOOR)
-            if w > 0 or f[1] < ANKLE_FLOOR:
+            if w > 0 or glide.any() or own[1] < ANKLE_FLOOR:
                 two_bone_ik(positions, thigh, knee, foot, goal, (np.sin(heading), 0.0, np.cos(heading)),
                             MIN_KNEE_BEND)

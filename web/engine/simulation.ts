@@ -8,7 +8,7 @@
 
 import { FIGURE_SIZE, FUTURE_OFFSETS, INPUT_SIZE, INTENTION_SIZE, KEYS, OUTPUT_SIZE, figureBlock, followerInput } from '../mirror/features';
 import { KEY_JOINTS, type Motion, N_JOINTS, POSITIONS_SIZE, ROTATIONS_SIZE } from '../mirror/skeleton';
-import { ContactLayer, FOLLOWER_CONTACT, HipGlide } from '../mirror/contact';
+import { ContactLayer, HipGlide } from '../mirror/contact';
 import { FootLock } from '../mirror/footik';
 import { type GuardSettings, type Ranges, hipSlackFor, mostUpright, nearestPlan, showsPlan, slackFor, uprightBody, uprightMargin } from '../mirror/guard';
 import { OnCount, STEPPED, drawnFootwork, drawnSteps, hipsTurnBack, nearestCount } from '../mirror/on_count';
@@ -34,7 +34,7 @@ class View implements DancerView {
   /** Path glide and foot locks of a follower beyond the first (compare mode), as ours gets them
    *  from the contact layer: both partners drawn alike, so the comparison is fair. */
   readonly glide = new HipGlide();
-  readonly feet = new FootLock(FOLLOWER_CONTACT);
+  readonly feet = new FootLock();
   resets = -1;
 
   constructor(withIntention: boolean) {

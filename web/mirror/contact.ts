@@ -10,7 +10,8 @@
 //    HAND_FULL and closer, with a weight that rises and falls smoothly;
 // 3. planted feet stay planted: FootLock on both dancers, last, so a body moved by 1. keeps its feet.
 // First of all, each body's path over the floor glides (HIP_GLIDE): the whole body is moved to
-// where its hips' smoothed path is; the feet, locked last, stay planted.
+// where its hips' smoothed path is, except the feet: a free foot stays where the network put it on
+// the floor, a planted one at its lock (FootLock, last), and the legs take up the difference.
 
 import { CONTACT_THRESHOLD, FootLock, twoBoneIk } from './footik';
 import { HANDS, PARENTS, SPINE } from './skeleton';
@@ -39,9 +40,6 @@ export const RELEASE_RATE = 0.7;
 export const ELBOW_POLE = [0, -1, 0];
 /** Radians: the recorded elbows bend at least 0.6-0.7 in 99.5 % of frames. */
 export const MIN_ELBOW_BEND = 0.6;
-/** The follower's feet lock from a lower contact than the leader's: its network, at its own
- *  variety, is unsure of its feet, which slid while low (training/mirror/contact.py: measured). */
-export const FOLLOWER_CONTACT = 0.3;
 /** Each step the shown hips take this share of the way from the step they last made to the
  *  network's new step over the floor (a running mean of its steps; horizontal only). Smoothing the
  *  velocity, not the place, the shown hips turn back only when the network's keep going back
@@ -215,7 +213,7 @@ export class HipGlide {
 /** State kept between steps: both dancers' glides, foot locks and the hand hold. */
 export class ContactLayer {
   readonly leaderFeet = new FootLock(CONTACT_THRESHOLD);
-  readonly followerFeet = new FootLock(FOLLOWER_CONTACT);
+  readonly followerFeet = new FootLock(CONTACT_THRESHOLD);
   /** 0..1: how far the closest hands are drawn together. */
   hold = 0;
   /** The pair held: indices into HANDS of the leader's and the follower's hand. */

@@ -22,8 +22,8 @@ export const RELEASE_DECAY = 0.5;
 /** The locks never hold the feet further apart than this (ankle to ankle): a lock trailing behind
  *  a dancer that travels on spread his stance past the recording's widest (1.07 m). */
 export const MAX_STANCE = 0.9;
-/** A foot locks while the model's contact for it is above this (the follower's layer locks from a
- *  lower one: contact.ts FOLLOWER_CONTACT). */
+/** A foot locks while the model's contact for it is above this (both dancers; training/mirror/contact.py
+ *  says why the follower's no longer locks from 0.3). */
 export const CONTACT_THRESHOLD = 0.5;
 
 /**
@@ -118,8 +118,6 @@ export class FootLock {
   private readonly locked = [false, false];
   private readonly target = new Float64Array(6);
   private readonly weight = new Float64Array(2);
-  /** The body's glide (x, z) when each lock began. */
-  private readonly glided = new Float64Array(4);
 
   /** Forget every lock (after a reset or a jump of the dancer). */
   clear(): void {
@@ -130,16 +128,19 @@ export class FootLock {
   /**
    * Lock or release each foot from `contacts` (left, right) and bend the legs of `positions`
    * (17 × 3 world, modified in place). `heading` gives the knee's bend direction for a straight leg.
-   * `glide` (x, z) is how far the contact layer moved the body from where the network put it
-   * (contact.ts HipGlide): a lock trails the network's own foot, so the legs, not the planted foot,
-   * take up what the glide moves the body during a contact.
+   * `glide` (x, z) is how far the contact layer's hip glide moved the body from where the network
+   * put it (contact.ts HipGlide). The feet do not glide: a free foot goes where the network put it
+   * on the floor, a planted one stays at its lock, and the legs take up the glide, so the drawn
+   * steps land when the network's do (training/mirror/footik.py: measured).
    */
   apply(positions: Float32Array | Float64Array, contacts: ArrayLike<number>, heading: number, glide: ArrayLike<number> = NO_GLIDE): void {
+    const glides = glide[0] !== 0 || glide[1] !== 0;
     for (let i = 0; i < FEET.length; i++) {
       const foot = FEET[i];
       const knee = PARENTS[foot];
       const thigh = PARENTS[knee];
-      const fx = positions[3 * foot], fy = positions[3 * foot + 1], fz = positions[3 * foot + 2];
+      // The network's own foot on the floor.
+      const fx = positions[3 * foot] - glide[0], fy = positions[3 * foot + 1], fz = positions[3 * foot + 2] - glide[1];
       const t = this.target;
       const o = 3 * i;
       if (contacts[i] > this.threshold) {
@@ -147,20 +148,15 @@ export class FootLock {
           t[o] = fx;
           t[o + 1] = Math.max(fy, ANKLE_FLOOR);
           t[o + 2] = fz;
-          this.glided[2 * i] = glide[0];
-          this.glided[2 * i + 1] = glide[1];
           this.locked[i] = true;
         } else {
-          // The foot as the glide at the lock's start had it.
-          const ox = fx - (glide[0] - this.glided[2 * i]);
-          const oz = fz - (glide[1] - this.glided[2 * i + 1]);
-          const behind = Math.hypot(t[o] - ox, t[o + 1] - fy, t[o + 2] - oz);
+          const behind = Math.hypot(t[o] - fx, t[o + 1] - fy, t[o + 2] - fz);
           if (behind > MAX_LOCK_DISTANCE) {
-            // Slide along, MAX_LOCK_DISTANCE behind the foot.
+            // slide along, MAX_LOCK_DISTANCE behind the foot
             const k = MAX_LOCK_DISTANCE / behind;
-            t[o] = ox + (t[o] - ox) * k;
+            t[o] = fx + (t[o] - fx) * k;
             t[o + 1] = Math.max(fy + (t[o + 1] - fy) * k, ANKLE_FLOOR);
-            t[o + 2] = oz + (t[o + 2] - oz) * k;
+            t[o + 2] = fz + (t[o + 2] - fz) * k;
           }
         }
         this.weight[i] = 1;
@@ -173,7 +169,7 @@ export class FootLock {
       const tx = fx + (t[o] - fx) * w;
       const ty = Math.max(fy + (t[o + 1] - fy) * w, ANKLE_FLOOR);
       const tz = fz + (t[o + 2] - fz) * w;
-      if (w > 0 || fy < ANKLE_FLOOR) twoBoneIk(positions, thigh, knee, foot, tx, ty, tz, Math.sin(heading), 0, Math.cos(heading), MIN_KNEE_BEND);
+      if (w > 0 || glides || fy < ANKLE_FLOOR) twoBoneIk(positions, thigh, knee, foot, tx, ty, tz, Math.sin(heading), 0, Math.cos(heading), MIN_KNEE_BEND);
     }
   }
 }
