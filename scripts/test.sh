@@ -178,17 +178,43 @@ else
 fi
 
 # The browser tests file by file (as `npm run test:e2e` runs them, one at a time), so that the
-# summary can say where their time goes and which files failed.
+# summary can say where their time goes and which files failed. What every file would make again
+# is made once (tests/e2e/harness.mjs): the built site in dist (DUET_BUILT) and one warm Vite dev
+# server (DUET_DEV_URL, tests/e2e/devserver.mjs). A file run alone makes its own.
 e2e_times=()
 e2e_failed=()
+dev_pid=
+stop_dev_server() {
+  if [ -n "$dev_pid" ]; then kill "$dev_pid" 2>/dev/null; wait "$dev_pid" 2>/dev/null; dev_pid=; fi
+}
+trap stop_dev_server EXIT
 run_e2e() {
-  local file name t0
+  local file name t0=$SECONDS url_file
+  if node node_modules/vite/bin/vite.js build --outDir dist --emptyOutDir --logLevel warn; then
+    export DUET_BUILT=dist
+  else
+    echo "vite build failed: each browser test file that needs the built site builds it itself"
+  fi
+  url_file=$(mktemp)
+  DUET_DEV_URL= node tests/e2e/devserver.mjs >"$url_file" &
+  dev_pid=$!
+  while kill -0 "$dev_pid" 2>/dev/null && ! grep -q '^http' "$url_file"; do sleep 0.5; done
+  if grep -q '^http' "$url_file"; then
+    export DUET_DEV_URL=$(head -n 1 "$url_file")
+  else
+    echo "the shared dev server did not start: each browser test file starts its own"
+    stop_dev_server
+  fi
+  rm -f "$url_file"
+  e2e_times+=("build-and-dev-server $((SECONDS - t0))")
   for file in tests/e2e/*.test.mjs; do
     name=$(basename "$file" .test.mjs)
     t0=$SECONDS
     node --test "$file" || e2e_failed+=("$name")
     e2e_times+=("$name $((SECONDS - t0))")
   done
+  stop_dev_server
+  unset DUET_BUILT DUET_DEV_URL
   [ ${#e2e_failed[@]} = 0 ]
 }
 say "end-to-end (Chromium, tests/e2e)"

@@ -58,8 +58,17 @@ export function freePort() {
   });
 }
 
-/** Run `vite build` into `outDir`. */
+/**
+ * A folder (relative to ROOT, or absolute) that already holds `vite build` of this tree
+ * (DUET_BUILT): scripts/test.sh builds the site once into `dist` for all the browser test files,
+ * where each file built it again (a build is a minute of CPU on a busy 2-core machine). Unset (a
+ * file run alone), each file builds its own.
+ */
+export const BUILT = process.env.DUET_BUILT ? resolve(ROOT, process.env.DUET_BUILT) : null;
+
+/** Run `vite build` into `outDir` (nothing to do when `outDir` is BUILT). */
 export function build(outDir = 'dist') {
+  if (BUILT && resolve(ROOT, outDir) === BUILT) return Promise.resolve();
   return new Promise((resolveBuild, reject) => {
     const child = spawn(process.execPath, [VITE, 'build', '--outDir', outDir, '--emptyOutDir', '--logLevel', 'warn'], {
       cwd: ROOT,
@@ -70,10 +79,38 @@ export function build(outDir = 'dist') {
 }
 
 /**
+ * The built site in a folder the caller may serve but not change: BUILT when scripts/test.sh made
+ * one, else a build into a new temporary folder. Returns { dir, remove() } (remove() deletes only
+ * a folder made here).
+ */
+export async function builtSite(prefix = 'duet-dist-') {
+  if (BUILT) return { dir: BUILT, remove: () => {} };
+  const dir = mkdtempSync(join(tmpdir(), prefix));
+  try {
+    await build(dir);
+  } catch (error) {
+    rmSync(dir, { recursive: true, force: true });
+    throw error;
+  }
+  return { dir, remove: () => rmSync(dir, { recursive: true, force: true }) };
+}
+
+/**
+ * The address of a Vite dev server already running (DUET_DEV_URL, ending in '/'): scripts/test.sh
+ * starts one (tests/e2e/devserver.mjs) for all the browser test files. Vite compiles the page's
+ * hundreds of modules on their first request, in memory: a server of its own per file paid that
+ * again in each file's first page (34 s to ready on a busy 2-core machine, 3-5 s on a warm
+ * server). Unset (a file run alone), each file starts its own.
+ */
+export const DEV_URL = process.env.DUET_DEV_URL || null;
+
+/**
  * Start `vite` (dev) or `vite preview` (built site) on a free port. `base` serves the site from a
- * sub-path (preview only). Returns { url, stop }; stop() kills exactly this process.
+ * sub-path (preview only). Returns { url, stop }; stop() kills exactly this process. A dev server
+ * at '/' is DEV_URL's when that is set (`shared: true`; stop() leaves it running).
  */
 export async function startServer({ mode = 'dev', base = '/', outDir = 'dist' } = {}) {
+  if (mode === 'dev' && base === '/' && DEV_URL) return { url: DEV_URL, stop: async () => {}, log: () => '', shared: true };
   const port = await freePort();
   const args = mode === 'dev' ? [VITE] : [VITE, 'preview', '--outDir', outDir];
   args.push('--host', '127.0.0.1', '--port', String(port), '--strictPort');
