@@ -12,7 +12,7 @@ import { cpSync, mkdirSync, readFileSync, rmSync, symlinkSync, renameSync, write
 import { join } from 'node:path';
 import { build as viteBuild } from 'vite';
 import { serve } from '../../scripts/serve.mjs';
-import { ROOT, sleep } from './harness.mjs';
+import { BUILT, ROOT, sleep } from './harness.mjs';
 
 /** Build the site into `outDir`, with public/ replaced by `publicDir` when given. */
 async function buildInto(outDir, publicDir) {
@@ -33,7 +33,9 @@ export async function twoBuilds(dir) {
   rmSync(dir, { recursive: true, force: true });
   mkdirSync(dir, { recursive: true });
   const a = join(dir, 'a'), b = join(dir, 'b'), publicB = join(dir, 'public-b');
-  await buildInto(a);
+  // Build A is the site as it is: a copy of the one scripts/test.sh made for all the files, if any.
+  if (BUILT) cpSync(BUILT, a, { recursive: true });
+  else await buildInto(a);
   cpSync(join(ROOT, 'public'), publicB, { recursive: true });
   const manifestPath = join(publicB, 'models', 'manifest.json');
   const manifest = JSON.parse(readFileSync(manifestPath, 'utf8'));

@@ -40,7 +40,9 @@ let server;
 
 before(async () => {
   server = await startServer({ mode: 'dev' });
-  // Warm the dev server (first compile, dependency scan) so the measured pages do not reload.
+  // Warm the dev server (first compile, dependency scan) so the measured pages do not reload (the
+  // shared one, DUET_DEV_URL, is warm already).
+  if (server.shared) return;
   const warm = await launch(QUICK);
   warm.page.setDefaultTimeout(READY_MS);
   await warm.page.goto(`${server.url}?seed=1`).catch(() => undefined);

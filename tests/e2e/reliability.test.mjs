@@ -8,15 +8,14 @@
 
 import { after, before, describe, test } from 'node:test';
 import assert from 'node:assert/strict';
-import { createReadStream, mkdtempSync, rmSync, statSync } from 'node:fs';
+import { createReadStream, statSync } from 'node:fs';
 import { createServer } from 'node:http';
-import { tmpdir } from 'node:os';
 import { extname, join, normalize, sep } from 'node:path';
 import {
   CHROMIUM_ARGS,
   QUICK,
   WAIT_MS,
-  build,
+  builtSite,
   distance,
   duet,
   launch,
@@ -360,18 +359,17 @@ describe('without cross-origin isolation the page runs on one thread', () => {
   });
 
   test('built site on a plain static server (no headers at all), from a sub-path', async (t) => {
-    const outDir = mkdtempSync(join(tmpdir(), 'duet-dist-'));
+    const site = await builtSite();
     let plain;
     try {
-      await build(outDir);
-      plain = await plainStaticServer(outDir);
+      plain = await plainStaticServer(site.dir);
       const { page, consoleErrors } = await openPage(browser);
       await expectOneThread(t, page, `${plain.url}?seed=4`);
       assert.deepEqual(consoleErrors, []);
       await page.close();
     } finally {
       await plain?.stop();
-      rmSync(outDir, { recursive: true, force: true });
+      site.remove();
     }
   });
 });

@@ -14,10 +14,7 @@
 
 import { after, before, test } from 'node:test';
 import assert from 'node:assert/strict';
-import { mkdtempSync, rmSync } from 'node:fs';
-import { tmpdir } from 'node:os';
-import { join } from 'node:path';
-import { QUICK, WAIT_MS, build, distance, duet, launch, sleep, startServer, waitReady } from './harness.mjs';
+import { QUICK, WAIT_MS, builtSite, distance, duet, launch, sleep, startServer, waitReady } from './harness.mjs';
 
 const SOAK_SECONDS = Number(process.env.DUET_SOAK_SECONDS ?? 120);
 const WARMUP_SECONDS = 10;
@@ -75,21 +72,20 @@ function watchWasmMemory() {
   });
 }
 
-let outDir;
+let site;
 let server;
 let browser;
 
 before(async () => {
-  outDir = mkdtempSync(join(tmpdir(), 'duet-soak-'));
-  await build(outDir);
-  server = await startServer({ mode: 'preview', outDir });
+  site = await builtSite('duet-soak-');
+  server = await startServer({ mode: 'preview', outDir: site.dir });
   browser = await launch(QUICK);
 });
 
 after(async () => {
   await browser?.close();
   await server?.stop();
-  if (outDir) rmSync(outDir, { recursive: true, force: true });
+  site?.remove();
 });
 
 const mb = (bytes) => `${(bytes / 2 ** 20).toFixed(2)} MiB`;
