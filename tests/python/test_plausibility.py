@@ -281,6 +281,15 @@ def test_the_leaders_guard_judges_his_head_from_its_own_margin_except_while_he_l
     his = np.zeros(feat.LEADER_INPUT_SIZE, np.float32)
     assert slack_for(his, 0.07, 0.03) == pytest.approx(0.04)
     assert slack_for(his, 0.07, None) == 0.0
+    leading = his.copy()                          # her turn runs: he leads, judged from the full margin
+    figure = feat.block_slices(feat.LEADER_INPUT_LAYOUT)["figure"]
+    leading[figure] = feat.figure_block(np.array([[feat.FIGURE_KINDS.index(("her_turn", 1)), 25, 45]]),
+                                        np.array([30]))[0]
+    assert slack_for(leading, 0.07, 0.03) == 0.0
+    coming = his.copy()                           # his own turn 2 s away: not yet
+    coming[figure] = feat.figure_block(np.array([[feat.FIGURE_KINDS.index(("his_turn", -1)), 90, 110]]),
+                                       np.array([30]))[0]
+    assert slack_for(coming, 0.07, 0.03) == pytest.approx(0.04)
     assert slack_for(np.zeros(feat.INPUT_SIZE), 0.07, 0.03) == pytest.approx(0.04)   # a follower's input
 
     calls = []

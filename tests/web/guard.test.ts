@@ -3,7 +3,7 @@
 // stand, one sunk by its hip), and the choice of the most upright; the leader's head margin.
 
 import { describe, expect, it } from 'vitest';
-import { INPUT_SIZE, LEADER_INPUT_SIZE, OUTPUT_SIZE } from '../../web/mirror/features';
+import { FIGURE_KINDS, FIGURE_OFFSETS, INPUT_SIZE, LEADER_INPUT_LAYOUT, LEADER_INPUT_SIZE, OUTPUT_SIZE, blockSlices, figureKind } from '../../web/mirror/features';
 import { PARTNER_HIPS, hipSlackFor, mostUpright, slackFor, uprightMargin } from '../../web/mirror/guard';
 import { expectClose, fixture } from './fixture';
 
@@ -65,8 +65,13 @@ describe('the leader guard\'s head margin', () => {
     expect(slackMargins[3]).toBeLessThan(0); // the sunk body stays low
   });
 
-  it('is let off only with a headMargin', () => {
+  it('is let off only with a headMargin, and not while a figure runs or comes', () => {
     expect(slackFor(new Float32Array(LEADER_INPUT_SIZE), 0.07, 0.03)).toBeCloseTo(0.04, 12);
+    const leading = new Float32Array(LEADER_INPUT_SIZE);
+    const figure = blockSlices(LEADER_INPUT_LAYOUT).figure.start;
+    const now = FIGURE_OFFSETS.indexOf(0);
+    leading[figure + 2 * (now * FIGURE_KINDS.length + figureKind('her_turn', 1))] = 1; // her turn, inside now
+    expect(slackFor(leading, 0.07, 0.03)).toBe(0);
     expect(slackFor(new Float32Array(LEADER_INPUT_SIZE), 0.07)).toBe(0);
     expect(slackFor(new Float32Array(INPUT_SIZE).fill(1), 0.07, 0.03)).toBeCloseTo(0.04, 12); // a follower's input
   });

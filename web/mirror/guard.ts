@@ -8,13 +8,14 @@
 // body never jumps; the guard only chooses among the network's own reactions. Measured in Python:
 // it chose in 210 of 1.8 M follower steps of the 100 x 10 min soak (docs/reliability.md). A
 // manifest's leaderGuard.headMargin judges the leader's head over his hips from a smaller margin
-// (0.03 m shipped), and its leaderGuard.hipMargin his hips from a
+// (0.03 m shipped), except while a figure runs or comes, and its leaderGuard.hipMargin his hips from a
 // larger one (0.10 m: a crouch caught before it is too deep); its guard.hipMargin judges the
 // follower's hips from a larger one (0.15 m shipped): beside the leader who then lunges, her hips drop fast when
 // she falls (guard.py, LEADER_HEAD_MARGIN and FOLLOWER_HIP_MARGIN); and while her input shows his
 // hips below guard.partnerLow (a lunge), from guard.partnerLowHipMargin (guard.py, PARTNER_LOW).
 
-import { FOLLOWER_INPUT_LAYOUT, INPUT_SIZE, N_JOINTS, OUTPUT_LAYOUT, blockSlices } from './features';
+import { FOLLOWER_INPUT_LAYOUT, INPUT_SIZE, LEADER_INPUT_SIZE, N_JOINTS, OUTPUT_LAYOUT, blockSlices } from './features';
+import { figureWay } from './on_count';
 import { MIN_ANKLE_HEIGHT, rotationsFromVectors } from './rollout';
 import { FEET, HEAD, forwardKinematicsReduced } from './skeleton';
 
@@ -113,10 +114,13 @@ function drawnMargin(lift: number, r: Ranges, headSlack: number, hipSlack: numbe
 
 /**
  * Metres a guard lets off the head-over-hips part for this input: margin - headMargin; none when
- * it has no headMargin.
+ * it has no headMargin, or while the input is a leader's whose figure runs or comes (figureWay):
+ * leading, he is judged from the full margin (guard.py slack_for: measured).
  */
 export function slackFor(input: ArrayLike<number>, margin: number, headMargin?: number): number {
-  return headMargin === undefined ? 0 : margin - headMargin;
+  if (headMargin === undefined) return 0;
+  if (input.length === LEADER_INPUT_SIZE && figureWay(input, 'leader') !== null) return 0;
+  return margin - headMargin;
 }
 
 /**
