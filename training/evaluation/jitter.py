@@ -128,12 +128,12 @@ def markdown(title: str, s: dict, reference: dict) -> str:
     for role in ("leader", "follower"):
         ref = reference[role]
         lines.append(f"| recorded {role} | {ref['reversals_per_s']:.2f} | {ref['speed_change_cm']:.2f} |")
-        for kind in ("raw", "shown"):
+        for kind in ("shown", "raw"):   # as drawn first: what a visitor sees
             cells = []
             for k in ("reversals_per_s", "speed_change_cm"):
                 c = s[f"{role}_{kind}_{k}"]
                 cells.append(f"{c['mean']:.2f} ({c['ratio']:.2f}×; worst seed {c['worst_seed']}: {c['worst']:.2f})")
-            lines.append(f"| {role}, {kind} | {' | '.join(cells)} |")
+            lines.append(f"| {role}, {'as drawn' if kind == 'shown' else 'its network'} | {' | '.join(cells)} |")
     return "\n".join(lines) + "\n"
 
 

@@ -177,9 +177,24 @@ def turn_counts(data: str) -> dict:
 FIGURES = ["pulse", "period_off", "on_beat"]
 
 
+# Every rhythm figure is read on the bodies the page draws (after the contact layer) and on the
+# networks' own: the layer's foot locks and hip glide can move when a foot lands.
+BODIES = {"drawn": "as drawn (after the contact layer)", "networks": "the networks' bodies"}
+
+
+def bodies_rhythm(record: dict, tempo: float, seed: int) -> dict[str, dict]:
+    """A recorded duet's rhythm (duet.soak_one's `record`) as drawn and the networks' own, after
+    the first second's standing start."""
+    sl = slice(FPS, None)
+    return {body: {"seed": seed, **rhythm(record["leader" + suffix][sl], record["follower" + suffix][sl],
+                                          record["beat"][sl], tempo)}
+            for body, suffix in (("drawn", "_shown"), ("networks", ""))}
+
+
 def duet_rhythm(manifest, leader, follower, seed: int, frames: int, temperature: float,
-                tempo: float, steered: bool) -> dict:
-    """One of the soak's duets (steered by its stick, or by nobody), at a tempo: its rhythm."""
+                tempo: float, steered: bool) -> dict[str, dict]:
+    """One of the soak's duets (steered by its stick, or by nobody), at a tempo: its rhythm as
+    drawn (the bodies the page shows, after the contact layer) and the networks' own."""
     from .duet import soak_one
     from .options import restart_count
     record: dict = {}
@@ -187,9 +202,7 @@ def duet_rhythm(manifest, leader, follower, seed: int, frames: int, temperature:
         restart_count(policy)
     soak_one(manifest, leader, follower, seed, frames, temperature, record=record, tempo=tempo,
              steer=steered)
-    # The first second is the standing start: the rhythm of the dance after it.
-    sl = slice(FPS, None)
-    return {"seed": seed, **rhythm(record["leader"][sl], record["follower"][sl], record["beat"][sl], tempo)}
+    return bodies_rhythm(record, tempo, seed)
 
 
 def summarize(rows: list[dict], reference: dict) -> dict:
@@ -344,10 +357,12 @@ def main(argv=None) -> int:
                 print(f"\r  {tempo:.0f} bpm, {'steered' if steered else 'nobody steering'}: seed {seed + 1}/{args.seeds} "
                       f"({time.time() - t0:.0f} s)", end="", file=sys.stderr, flush=True)
             print(file=sys.stderr)
-            s = summarize(rows, reference)
-            title = f"{tempo:.1f} beats a minute, {'steered (the soak stick)' if steered else 'nobody steering'}"
-            print(format_summary(title, s, reference), flush=True)
-            report["runs"].append({"tempo": tempo, "steered": steered, "summary": s, "seeds": rows})
+            for body, what in BODIES.items():
+                b_rows = [r[body] for r in rows]
+                s = summarize(b_rows, reference)
+                title = f"{tempo:.1f} beats a minute, {'steered (the soak stick)' if steered else 'nobody steering'}, {what}"
+                print(format_summary(title, s, reference), flush=True)
+                report["runs"].append({"tempo": tempo, "steered": steered, "bodies": body, "summary": s, "seeds": b_rows})
     if args.out:
         Path(args.out).parent.mkdir(parents=True, exist_ok=True)
         Path(args.out).write_text(json.dumps(report, indent=1, default=float))

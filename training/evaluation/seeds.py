@@ -102,8 +102,8 @@ def _one(job: tuple[int, int, float, float]) -> dict:
     out = {"seed": seed, "resets": soak["resets"], "guarded": getattr(w["follower"], "guarded", 0),
            "leader_guarded": getattr(w["leader"], "guarded", 0),
            "figures": {"leader": dancer_figures(rec["leader"]), "follower": dancer_figures(rec["follower"])},
-           # on the count: after the first second's standing start (evaluation.rhythm)
-           "rhythm": {"seed": seed, **R.rhythm(rec["leader"][FPS:], rec["follower"][FPS:], rec["beat"][FPS:], tempo)}}
+           # on the count, as drawn and the networks' own (evaluation.rhythm)
+           "rhythm": R.bodies_rhythm(rec, tempo, seed)}
     for kind, suffix in (("alone", ""), ("layer", "_shown")):
         lead, follow = rec["leader" + suffix], rec["follower" + suffix]
         out[kind] = {**P.duet(lead, follow, w["ranges"]),
@@ -131,7 +131,7 @@ def run_method(args, method: str, r: dict, test: list[str], bar, r_rhythm: dict)
     row = {"per_seed": per_seed, "resets": int(sum(s["resets"] for s in per_seed)),
            "guarded": int(sum(s["guarded"] for s in per_seed)),
            "seeds_guarded": int(sum(s["guarded"] > 0 for s in per_seed)), "figures": figures_row(per_seed),
-           "rhythm": R.summarize([s["rhythm"] for s in per_seed], r_rhythm)}
+           "rhythm": {body: R.summarize([s["rhythm"][body] for s in per_seed], r_rhythm) for body in R.BODIES}}
     for kind in ("alone", "layer"):
         duets = [s[kind] for s in per_seed]
         row[kind] = {**P.summarize(duets, [frames] * len(duets)), **weighted(duets, [frames] * len(duets))}
@@ -284,8 +284,9 @@ def main(argv=None) -> int:
     (out / "seeds.json").write_text(json.dumps(res, indent=1))
     write_markdown(out / "seeds.md", res)
     for m, row in res["methods"].items():
-        print(R.format_summary(f"rhythm of {m}, steered, at {res['tempo']:g} beats a minute", row["rhythm"],
-                               res["rhythm_recording"]))
+        for body, what in R.BODIES.items():
+            print(R.format_summary(f"rhythm of {m}, steered, at {res['tempo']:g} beats a minute, {what}",
+                                   row["rhythm"][body], res["rhythm_recording"]))
     print(f"wrote {out}/seeds.json and seeds.md")
     return 0
 

@@ -163,8 +163,8 @@ def main(argv=None) -> int:
             r["collapsed"] = [who for who in ("leader", "follower") if r["plausibility"][who]["collapse"]]
             r["fell"] = r["plausibility"]["follower"]["worst_second"] > P.BAD_SECOND
         r["failures"] = failures(r)
-        # on the count, after the first second's standing start (evaluation.rhythm)
-        r["rhythm"] = {"seed": r["seed"], **R.rhythm(rec["leader"][FPS:], rec["follower"][FPS:], rec["beat"][FPS:], args.tempo)}
+        # on the count, as drawn and the networks' own (evaluation.rhythm)
+        r["rhythm"] = R.bodies_rhythm(rec, args.tempo, r["seed"])
         results.append(r)
         tqdm.write(f"{r['seed']:>5} {r['nonfinite']:>10} {r['max_distance']:>11.2f} "
                    f"{r['bone_error'] * 1000:>12.4f} {r['min_foot'] * 100:>12.1f} {r['frozen_leader']:>9.3f} "
@@ -206,8 +206,10 @@ def main(argv=None) -> int:
         except Exception as e:   # a data folder that is not the couples: the rhythm stays unrated
             print(f"rhythm: not compared with the recording ({e})")
         else:
-            summary["rhythm"] = R.summarize([r["rhythm"] for r in results], reference)
-            print(R.format_summary(f"rhythm at {args.tempo:g} beats a minute, steered", summary["rhythm"], reference))
+            summary["rhythm"] = {body: R.summarize([r["rhythm"][body] for r in results], reference) for body in R.BODIES}
+            for body, what in R.BODIES.items():
+                print(R.format_summary(f"rhythm at {args.tempo:g} beats a minute, steered, {what}",
+                                       summary["rhythm"][body], reference))
     if out is not None:
         out.write_text(json.dumps({"summary": summary, "rollouts": results}, indent=1))
         print(f"wrote {out}")
