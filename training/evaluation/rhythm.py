@@ -245,7 +245,7 @@ def format_summary(title: str, s: dict, reference: dict) -> str:
 def plot(path: str, data: str, manifest, leader, follower, temperature: float, tempo: float,
          take: str = "07", seed: int = 0, start: float = 6.0, seconds: float = 5.0) -> None:
     """Footwork against the beat: a recorded take at its found count above a duet of the shipped
-    networks (nobody steering, `seed`) at `tempo`; vertical lines are the beats."""
+    dancers as the page draws them (nobody steering, `seed`) at `tempo`; vertical lines are the beats."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -257,8 +257,8 @@ def plot(path: str, data: str, manifest, leader, follower, temperature: float, t
     frames = int((start + seconds) * FPS) + FPS
     soak_one(manifest, leader, follower, seed, frames, temperature, record=rec, tempo=tempo, steer=False)
     rows = [(f"recorded take {take}, its found count", lead.positions, follow.positions, lead.beat),
-            (f"the shipped networks, nobody steering (seed {seed}), music at {tempo:g} beats a minute",
-             rec["leader"], rec["follower"], rec["beat"])]
+            (f"the shipped dancers as the page draws them, nobody steering (seed {seed}), music at {tempo:g} beats a minute",
+             rec["leader_shown"], rec["follower_shown"], rec["beat"])]
     fig, axes = plt.subplots(2, 1, figsize=(10, 4.2), sharex=True)
     for ax, (title, lp, fp, beat) in zip(axes, rows):
         x, sl = plot_footwork(ax, lp, fp, start, seconds)
