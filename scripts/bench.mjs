@@ -66,8 +66,8 @@ function pageOptions() {
   }
   return {
     threadCounts: option('threads', '1,2').split(',').map(Number),
-    // --leading presses T every 2 s to time the steps while her turn is led (both dancers read the
-    // figure; the step's work is the same as nobody asking, which this shows).
+    // While a turn is led the leader's guard draws its samples every step (leaderGuard.keepPlan), so the
+    // step costs more then: --leading presses T every 2 s (a request lasts 2.5 s) to time those steps.
     leading: args.includes('--leading'),
     // Both dancers choose each step among onCount.samples at once (web/mirror/on_count.ts): --count-cost
     // also runs the page with the manifest's onCount taken out, so the two step times share one machine state.

@@ -655,11 +655,12 @@ def figures_fixture(manifest: dict) -> dict:
                                       (40, "her_turn", -3, False), (7, "his_turn", 1, False), (12, "his_turn", -1, False),
                                       (40, "his_turn", 2, True))]
     led = ro.Led("her_turn", -1, 20, 56)
-    share = [{"frame": f, "share": ro.figure_share(led, f)}
+    share = [{"frame": f, "share": ro.figure_share(led, f), "raised": ro.raised(led, f)}
              for f in (0, 19, 20, 21, 26, 32, 38, 50, 56, 57, 64, 71, 72, 100)]
     return {"tempo": 183.0, "beat": 0.61, "draws": draws.numbers, "drawn": draws.used, "asks": SCHEDULE_ASKS,
             "ownOff": list(SCHEDULE_OWN_OFF), "steps": steps,
             "FIGURE_BEATS": ro.FIGURE_BEATS, "OWN_GAP_BEATS": list(ro.OWN_GAP_BEATS), "HIS_SHARE": ro.HIS_SHARE,
+            "RAISE": list(ro.RAISE),
             "clock": {"tempo": 171.0, "frame": 7, "beat": 2.95, "framesToBeat": to_beat, "figureFrom": figure_from},
             "led": [led.name, led.way, led.start, led.end], "share": share}
 
@@ -671,6 +672,7 @@ def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_o
     manifest = {"skeleton": {"offsets": {"leader": lead_offsets.tolist(), "follower": follow_offsets.tolist()}},
                 "startPose": start_pose}
     started = ro.start_duet(manifest)
+    request_hands = np.round(np.random.default_rng(30).normal([0.0, 1.3, 0.25], 0.15, size=(2, 2, 3)), 5)
 
     def window(track: Track) -> Track:   # frames 0..60 of a procedural track: NOW is its frame 30
         n = ro.TRACK_FRAMES
@@ -759,6 +761,10 @@ def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_o
     # The leader's head margin: the head over the hips let off 0.04 m, under a range whose head part
     # binds for the upright bodies (so the slack shows).
     tight = {**ranges, "head_above_hip_low": 0.75}
+    plan_input = np.zeros(feat.LEADER_INPUT_SIZE)
+    plan_input[G.HANDS_PLAN_SHOWN] = 1.0
+    plan_input[G.HAND_HEIGHTS] = 0.8, 0.7
+    plan_input[G.HAND_PLAN_FIRST] = 0.05, 0.4
     uprightness = {"outputs": exact(outputs), "ranges": ranges,
                    "margins": out7(G.upright_margin(outputs, ranges, follow_offsets)),
                    "best": G.most_upright(outputs, ranges, follow_offsets),
@@ -767,8 +773,16 @@ def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_o
                    # The follower's hip margin: her hips judged 0.1 m further from the edge.
                    "hipSlackMargins": out7(G.upright_margin(outputs, ranges, follow_offsets, 0.0, -0.1)),
                    "hipSlackBest": G.most_upright(outputs, ranges, follow_offsets, 0.0, -0.1),
+                   "handsPlanShown": G.HANDS_PLAN_SHOWN,
                    # Her hips' slack from what her input shows of his hips (guard.hip_slack_for).
-                   "partnerHips": G.PARTNER_HIPS, "hipSlackFor": hip_slack_cases()}
+                   "partnerHips": G.PARTNER_HIPS, "hipSlackFor": hip_slack_cases(),
+                   # The leader's lead hand kept to a request's plan (guard.lead_hand_miss, nearest_plan),
+                   # on the same bodies: the plan raises his right hand 0.4 m by the first key. At margin 0
+                   # the second body's hand is nearest; at 0.05 it does not stand, and the first is taken.
+                   "handHeights": G.HAND_HEIGHTS, "handPlanFirst": G.HAND_PLAN_FIRST,
+                   "planInput": exact(plan_input), "planMiss": out7(G.lead_hand_miss(outputs, plan_input, follow_offsets)),
+                   "planBest": G.nearest_plan(outputs, plan_input, ranges, follow_offsets, 0.0),
+                   "planBestStanding": G.nearest_plan(outputs, plan_input, ranges, follow_offsets, 0.05)}
     return {
         "NOW": ro.NOW, "TRACK_FRAMES": ro.TRACK_FRAMES, "guards": guards, "upright": uprightness,
         "onCount": on_count_cases(np.random.default_rng(SEED + 3), outputs, ranges, follow_offsets),
@@ -781,20 +795,47 @@ def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_o
         "steps": steps,
         "stepDraws": step_draws.numbers, "stepDrawn": step_draws.used,
         "figures": figures_fixture(manifest),
+        "handsInputs": hands_input_cases(lead_offsets, window(lead), request_hands),
         "leadPlans": lead_plan_cases(lead_offsets, window(lead)),
     }
 
 
-# A figure at duet frames 40-76 for the bent path, read at frames around it.
-PLAN_FIGURE = (40, 76)
+# A figure at duet frames 40-76 for the hands plan and the bent path, read at frames around it.
+HANDS_FIGURE = (40, 76)
+HANDS_FRAMES = (5, 10, 11, 25, 40, 46, 52, 70, 76, 80, 91, 92)
+
+
+def hands_input_cases(offsets, track: Track, hands: np.ndarray) -> list[dict]:
+    """rollout.hands_input for the leader standing at frame 30 of the procedural track, a figure of
+    each kind (his hands when its plan began given, or taken now: None; his own turn has no plan)
+    at HANDS_FRAMES, and two figures at once (the plan is for the first near her turn)."""
+    out = []
+    for name, way, given in (("her_turn", 1, hands[0]), ("her_turn", -1, hands[1]), ("her_turn", -1, None),
+                             ("his_turn", 1, None), ("his_turn", -1, hands[1])):
+        for frame in HANDS_FRAMES:
+            duet = ro.Duet(ro.Dancer(offsets, track), ro.Dancer(offsets, track), {}, frame=frame)
+            led = ro.Led(name, way, *HANDS_FIGURE, hands=None if given is None else given.copy())
+            duet.figures.led = [led]
+            moves = ro.hands_input(duet)
+            out.append({"name": name, "way": way, "frame": frame, "hands": None if given is None else exact(given),
+                        "moves": None if moves is None else out7(moves),
+                        "handsAfter": None if led.hands is None else out7(led.hands)})
+    for two in ([("her_turn", 1, 20, 56), ("her_turn", -1, 60, 96)],
+                [("his_turn", 1, 50, 70), ("her_turn", -1, 60, 96)],   # his own turn first: the plan is for hers
+                [("her_turn", 1, 20, 56), ("his_turn", -1, 60, 96)]):  # hers lowering while his runs
+        duet = ro.Duet(ro.Dancer(offsets, track), ro.Dancer(offsets, track), {}, frame=70)
+        duet.figures.led = [ro.Led(n, w, a, b, hands=h.copy()) for (n, w, a, b), h in zip(two, hands)]
+        out.append({"two": [list(x) for x in two], "hands": [exact(hands[0]), exact(hands[1])], "frame": 70,
+                    "moves": out7(ro.hands_input(duet))})
+    return out
 
 
 def lead_plan_cases(offsets, track: Track) -> list[dict]:
     """rollout.lead_plan on the leader's planned path (the procedural track's frames 31-60) for a
     figure of each kind and for two at once (her turn and his), at frames before, in and after them."""
     out = []
-    for spans in ([("her_turn", 1, *PLAN_FIGURE)], [("her_turn", -1, *PLAN_FIGURE)],
-                  [("his_turn", 1, *PLAN_FIGURE)], [("his_turn", -1, 40, 60)],
+    for spans in ([("her_turn", 1, *HANDS_FIGURE)], [("her_turn", -1, *HANDS_FIGURE)],
+                  [("his_turn", 1, *HANDS_FIGURE)], [("his_turn", -1, 40, 60)],
                   [("her_turn", 1, 20, 56), ("her_turn", -1, 60, 96)],
                   [("his_turn", -1, 20, 40), ("her_turn", 1, 50, 86)]):
         for frame in (0, 15, 30, 45, 58, 70, 76, 90):

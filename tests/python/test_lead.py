@@ -113,17 +113,30 @@ def test_hands_moves_are_where_his_hands_go_less_where_they_are():
     assert np.all(feat.hands_plan_block(None, 2) == 0)
 
 
-def test_his_hands_plan_stays_hidden_while_he_leads_her_turn():
-    """The page leads her turn through the figure both dancers read, not through his hands plan
-    (rollout.py says why): his input holds the figure and no plan."""
+def test_a_figure_raises_his_lead_hand_and_lowers_it():
     duet = manifest_duet(figures=False)
-    ro.ask_turn(duet, -1)
-    duet.frame = duet.figures.led[0].start
-    x_leader, x_follower = ro.step_inputs(duet)
-    blocks = feat.block_slices(feat.LEADER_INPUT_LAYOUT)
-    assert np.all(x_leader[blocks["hands_plan"]] == 0)
-    assert np.any(x_leader[blocks["figure"]] != 0)
-    assert np.array_equal(x_leader[blocks["figure"]], x_follower[feat.block_slices(feat.FOLLOWER_INPUT_LAYOUT)["figure"]])
+    ro.ask_turn(duet, -1)                                  # her turn to the right: his right hand leads
+    led, leader = duet.figures.led[0], duet.leader
+    hands = feat.to_root_space_points(leader.positions[HANDS], leader.root, leader.heading)
+    assert ro.raised(led, led.start) == 0 and ro.raised(led, led.start + ro.RAISE[0] * FPS) == 1
+    assert ro.raised(led, led.end + ro.RAISE[1] * FPS) == 0
+    top = np.array(ro.LEAD_HAND_RAISED) * [-1, 1, 1]
+    tops = []
+    for f in range(led.end + int(ro.RAISE[1] * FPS) + 2):
+        duet.frame = f
+        moves = ro.hands_input(duet)
+        if moves is None:
+            tops.append(None)
+            continue
+        assert np.allclose(moves[:, 0], 0.0)               # the other hand stays where it was
+        tops.append(hands[1] + moves[0, 1])               # where the lead hand is to be 1/6 s ahead
+    assert np.allclose(led.hands, hands)
+    up = tops[led.start + int(ro.RAISE[0] * FPS):led.end - 5]
+    assert up and all(np.allclose(t, top) for t in up)  # held up while she turns
+    assert tops[-1] is None                                # and no plan once it is down
+    duet.frame = led.start
+    x_leader, _ = ro.step_inputs(duet)
+    assert x_leader[feat.block_slices(feat.LEADER_INPUT_LAYOUT)["hands_plan"]][0] == 1
 
 
 def test_his_planned_path_leads_her_turns_way():
@@ -335,3 +348,4 @@ def test_his_own_turn_turns_his_planned_path_a_full_turn_without_a_side_step():
     share = np.array([ro.figure_share(led, led.start + o) for o in FUTURE_OFFSETS])
     assert np.allclose(t.heading[keys] - heading[keys], -2 * np.pi * share)
     assert np.array_equal(t.root, root)
+    assert ro.hands_input(duet) is None                    # his own turn raises no lead hand

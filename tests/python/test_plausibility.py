@@ -254,9 +254,9 @@ def test_seeds_runs_the_guard_and_refuses_a_guard_of_one(exported, data3, tmp_pa
 def test_the_leaders_guard_judges_his_head_from_its_own_margin_except_while_he_leads():
     """guard.slack_for and UprightGuard(head_margin=...): the leader's head over his hips is judged
     from the smaller head margin (a narrow range: at the full margin the guard kept his stiffest
-    sample)."""
+    sample), but while his input shows a hands plan (a request runs) from the full one."""
     from training.evaluation.plausibility import CHEST
-    from training.mirror.guard import POSE, UprightGuard, slack_for, upright_margin
+    from training.mirror.guard import HANDS_PLAN_SHOWN, POSE, UprightGuard, slack_for, upright_margin
     from training.mirror.skeleton import HEAD
 
     r = {"hip_low": 0.7, "head_above_hip_low": 0.6, "feet_wide": 1.0, "angle_high": [3.0, 0.6]}
@@ -278,19 +278,13 @@ def test_the_leaders_guard_judges_his_head_from_its_own_margin_except_while_he_l
     low[POSE.start + 1] = 0.72
     assert upright_margin(low, r, head_slack=1.0)[0] < 0.05
 
-    his = np.zeros(feat.LEADER_INPUT_SIZE, np.float32)
-    assert slack_for(his, 0.07, 0.03) == pytest.approx(0.04)
-    assert slack_for(his, 0.07, None) == 0.0
-    leading = his.copy()                          # her turn runs: he leads, judged from the full margin
-    figure = feat.block_slices(feat.LEADER_INPUT_LAYOUT)["figure"]
-    leading[figure] = feat.figure_block(np.array([[feat.FIGURE_KINDS.index(("her_turn", 1)), 25, 45]]),
-                                        np.array([30]))[0]
+    unasked = np.zeros(feat.LEADER_INPUT_SIZE, np.float32)
+    leading = unasked.copy()
+    leading[HANDS_PLAN_SHOWN] = 1.0
+    assert slack_for(unasked, 0.07, 0.03) == pytest.approx(0.04)
     assert slack_for(leading, 0.07, 0.03) == 0.0
-    coming = his.copy()                           # his own turn 2 s away: not yet
-    coming[figure] = feat.figure_block(np.array([[feat.FIGURE_KINDS.index(("his_turn", -1)), 90, 110]]),
-                                       np.array([30]))[0]
-    assert slack_for(coming, 0.07, 0.03) == pytest.approx(0.04)
-    assert slack_for(np.zeros(feat.INPUT_SIZE), 0.07, 0.03) == pytest.approx(0.04)   # a follower's input
+    assert slack_for(unasked, 0.07, None) == 0.0
+    assert slack_for(np.zeros(feat.INPUT_SIZE), 0.07, 0.03) == pytest.approx(0.04)   # not a leader's input
 
     calls = []
 
@@ -301,11 +295,10 @@ def test_the_leaders_guard_judges_his_head_from_its_own_margin_except_while_he_l
 
     guard = UprightGuard(policy, r, samples=4, margin=0.07, head_margin=0.03)
     rng = np.random.default_rng(0)
-    guard(his, 0.5, rng)                          # 0.04 above the low end, the head margin 0.03: passes
+    guard(unasked, 0.5, rng)                      # 0.04 above the low end, the head margin 0.03: passes
     assert guard.guarded == 0 and calls == [1]
-    full = UprightGuard(policy, r, samples=4, margin=0.07)
-    chosen = full(his, 0.5, rng)                  # without the head margin: judged from 0.07, the batch drawn
-    assert full.guarded == 1 and calls == [1, 1, 4]
+    chosen = guard(leading, 0.5, rng)             # leading: judged from 0.07, so the batch is drawn
+    assert guard.guarded == 1 and calls == [1, 1, 4]
     assert chosen["output"][0][POSE][HEAD * 12 + 1] == pytest.approx(1.7)
 
 
@@ -392,3 +385,57 @@ def test_the_followers_guard_judges_her_hips_from_further_up_while_he_lunges():
     assert chosen["output"][0][POSE.start + 1] == pytest.approx(0.95)
 
 
+def test_the_leaders_guard_keeps_his_lead_hand_to_a_requests_plan():
+    """guard.lead_hand_miss, nearest_plan and UprightGuard(keep_plan=True): while his input shows a
+    hands plan, every step draws the batch and takes the standing sample whose lead hand (the one the
+    plan puts higher) is nearest the plan's height one step on; with no plan, one sample as before."""
+    from training.mirror.guard import (HAND_HEIGHTS, HAND_PLAN_FIRST, HANDS_PLAN_SHOWN, POSE, UprightGuard,
+                                       drawn_joints, lead_hand_miss, nearest_plan)
+    from training.mirror.skeleton import HANDS
+
+    # A straight column of 20 cm bones, upright: every joint's drawn height is the hips' plus its depth.
+    offsets = np.zeros((feat.N_JOINTS, 3))
+    offsets[1:, 1] = 0.2
+    r = {"hip_low": 0.7, "head_above_hip_low": 0.0, "feet_wide": 1.0, "angle_high": [3.0, 0.6]}
+
+    def output(hips: float) -> np.ndarray:
+        out = np.zeros(feat.OUTPUT_SIZE, np.float32)
+        pose = out[POSE].reshape(feat.N_JOINTS, 12)
+        pose[0, 1] = hips
+        pose[:, 6:9], pose[:, 9:12] = (0, 0, 1), (0, 1, 0)
+        out[POSE] = pose.reshape(-1)
+        return out
+
+    above_hips = drawn_joints(output(1.0), offsets)[0, HANDS, 1] - 1.0   # each hand's height over the hips
+    x = np.zeros(feat.LEADER_INPUT_SIZE)
+    x[HANDS_PLAN_SHOWN] = 1.0
+    x[HAND_HEIGHTS] = 1.9, 1.8             # his hands now: the left at 1.9 m, the right at 1.8 m
+    x[HAND_PLAN_FIRST] = 0.0, 0.5          # the plan raises his right hand 0.5 m by the first key
+    target = 1.8 + 0.5 / feat.KEY_STEP     # the right hand leads (2.3 m at the key): 1.9 m one step on
+    hips = np.array([1.3, 0.75, target - above_hips[1], 0.6])
+    samples = [output(h) for h in hips]
+    miss = lead_hand_miss(np.stack(samples), x, offsets)
+    assert np.allclose(miss, np.abs(hips + above_hips[1] - target), atol=1e-5) and miss[2] == pytest.approx(0.0, abs=1e-5)
+    assert nearest_plan(np.stack(samples), x, r, offsets, margin=0.07) == 2   # 0.75 m is within the margin
+    # The nearest must stand: with the range's hips raised past it, the next nearest that stands.
+    high = {**r, "hip_low": hips[2] - 0.05}
+    assert nearest_plan(np.stack(samples), x, high, offsets, margin=0.07) == 0
+    assert nearest_plan(np.stack([output(0.5), output(0.6)]), x, r, offsets, margin=0.07) == 1   # none stands
+
+    calls = []
+
+    def policy(x, temperature, rng):
+        calls.append(len(np.atleast_2d(x)))
+        return {"output": np.stack(samples[:len(np.atleast_2d(x))])}
+
+    rng = np.random.default_rng(0)
+    guard = UprightGuard(policy, r, samples=4, margin=0.07, offsets=offsets, keep_plan=True)
+    chosen = guard(x, 0.7, rng)
+    assert calls == [4] and guard.kept == 1 and guard.guarded == 0
+    assert chosen["output"][0][POSE.start + 1] == pytest.approx(hips[2])
+    plain = x.copy()
+    plain[HANDS_PLAN_SHOWN] = 0.0          # nobody asks: one sample, as before
+    assert guard(plain, 0.7, rng)["output"][0][POSE.start + 1] == pytest.approx(1.3) and calls == [4, 1]
+    assert UprightGuard(policy, r, samples=4, offsets=offsets)(x, 0.7, rng) is not None and calls[-1] == 1
+    with pytest.raises(ValueError, match="bones"):
+        UprightGuard(policy, r, samples=4, keep_plan=True)

@@ -3,13 +3,14 @@
 // stand, one sunk by its hip), and the choice of the most upright; the leader's head margin.
 
 import { describe, expect, it } from 'vitest';
-import { FIGURE_KINDS, FIGURE_OFFSETS, INPUT_SIZE, LEADER_INPUT_LAYOUT, LEADER_INPUT_SIZE, OUTPUT_SIZE, blockSlices, figureKind } from '../../web/mirror/features';
-import { PARTNER_HIPS, hipSlackFor, mostUpright, slackFor, uprightMargin } from '../../web/mirror/guard';
+import { INPUT_SIZE, LEADER_INPUT_SIZE, OUTPUT_SIZE } from '../../web/mirror/features';
+import { HAND_HEIGHTS, HAND_PLAN_FIRST, HANDS_PLAN_SHOWN, PARTNER_HIPS, hipSlackFor, leadHandMiss, mostUpright, nearestPlan, showsPlan, slackFor, uprightMargin } from '../../web/mirror/guard';
 import { expectClose, fixture } from './fixture';
 
 const data = fixture('rollout');
-const { outputs, ranges, margins, best, tight, tightMargins, slackMargins, hipSlackMargins, hipSlackBest, partnerHips, hipSlackFor: hipCases } =
+const { outputs, ranges, margins, best, tight, tightMargins, slackMargins, hipSlackMargins, hipSlackBest, handsPlanShown, partnerHips, hipSlackFor: hipCases } =
   data.upright;
+const { handHeights, handPlanFirst, planInput, planMiss, planBest, planBestStanding } = data.upright;
 const offsets = Float64Array.from(data.offsets.follower);
 
 describe('uprightMargin', () => {
@@ -65,14 +66,37 @@ describe('the leader guard\'s head margin', () => {
     expect(slackMargins[3]).toBeLessThan(0); // the sunk body stays low
   });
 
-  it('is let off only with a headMargin, and not while a figure runs or comes', () => {
-    expect(slackFor(new Float32Array(LEADER_INPUT_SIZE), 0.07, 0.03)).toBeCloseTo(0.04, 12);
-    const leading = new Float32Array(LEADER_INPUT_SIZE);
-    const figure = blockSlices(LEADER_INPUT_LAYOUT).figure.start;
-    const now = FIGURE_OFFSETS.indexOf(0);
-    leading[figure + 2 * (now * FIGURE_KINDS.length + figureKind('her_turn', 1))] = 1; // her turn, inside now
-    expect(slackFor(leading, 0.07, 0.03)).toBe(0);
+  it('is let off unless his input shows a hands plan (he leads a turn), and only with a headMargin', () => {
+    expect(HANDS_PLAN_SHOWN).toBe(handsPlanShown);
+    const input = new Float32Array(LEADER_INPUT_SIZE);
+    expect(slackFor(input, 0.07, 0.03)).toBeCloseTo(0.04, 12);
+    input[HANDS_PLAN_SHOWN] = 1;
+    expect(slackFor(input, 0.07, 0.03)).toBe(0);
     expect(slackFor(new Float32Array(LEADER_INPUT_SIZE), 0.07)).toBe(0);
-    expect(slackFor(new Float32Array(INPUT_SIZE).fill(1), 0.07, 0.03)).toBeCloseTo(0.04, 12); // a follower's input
+    expect(slackFor(new Float32Array(INPUT_SIZE).fill(1), 0.07, 0.03)).toBeCloseTo(0.04, 12); // not a leader's input
+  });
+});
+
+describe('the leader guard keeps his lead hand to a request\'s plan', () => {
+  it('reads his hands and their plan where Python does, and measures the lead hand\'s miss as Python does', () => {
+    expect(HAND_HEIGHTS).toEqual(handHeights);
+    expect(HAND_PLAN_FIRST).toEqual(handPlanFirst);
+    const input = Float32Array.from(planInput);
+    expect(showsPlan(input)).toBe(true);
+    expect(showsPlan(new Float32Array(LEADER_INPUT_SIZE))).toBe(false);
+    const out = Float32Array.from(outputs);
+    const got = planMiss.map((_: number, i: number) => leadHandMiss(out, i * OUTPUT_SIZE, input, offsets));
+    expectClose(got, planMiss, 'lead hand misses');
+  });
+
+  it('takes the standing sample nearest the plan, as Python does', () => {
+    const input = Float32Array.from(planInput);
+    const out = Float32Array.from(outputs);
+    expect(nearestPlan(out, planMiss.length, OUTPUT_SIZE, input, ranges, offsets, 0)).toBe(planBest);
+    // At 0.05 m the nearer body is within the margin: the standing one is taken instead.
+    expect(planBestStanding).not.toBe(planBest);
+    expect(nearestPlan(out, planMiss.length, OUTPUT_SIZE, input, ranges, offsets, 0.05)).toBe(planBestStanding);
+    // None standing: the most upright.
+    expect(nearestPlan(out, planMiss.length, OUTPUT_SIZE, input, ranges, offsets, 5)).toBe(best);
   });
 });

@@ -1,8 +1,8 @@
 // web/mirror/rollout.ts against training/mirror/rollout.py: start pose, and four steps of the duet loop from the
 // procedural dancers (his own figure planned, a visitor's ask, steering, both inputs, outputs applied,
 // intention, and absurd outputs that reset a dancer: NaN, a root jump, a joint too far); the figures'
-// schedule on the count over 420 steps (his own, her turns and his, drawn from a fixed list) and the
-// path each bends.
+// schedule on the count over 420 steps (his own, her turns and his, drawn from a fixed list), their hands
+// plan and bent path.
 
 import { describe, expect, it } from 'vitest';
 import { type FigureName, INPUT_SIZE, LEADER_INPUT_SIZE } from '../../web/mirror/features';
@@ -41,7 +41,8 @@ function duetAt(frame: number, led: R.Led[], leader = standingLeader()): R.Duet 
   return { leader, followers: [leader], startPose: data.startPose, steering: new R.Steering(), frame, figures, tempo: 170, beat: 0 };
 }
 
-const led = (name: FigureName, way: number, start: number, end: number): R.Led => ({ name, way, start, end, asked: false });
+const led = (name: FigureName, way: number, start: number, end: number, hands: number[] | null = null): R.Led =>
+  ({ name, way, start, end, asked: false, hands: hands === null ? null : Float64Array.from(hands) });
 
 function expectDancer(d: R.Dancer, expected: Json, label: string): void {
   const t = d.track;
@@ -162,7 +163,7 @@ describe('the figures', () => {
   const f = data.figures;
 
   it('constants match Python', () => {
-    expect([R.FIGURE_BEATS, [...R.OWN_GAP_BEATS], R.HIS_SHARE]).toEqual([f.FIGURE_BEATS, f.OWN_GAP_BEATS, f.HIS_SHARE]);
+    expect([R.FIGURE_BEATS, [...R.OWN_GAP_BEATS], R.HIS_SHARE, [...R.RAISE]]).toEqual([f.FIGURE_BEATS, f.OWN_GAP_BEATS, f.HIS_SHARE, f.RAISE]);
   });
 
   it('framesToBeat and figureFrom keep to the count', () => {
@@ -177,10 +178,11 @@ describe('the figures', () => {
     }
   });
 
-  it('figureShare over a figure', () => {
+  it('figureShare and raised over a figure', () => {
     const [name, way, start, end] = f.led;
     for (const c of f.share) {
       expect(R.figureShare(led(name, way, start, end), c.frame), `share at ${c.frame}`).toBeCloseTo(c.share, 12);
+      expect(R.raised(led(name, way, start, end), c.frame), `raised at ${c.frame}`).toBeCloseTo(c.raised, 12);
     }
   });
 
@@ -205,6 +207,23 @@ describe('the figures', () => {
     // Every kind was led: her turn and his, each way.
     const kinds = new Set((f.steps as { led: [string, number][] }[]).flatMap((s) => s.led.map(([n, w]) => `${n} ${w}`)));
     expect([...kinds].sort()).toEqual(['her_turn -1', 'her_turn 1', 'his_turn -1', 'his_turn 1']);
+  });
+
+  it('handsInput raises his lead hand for a figure near, and lowers it after', () => {
+    for (const c of data.handsInputs as Json[]) {
+      const figures = c.two
+        ? (c.two as [FigureName, number, number, number][]).map(([n, w, a, b], i) => led(n, w, a, b, c.hands[i]))
+        : [led(c.name, c.way, 40, 76, c.hands)];
+      const duet = duetAt(c.frame, figures);
+      const moves = R.handsInput(duet);
+      const label = `hands plan, ${c.two ? JSON.stringify(c.two) : `${c.name} way ${c.way}`} at ${c.frame}`;
+      if (c.moves === null) expect(moves, label).toBeNull();
+      else expectClose(moves!, c.moves, label);
+      if (!c.two) {
+        if (c.handsAfter === null) expect(figures[0].hands, `${label}: hands kept`).toBeNull();
+        else expectClose(figures[0].hands!, c.handsAfter, `${label}: hands kept`);
+      }
+    }
   });
 
   it('leadPlan bends his planned path for every figure near', () => {

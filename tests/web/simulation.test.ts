@@ -260,17 +260,27 @@ describe('createSimulation', () => {
     }
   });
 
-  it('a request leaves his guard as it is: his one run, standing, the hands plan hidden', async () => {
+  it('with keepPlan, a request draws his samples at once and keeps the standing one whose lead hand is nearest the plan', async () => {
     const ranges = { hip_low: 0.7, head_above_hip_low: 0.4, feet_wide: 1.07, angle_high: [2.5, 0.59] };
-    const guarded = { leaderTemperature: 0.5, leaderGuard: { samples: 4, margin: 0.05 }, plausibility: ranges };
-    // His own figures are off: only the visitor's leads.
-    const { sim, lead } = simulation([{ role: 'follower' }], { role: 'leader', spread: 0.02 }, guarded, false);
+    const keep = { leaderTemperature: 0.5, leaderGuard: { samples: 4, margin: 0.05, keepPlan: true }, plausibility: ranges };
+    // Sample i stands 2 cm x i further to his side (the fake's spread): the samples differ, all stand.
+    // His own figures are off: only the visitor's leads (a hands plan only for it).
+    const { sim, lead } = simulation([{ role: 'follower' }], { role: 'leader', spread: 0.02 }, keep, false);
     await sim.step(steer, 1);
+    expect(lead.temperatures).toEqual([0.5]); // nobody asks: his one run, standing, as before
     expect(sim.askTurn(-1)).toBe(true);
     await sim.step(steer, 1);
-    expect(lead.runs).toBe(2);
-    expect(lead.batchSizes).toEqual([]);
-    expect(lead.input[blockSlices(LEADER_INPUT_LAYOUT).hands_plan.start]).toBe(0);
+    expect(lead.runs).toBe(1); // asked: no single run ...
+    expect(lead.batchSizes).toEqual([4]); // ... the batch alone, at his variety
+    expect(lead.temperatures).toEqual([0.5, 0.5]);
+    expect(sim.guards().upright).toBe(0); // a standing sample was kept: not a guarded step
+    // Without keepPlan the same request takes his one sample, as before.
+    const plain = simulation([{ role: 'follower' }], { role: 'leader', spread: 0.02 }, { ...keep, leaderGuard: { samples: 4, margin: 0.05 } }, false);
+    await plain.sim.step(steer, 1);
+    plain.sim.askTurn(-1);
+    await plain.sim.step(steer, 1);
+    expect(plain.lead.runs).toBe(2);
+    expect(plain.lead.batchSizes).toEqual([]);
   });
 
   it('starts both dancers in world space: leader at the origin, follower 0.8 m ahead facing it', () => {
@@ -521,8 +531,8 @@ describe('figures', () => {
       if (sim.figure && !sim.figure.coming) {
         dancing++;
         expect(sim.figure).toMatchObject({ name: 'her_turn', way: -1, asked: true });
-        // No hands plan is shown, and both read her turn to her right inside now (key 6).
-        expect(lead.input[blockSlices(LEADER_INPUT_LAYOUT).hands_plan.start]).toBe(0);
+        // A hands plan is shown, and both read her turn to her right inside now (key 6).
+        expect(lead.input[blockSlices(LEADER_INPUT_LAYOUT).hands_plan.start]).toBe(1);
         expect(leaderFigure(lead)[2 * (6 * FIGURE_KINDS.length + figureKind('her_turn', -1))]).toBe(1);
       }
       expect(steps).toBeLessThan(100);

@@ -139,7 +139,8 @@ def follower_policy(policy, manifest: dict, args, leader_temperature: float):
 def leader_policy(policy, manifest: dict, args):
     """The leader's policy as the (resolved) options ask: guarded like the follower (at the
     manifest's leaderGuard margin, his head over his hips at its headMargin and his hips at its
-    hipMargin when it has them, judging the body his bones draw), or as it is."""
+    hipMargin when it has them, judging the body his bones draw, his lead hand kept to a request's
+    plan when it says keepPlan), or as it is."""
     samples = getattr(args, "leader_guard", 0) or 0
     if samples and manifest.get("plausibility"):
         settings = manifest.get("leaderGuard") or {}
@@ -147,7 +148,7 @@ def leader_policy(policy, manifest: dict, args):
         return UprightGuard(policy, manifest["plausibility"], samples, None, float(settings.get("margin", 0.0)),
                             manifest["skeleton"]["offsets"]["leader"], None if head is None else float(head),
                             hip_margin=None if hips is None else float(hips),
-                            on_count=on_count_for("leader", args))
+                            keep_plan=bool(settings.get("keepPlan", False)), on_count=on_count_for("leader", args))
     return policy
 
 

@@ -1,7 +1,7 @@
 """python -m training.evaluation.recorded_leads: what the recorded leader's hands do around her turns.
 
-What a leader's hand does when he leads her turn (figures.HAND_RAISED, lead's measure of his
-hand, and the hand that leads each direction). For every recorded follower turn (figures.turns: 300 degrees
+The numbers behind the page's lead (training/mirror/rollout.py: LEAD_HAND_RAISED, RAISE, and the
+hand that leads each direction). For every recorded follower turn (figures.turns: 300 degrees
 within 2.5 s, timed where the 300 are reached), in every take as recorded and mirrored, it reads
 the leader's hands in his own root space (x to his left, y up, z ahead) from WINDOW[0] to
 WINDOW[1] seconds around the turn's completion, and reports:

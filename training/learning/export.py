@@ -35,7 +35,7 @@ from ..data.prepared import TrainError
 from .runs import fingerprint, load_run
 from .stamp import PAGE_MODELS, eval_file, write_stamp
 from ..mirror.skeleton import FPS, JOINT_NAMES, KEY_JOINTS, PARENTS
-from ..mirror.guard import FOLLOWER_HIP_MARGIN, LEADER_HEAD_MARGIN, LEADER_HIP_MARGIN, PARTNER_LOW, PARTNER_LOW_HIP_MARGIN, LEADER_MARGIN, LEADER_SAMPLES, MARGIN as GUARD_MARGIN, SAMPLES as GUARD_SAMPLES
+from ..mirror.guard import FOLLOWER_HIP_MARGIN, LEADER_HEAD_MARGIN, LEADER_HIP_MARGIN, LEADER_KEEP_PLAN, PARTNER_LOW, PARTNER_LOW_HIP_MARGIN, LEADER_MARGIN, LEADER_SAMPLES, MARGIN as GUARD_MARGIN, SAMPLES as GUARD_SAMPLES
 from .train import SHIPPED
 
 MANIFEST_VERSION = 1
@@ -191,7 +191,8 @@ def write_manifest(out: Path, models: dict[str, StepModel], data: str, prepared:
         # ... and the leader's (the same guard with its own margin).
         "leaderGuard": {"samples": LEADER_SAMPLES, "margin": LEADER_MARGIN,
                         **({} if LEADER_HEAD_MARGIN is None else {"headMargin": LEADER_HEAD_MARGIN}),
-                        **({} if LEADER_HIP_MARGIN is None else {"hipMargin": LEADER_HIP_MARGIN})},
+                        **({} if LEADER_HIP_MARGIN is None else {"hipMargin": LEADER_HIP_MARGIN}),
+                        **({"keepPlan": True} if LEADER_KEEP_PLAN else {})},
         # Both guards choose, every step, the sample whose footwork follows the count
         # (training/mirror/on_count.py, web/mirror/on_count.ts).
         "onCount": {"samples": on_count.SAMPLES, "strength": on_count.STRENGTH, "hips": on_count.HIPS,

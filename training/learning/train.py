@@ -209,9 +209,7 @@ MODELS = {
     # labels them, training/data/led_figures.py; at run time the visitor's and his own,
     # rollout.Figures), always shown. The leader also reads the hands plan
     # (features.hands_plan_block: where his hands go over the next second), hidden in half the
-    # samples as when nobody plans. The page keeps it hidden: a plan raising his lead hand for her
-    # turn left his hand where it was and took his footwork off the count (rollout.py, after
-    # HIS_SHARE); a retrain may drop the block.
+    # samples as when nobody plans: a figure raises his lead hand through it (rollout.hands_input).
     # His decoder sees its own state in half the samples and he trains on his own rollouts (his plan
     # the recorded path laid from where he stands), as the followers: he dances (steered, body
     # motion 0.54 m/s against 0.33 without, the recording 0.83), and the page's upright guard keeps

@@ -20,7 +20,7 @@ from . import music
 from .contact import ContactLayer
 from .features import (FUTURE_OFFSETS, HISTORY, KEYS, Track, follower_input, from_root_space_directions,
                        from_root_space_points, leader_input)
-from .skeleton import FEET, FPS, KEY_JOINTS, forward_kinematics_reduced
+from .skeleton import FEET, FPS, HANDS, KEY_JOINTS, forward_kinematics_reduced
 
 NOW = HISTORY
 TRACK_FRAMES = 2 * HISTORY + 1
@@ -51,12 +51,19 @@ START_DISTANCE = 0.8       # m between the partners at the start and after a res
 FIGURE_BEATS = {"her_turn": 3.5, "his_turn": 2.0}
 OWN_GAP_BEATS = (0.5, 6.5)
 HIS_SHARE = 0.27
-# His hands plan (features.hands_plan_block) stays hidden, as in the leader's training samples
-# whose plan was hidden: a plan raising his lead hand through her turn (to 1.90 m, over the first
-# 0.4 s, down over 0.5 s after) left his hand where it was (above 1.6 m after 35 % of requests,
-# 38 % without it; lead --seeds 20) and took his footwork off the count while it ran: his steps on
-# the beat +0.11 against +0.37 without it, his pulse 0.10 against 0.22 (rhythm --seeds 8 --seconds
-# 30, steered; docs/results.md, "The hands plan"). Her turn is led through the figure both read.
+# A figure also becomes his hands plan (features.hands_plan_block): his lead hand (the left for
+# her turn to the left, +1, the right for -1) rises above his head and comes down again, the other
+# stays where it was. In the recording (training.evaluation.recorded_leads) his higher hand peaks
+# above 1.6 m in 84 % of her turns (median 1.83 m; in 17 % of all frames), a third of a second
+# before the turn completes: the left hand for 60 % of her turns to the left, at (0.02, 1.80, 0.28)
+# m in his root space (x to his left, z ahead), the right hand mirrored for her turns to the right.
+# RAISE: (up, down) in s: his hand goes up over the figure's first `up` seconds, is held until
+# the figure ends and comes down over `down` after it. The plan asks 1.90 m, above the recorded
+# 1.80: the network stops short of a planned hand (a median 1.76 m asked for 1.90). In the recording the hand also circles the way she turns; a
+# planned circle (12 or 25 cm) left his hand's path as it was, so the plan holds none
+# (docs/results.md, "The hands plan").
+LEAD_HAND_RAISED = (0.02, 1.90, 0.28)  # m, the left hand, root space
+RAISE = (0.4, 0.5)                     # s
 # A figure also bends his planned path (lead_plan): it turns LEAD_TURN her way and moves
 # LEAD_SIDE to his other side (his right for her turn to the left), eased as her planned turn. The
 # recorded leader turns with her: over the 2.5 s from 1.7 s before her turn completes his facing
@@ -205,12 +212,14 @@ def steer_plan(leader: Dancer, steering: Steering, stick: np.ndarray) -> None:
 class Led:
     """One figure the leader leads: `name` her_turn or his_turn, to the dancer's left (way +1,
     counterclockwise seen from above) or right (-1), from duet frame `start` to `end` (both
-    danced); `asked` when the visitor asked for it."""
+    danced); `asked` when the visitor asked for it; `hands`: his hands (left, right) in his root
+    space when his plan for it began."""
     name: str
     way: int
     start: int
     end: int
     asked: bool = False
+    hands: np.ndarray | None = None
 
 
 @dataclass
@@ -276,6 +285,40 @@ def figure_share(led: Led, frame: float) -> float:
     """How much of the figure's turn is planned done at `frame`, 0 to 1 (smoothstep over it)."""
     u = min(1.0, max(0.0, (frame - led.start) / max(led.end - led.start, 1)))
     return u * u * (3 - 2 * u)
+
+
+def raised(led: Led, frame: float) -> float:
+    """How far his lead hand is raised for `led` at `frame`, 0 to 1 (smoothsteps up and down)."""
+    up = min(1.0, max(0.0, (frame - led.start) / (RAISE[0] * FPS)))
+    down = min(1.0, max(0.0, (frame - led.end) / (RAISE[1] * FPS)))
+    return up * up * (3 - 2 * up) * (1 - down * down * (3 - 2 * down))
+
+
+def planning(duet: "Duet") -> Led | None:
+    """The figure his hands plan is for: the one danced now or beginning within the next second,
+    else one whose raise is coming down. A figure that follows another at once takes the plan
+    over as soon as the one before ends."""
+    near = [x for x in duet.figures.led if x.name == "her_turn"
+            and x.start - HISTORY <= duet.frame <= x.end + int(RAISE[1] * FPS)]
+    return next((x for x in near if x.end >= duet.frame), near[0] if near else None)
+
+
+def hands_input(duet: "Duet") -> np.ndarray | None:
+    """The leader's hands plan [KEYS, 2, 3] for the figure he plans (None: none): from where his
+    hands are now to where the raise puts them at each future key, in his root space."""
+    led, leader = planning(duet), duet.leader
+    if led is None:
+        return None
+    hands = feat.to_root_space_points(leader.positions[HANDS], leader.root, leader.heading)
+    if led.hands is None:
+        led.hands = hands
+    lead = 0 if led.way > 0 else 1
+    top = np.array(LEAD_HAND_RAISED) * np.array([1.0 if lead == 0 else -1.0, 1.0, 1.0])
+    out = np.repeat(led.hands[None], KEYS, 0) - hands[None]
+    for k, off in enumerate(FUTURE_OFFSETS):
+        u = raised(led, duet.frame + off)
+        out[k, lead] = led.hands[lead] + u * (top - led.hands[lead]) - hands[lead]
+    return out
 
 
 def lead_plan(duet: "Duet") -> None:
@@ -399,12 +442,14 @@ def music_input(duet: Duet) -> np.ndarray:
 
 
 def step_inputs(duet: Duet) -> tuple[np.ndarray, np.ndarray]:
-    """Both models' inputs at NOW. Both read the figure being led (what her hand feels); his hands
-    plan stays hidden (the comment after HIS_SHARE says why)."""
+    """Both models' inputs at NOW. Both read the figure being led (what her hand feels); only his
+    hands plan says where his hands go."""
     now = np.array([NOW])
     figure = feat.figure_block(duet.figures.spans(duet.frame), now)
+    moves = hands_input(duet)
+    plan = None if moves is None else feat.hands_plan_block(moves[None], 1)
     heard = music_input(duet)
-    return (leader_input(duet.follower.track, duet.leader.track, now, figure, None, heard)[0],
+    return (leader_input(duet.follower.track, duet.leader.track, now, figure, plan, heard)[0],
             follower_input(duet.leader.track, duet.follower.track, now, figure, heard)[0])
 
 

@@ -10,7 +10,7 @@ import { FIGURE_SIZE, FUTURE_OFFSETS, INPUT_SIZE, INTENTION_SIZE, KEYS, OUTPUT_S
 import { KEY_JOINTS, type Motion, N_JOINTS, POSITIONS_SIZE, ROTATIONS_SIZE } from '../mirror/skeleton';
 import { ContactLayer, HipGlide } from '../mirror/contact';
 import { FootLock } from '../mirror/footik';
-import { type GuardSettings, type Ranges, hipSlackFor, mostUpright, slackFor, uprightBody, uprightMargin } from '../mirror/guard';
+import { type GuardSettings, type Ranges, hipSlackFor, mostUpright, nearestPlan, showsPlan, slackFor, uprightBody, uprightMargin } from '../mirror/guard';
 import { OnCount, STEPPED, drawnFootwork, drawnSteps, hipsTurnBack, nearestCount } from '../mirror/on_count';
 import { LeaderPlayback } from './playback';
 import { StepTimer } from './timing';
@@ -357,7 +357,8 @@ export class DuetSimulation implements Simulation {
 
   /** The leader's output of this step, under the same guard (mirror/guard.py's UprightGuard wraps
    *  his policy alike): his head judged from the headMargin, his hips from the hipMargin, when the
-   *  manifest has them. */
+   *  manifest has them. With keepPlan, while a request runs, every step draws the samples at once
+   *  and takes the standing one whose lead hand is nearest the plan (guard.ts nearestPlan). */
   private async stepLeader(temperature: number): Promise<void> {
     const guard = this.leaderGuard;
     if (!guard) {
@@ -366,10 +367,11 @@ export class DuetSimulation implements Simulation {
     }
     const offsets = this.duet.leader.offsets;
     const policy = this.leaderPolicy;
-    const { margin, headMargin, hipMargin, samples: k } = guard.settings;
+    const { margin, headMargin, hipMargin, keepPlan, samples: k } = guard.settings;
     const slack = slackFor(policy.input, margin, headMargin);
     const hipSlack = hipSlackFor(policy.input, margin, hipMargin);
-    const onCount = this.leaderOnCount;
+    const plan = keepPlan === true && showsPlan(policy.input);
+    const onCount = plan ? null : this.leaderOnCount;
     // His step on the count (on_count.ts): the standing sample whose footwork follows the beat and
     // whose hips go on; while he turns, the first standing one whose hips go on.
     const target = onCount ? onCount.target(policy.input) : null;
@@ -382,15 +384,17 @@ export class DuetSimulation implements Simulation {
         if (target !== null) this.counted++;
         return;
       }
-    } else {
+    } else if (!plan) {
       const result = await policy.run(temperature);
       this.leaderOutput.set(result.output);
       if (uprightMargin(this.leaderOutput, 0, guard.ranges, offsets, slack, hipSlack) >= margin) return;
     }
     const { output } = await policy.runDraws(k, temperature);
-    const best = mostUpright(output, k, OUTPUT_SIZE, guard.ranges, offsets, slack, hipSlack);
+    const best = plan
+      ? nearestPlan(output, k, OUTPUT_SIZE, policy.input, guard.ranges, offsets, margin, slack, hipSlack)
+      : mostUpright(output, k, OUTPUT_SIZE, guard.ranges, offsets, slack, hipSlack);
     this.leaderOutput.set(output.subarray(best * OUTPUT_SIZE, (best + 1) * OUTPUT_SIZE));
-    this.upright++;
+    if (!plan || uprightMargin(this.leaderOutput, 0, guard.ranges, offsets, slack, hipSlack) < margin) this.upright++;
   }
 
   /**

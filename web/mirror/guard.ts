@@ -8,16 +8,18 @@
 // body never jumps; the guard only chooses among the network's own reactions. Measured in Python:
 // it chose in 210 of 1.8 M follower steps of the 100 x 10 min soak (docs/reliability.md). A
 // manifest's leaderGuard.headMargin judges the leader's head over his hips from a smaller margin
-// (0.03 m shipped), except while a figure runs or comes, and its leaderGuard.hipMargin his hips from a
+// (0.03 m shipped), except while he leads a turn, and its leaderGuard.hipMargin his hips from a
 // larger one (0.10 m: a crouch caught before it is too deep); its guard.hipMargin judges the
 // follower's hips from a larger one (0.15 m shipped): beside the leader who then lunges, her hips drop fast when
 // she falls (guard.py, LEADER_HEAD_MARGIN and FOLLOWER_HIP_MARGIN); and while her input shows his
 // hips below guard.partnerLow (a lunge), from guard.partnerLowHipMargin (guard.py, PARTNER_LOW).
+// A manifest's leaderGuard.keepPlan keeps his lead hand to a request's hands plan: while his input
+// shows one, every step draws the samples and takes the standing one whose lead hand is nearest the
+// plan's height one step on (nearestPlan; guard.py, LEADER_KEEP_PLAN).
 
-import { FOLLOWER_INPUT_LAYOUT, INPUT_SIZE, LEADER_INPUT_SIZE, N_JOINTS, OUTPUT_LAYOUT, blockSlices } from './features';
-import { figureWay } from './on_count';
+import { FOLLOWER_INPUT_LAYOUT, INPUT_SIZE, KEY_STEP, LEADER_INPUT_LAYOUT, LEADER_INPUT_SIZE, N_JOINTS, OUTPUT_LAYOUT, blockSlices } from './features';
 import { MIN_ANKLE_HEIGHT, rotationsFromVectors } from './rollout';
-import { FEET, HEAD, forwardKinematicsReduced } from './skeleton';
+import { FEET, HANDS, HEAD, forwardKinematicsReduced } from './skeleton';
 
 /** The chest joint, whose offset over the hips is the torso's lean (evaluation/plausibility.py CHEST). */
 export const CHEST = 2;
@@ -44,9 +46,17 @@ export interface GuardSettings {
    *  from partnerLowHipMargin instead (she goes down with his lunge). */
   partnerLow?: number;
   partnerLowHipMargin?: number;
+  /** The leader's: while a request runs, keep his lead hand to its plan (nearestPlan). */
+  keepPlan?: boolean;
 }
 
 const POSE = blockSlices(OUTPUT_LAYOUT).pose;
+/** The leader input's column that is 1 while a request runs (the hands plan's "shown"). */
+export const HANDS_PLAN_SHOWN = blockSlices(LEADER_INPUT_LAYOUT).hands_plan.start;
+/** In a leader's input: each hand's height now (his own pose block, y, his root space), left then right. */
+export const HAND_HEIGHTS: readonly number[] = HANDS.map((h) => blockSlices(LEADER_INPUT_LAYOUT).self_pose.start + 12 * h + 1);
+/** ... and its planned move to the first future key (the hands plan's first key, y). */
+export const HAND_PLAN_FIRST: readonly number[] = HANDS.map((_, k) => HANDS_PLAN_SHOWN + 1 + 3 * k + 1);
 /** The partner's hip height in a follower's input (the pose block's first joint, y, in her root space). */
 export const PARTNER_HIPS = blockSlices(FOLLOWER_INPUT_LAYOUT).partner_pose.start + 1;
 const forward = new Float64Array(3 * N_JOINTS);
@@ -112,14 +122,58 @@ function drawnMargin(lift: number, r: Ranges, headSlack: number, hipSlack: numbe
   return Math.min(hip - r.hip_low + hipSlack, head - hip - r.head_above_hip_low + headSlack, r.feet_wide - feet, allowed - sideways);
 }
 
+/** Whether this is a leader's input that shows a hands plan (a request runs). */
+export function showsPlan(input: ArrayLike<number>): boolean {
+  return input.length === LEADER_INPUT_SIZE && input[HANDS_PLAN_SHOWN] >= 0.5;
+}
+
+/**
+ * Metres by which the lead hand that output[at..] draws misses the height the hands plan in the
+ * leader's `input` puts it at one step on (a KEY_STEP-th of its move to the first key). The lead
+ * hand is the one the plan puts higher at that key. Height alone: it is the same in this root's
+ * space and the next one's, and it is what she sees rise.
+ */
+export function leadHandMiss(output: ArrayLike<number>, at: number, input: ArrayLike<number>, offsets: ArrayLike<number>): number {
+  return drawnMiss(drawnJoints(output, at, offsets), input);
+}
+
+/** leadHandMiss of the body drawnJoints last left in `joints`, lifted by `lift`. */
+function drawnMiss(lift: number, input: ArrayLike<number>): number {
+  const lead = input[HAND_HEIGHTS[1]] + input[HAND_PLAN_FIRST[1]] > input[HAND_HEIGHTS[0]] + input[HAND_PLAN_FIRST[0]] ? 1 : 0;
+  const target = input[HAND_HEIGHTS[lead]] + input[HAND_PLAN_FIRST[lead]] / KEY_STEP;
+  return Math.abs(joints[3 * HANDS[lead] + 1] + lift - target);
+}
+
+/**
+ * The index of the `count` outputs from output[0..] whose lead hand is nearest the plan
+ * (leadHandMiss) among those standing at least `margin` inside the range; the most upright when
+ * none does. Each sample's body is drawn once for both judgements (this runs every step of a request).
+ */
+export function nearestPlan(
+  output: ArrayLike<number>, count: number, size: number, input: ArrayLike<number>, r: Ranges, offsets: ArrayLike<number>,
+  margin: number, headSlack = 0, hipSlack = 0,
+): number {
+  let best = -1;
+  let bestMiss = Infinity;
+  for (let i = 0; i < count; i++) {
+    const lift = drawnJoints(output, i * size, offsets);
+    if (drawnMargin(lift, r, headSlack, hipSlack) < margin) continue;
+    const miss = drawnMiss(lift, input);
+    if (miss < bestMiss) {
+      best = i;
+      bestMiss = miss;
+    }
+  }
+  return best >= 0 ? best : mostUpright(output, count, size, r, offsets, headSlack, hipSlack);
+}
+
 /**
  * Metres a guard lets off the head-over-hips part for this input: margin - headMargin; none when
- * it has no headMargin, or while the input is a leader's whose figure runs or comes (figureWay):
- * leading, he is judged from the full margin (guard.py slack_for: measured).
+ * it has no headMargin, or while the input is a leader's that shows a hands plan (he leads a turn).
  */
 export function slackFor(input: ArrayLike<number>, margin: number, headMargin?: number): number {
   if (headMargin === undefined) return 0;
-  if (input.length === LEADER_INPUT_SIZE && figureWay(input, 'leader') !== null) return 0;
+  if (showsPlan(input)) return 0;
   return margin - headMargin;
 }
 

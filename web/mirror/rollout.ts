@@ -19,9 +19,9 @@
 
 import {
   FIGURE_SIZE, type FigureName, FUTURE_OFFSETS, HISTORY, INTENTION_SIZE, KEYS, N_JOINTS, OUTPUT_LAYOUT, OUTPUT_SIZE, Track,
-  blockSlices, figureBlock, figureKind, followerInput, fromRootSpaceDirections, fromRootSpacePoints, leaderInput, wrapAngle,
+  blockSlices, figureBlock, figureKind, followerInput, fromRootSpaceDirections, fromRootSpacePoints, leaderInput, toRootSpacePoints, wrapAngle,
 } from './features';
-import { FEET, FPS, KEY_JOINTS, type Out, PARENTS, POSITIONS_SIZE, ROTATIONS_SIZE, forwardKinematicsReduced } from './skeleton';
+import { FEET, FPS, HANDS, KEY_JOINTS, type Out, PARENTS, POSITIONS_SIZE, ROTATIONS_SIZE, forwardKinematicsReduced } from './skeleton';
 import { DEFAULT_TEMPO, MUSIC_SIZE, beatsPerStep, musicBlock } from './music';
 import { createUniform } from '../engine/random';
 
@@ -53,10 +53,19 @@ export const START_DISTANCE = 0.8; // m between the partners at the start and af
 export const FIGURE_BEATS: Readonly<Record<FigureName, number>> = { her_turn: 3.5, his_turn: 2.0 };
 export const OWN_GAP_BEATS: readonly number[] = [0.5, 6.5];
 export const HIS_SHARE = 0.27;
-// His hands plan (features handsPlanBlock) stays hidden, as in the leader's training samples whose
-// plan was hidden: a plan raising his lead hand through her turn left his hand where it was and took
-// his footwork off the count (training/mirror/rollout.py: measured). Her turn is led through the
-// figure both read.
+// A figure also becomes his hands plan (features handsPlanBlock): his lead hand (the left for
+// her turn to the left, +1, the right for -1) rises above his head and comes down again, the other
+// stays where it was. In the recording (training.evaluation.recorded_leads) his higher hand peaks
+// above 1.6 m in 84 % of her turns (median 1.83 m; in 17 % of all frames), a third of a second
+// before the turn completes: the left hand for 60 % of her turns to the left, at (0.02, 1.80, 0.28)
+// m in his root space (x to his left, z ahead), the right hand mirrored for her turns to the right.
+// RAISE: (up, down) in s: his hand goes up over the figure's first `up` seconds, is held until the
+// figure ends and comes down over `down` after it. The plan asks 1.90 m, above the recorded 1.80:
+// the network stops short of a planned hand (a median 1.76 m asked for 1.90). In the recording the
+// hand also circles the way she turns; a planned circle (12 or 25 cm) left his hand's path as it
+// was, so the plan holds none (docs/results.md, "The hands plan").
+export const LEAD_HAND_RAISED: readonly number[] = [0.02, 1.9, 0.28]; // m, the left hand, root space
+export const RAISE: readonly number[] = [0.4, 0.5]; // s
 // Her turn also bends his planned path (leadPlan): it turns LEAD_TURN her way and moves LEAD_SIDE
 // to his other side (his right for her turn to the left), eased as her planned turn (his own turn
 // turns his plan a full turn his way). The recorded
@@ -397,7 +406,8 @@ export function keepClose(follower: Dancer, leader: Dancer): boolean {
 /**
  * One figure the leader leads: `name` her_turn or his_turn, to the dancer's left (way +1,
  * counterclockwise seen from above) or right (-1), from duet frame `start` to `end` (both danced);
- * `asked` when the visitor asked for it.
+ * `asked` when the visitor asked for it; `hands`: his hands (left, right; [2 × 3]) in his root
+ * space when his plan for it began.
  */
 export interface Led {
   name: FigureName;
@@ -405,6 +415,7 @@ export interface Led {
   start: number;
   end: number;
   asked: boolean;
+  hands: Float64Array | null;
 }
 
 /**
@@ -451,7 +462,7 @@ export function figureFrom(duet: Duet, frame: number, name: FigureName, way: num
   const per = beatsPerStep(duet.tempo);
   const beat = duet.beat + (frame - duet.frame) * per;
   const start = framesToBeat(duet, frame, Math.ceil(beat - 1e-9));
-  return { name, way: way >= 0 ? 1 : -1, start, end: start + roundHalfEven(FIGURE_BEATS[name] / per), asked };
+  return { name, way: way >= 0 ? 1 : -1, start, end: start + roundHalfEven(FIGURE_BEATS[name] / per), asked, hands: null };
 }
 
 /**
@@ -486,6 +497,71 @@ export function planFigures(duet: Duet): void {
 export function figureShare(led: Led, frame: number): number {
   const u = Math.min(1, Math.max(0, (frame - led.start) / Math.max(led.end - led.start, 1)));
   return u * u * (3 - 2 * u);
+}
+
+/** How far his lead hand is raised for `led` at `frame`, 0 to 1 (smoothsteps up and down). */
+export function raised(led: Led, frame: number): number {
+  const up = Math.min(1, Math.max(0, (frame - led.start) / (RAISE[0] * FPS)));
+  const down = Math.min(1, Math.max(0, (frame - led.end) / (RAISE[1] * FPS)));
+  return up * up * (3 - 2 * up) * (1 - down * down * (3 - 2 * down));
+}
+
+/**
+ * The figure his hands plan is for (her turns only): the one danced now or beginning within the
+ * next second, else one whose raise is coming down. A figure that follows another at once takes the
+ * plan over as soon as the one before ends.
+ */
+export function planning(duet: Duet): Led | null {
+  // A loop, not filter/find: this runs every step and allocates nothing.
+  const lowering = Math.trunc(RAISE[1] * FPS);
+  let lowered: Led | null = null;
+  for (const x of duet.figures.led) {
+    if (x.name !== 'her_turn' || x.start - HISTORY > duet.frame || duet.frame > x.end + lowering) continue;
+    if (x.end >= duet.frame) return x;
+    lowered ??= x;
+  }
+  return lowered;
+}
+
+const HANDS_MOVES = KEYS * HANDS.length * 3;
+const handsMoves = new Float64Array(HANDS_MOVES);
+const handsNow = new Float64Array(HANDS.length * 3);
+const handsWorld = new Float64Array(HANDS.length * 3);
+
+/** His hands (left, right) in his root space now, into out [2 × 3]. */
+function handsInRootSpace(leader: Dancer, out: Float64Array): void {
+  const p = leader.positions;
+  for (let i = 0; i < HANDS.length; i++) {
+    for (let c = 0; c < 3; c++) handsWorld[3 * i + c] = p[3 * HANDS[i] + c];
+  }
+  toRootSpacePoints(handsWorld, 0, HANDS.length, leader.rootX, leader.rootZ, leader.heading, out, 0);
+}
+
+/**
+ * The leader's hands plan [KEYS × 2 × 3] for the figure he plans (null: none): from where his hands
+ * are now to where the raise puts them at each future key, in his root space. A shared scratch array.
+ */
+export function handsInput(duet: Duet): Float64Array | null {
+  const led = planning(duet);
+  if (!led) return null;
+  handsInRootSpace(duet.leader, handsNow);
+  led.hands ??= Float64Array.from(handsNow);
+  const lead = led.way > 0 ? 0 : 1;
+  for (let k = 0; k < KEYS; k++) {
+    const u = raised(led, duet.frame + FUTURE_OFFSETS[k]);
+    for (let h = 0; h < HANDS.length; h++) {
+      for (let c = 0; c < 3; c++) {
+        const from = led.hands[3 * h + c];
+        let to = from;
+        if (h === lead) {
+          const top = c === 0 ? (lead === 0 ? 1 : -1) * LEAD_HAND_RAISED[0] : LEAD_HAND_RAISED[c];
+          to = from + u * (top - from);
+        }
+        handsMoves[(k * HANDS.length + h) * 3 + c] = to - handsNow[3 * h + c];
+      }
+    }
+  }
+  return handsMoves;
 }
 
 export interface Duet {
@@ -569,13 +645,13 @@ const figureNow = new Float64Array(FIGURE_SIZE);
 
 /**
  * Both models' inputs at NOW: the leader's (partner = first follower) and each follower's. All read
- * the figure being led (what her hand feels); his hands plan stays hidden (after HIS_SHARE: why).
+ * the figure being led (what her hand feels); only his hands plan says where his hands go.
  */
 export function stepInputs(duet: Duet, leaderOut: Out | null, followerOuts: Out[]): void {
   figureBlock(duet.figures.spans(duet.frame), NOW, figureNow, 0);
   const heard = musicInput(duet);
   if (leaderOut) {
-    leaderInput(duet.followers[0].track, duet.leader.track, NOW, leaderOut, 0, figureNow, null, heard);
+    leaderInput(duet.followers[0].track, duet.leader.track, NOW, leaderOut, 0, figureNow, handsInput(duet), heard);
   }
   duet.followers.forEach((f, i) => followerInput(duet.leader.track, f.track, NOW, followerOuts[i], 0, figureNow, heard));
 }
