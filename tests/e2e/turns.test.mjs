@@ -12,7 +12,7 @@
 //   doing), and the leader's pose differs by more than 1 cm within 1 s after it;
 // - the request reaches both dancers through the figure they read: his input holds her turn, the
 //   asked way, while it is danced, and no figure before the request (his hand's height is printed:
-//   in the recording it passes 1.6 m in 84 % of her turns; in Python after 31 % of requests,
+//   in the recording it passes 1.6 m in 84 % of her turns; in Python after 37 % of requests,
 //   docs/results.md, "Leading a turn");
 // - the page keeps dancing through the turn: a step every 1/30 s of dance, both hips above 0.5 m,
 //   no error; the phone dances the same steps as the desktop;
