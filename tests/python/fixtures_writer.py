@@ -782,7 +782,11 @@ def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_o
                    "handHeights": G.HAND_HEIGHTS, "handPlanFirst": G.HAND_PLAN_FIRST,
                    "planInput": exact(plan_input), "planMiss": out7(G.lead_hand_miss(outputs, plan_input, follow_offsets)),
                    "planBest": G.nearest_plan(outputs, plan_input, ranges, follow_offsets, 0.0),
-                   "planBestStanding": G.nearest_plan(outputs, plan_input, ranges, follow_offsets, 0.05)}
+                   "planBestStanding": G.nearest_plan(outputs, plan_input, ranges, follow_offsets, 0.05),
+                   # The n standing bodies nearest the plan (guard.near_plan), n = 1..4, at margin 0 and 0.05.
+                   "nearPlan": {str(margin): [G.near_plan(G.drawn_joints(outputs, follow_offsets), plan_input,
+                                                          G.upright_margin(outputs, ranges, follow_offsets), margin, n).tolist()
+                                              for n in range(1, 5)] for margin in (0.0, 0.05)}}
     return {
         "NOW": ro.NOW, "TRACK_FRAMES": ro.TRACK_FRAMES, "guards": guards, "upright": uprightness,
         "onCount": on_count_cases(np.random.default_rng(SEED + 3), outputs, ranges, follow_offsets),

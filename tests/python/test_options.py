@@ -86,7 +86,9 @@ def test_the_leader_is_guarded_as_the_manifest_says():
     assert guarded.hip_margin == 0.1 and guarded.hip_slack == pytest.approx(0.07 - 0.1)
     assert not guarded.keep_plan                          # no keepPlan: a request's plan is not kept to
     plan = manifest(leaderTemperature=0.5, leaderGuard={"samples": 8, "margin": 0.07, "keepPlan": True})
-    assert O.leader_policy(policy, plan, args).keep_plan
+    assert O.leader_policy(policy, plan, args).keep_plan == 1   # true: the nearest the plan
+    among = manifest(leaderTemperature=0.5, leaderGuard={"samples": 8, "margin": 0.07, "keepPlan": 3})
+    assert O.leader_policy(policy, among, args).keep_plan == 3
     off = parse("--leader-guard", "0")
     assert O.resolve(off, m) is None and O.leader_policy(policy, m, off) is policy
     old = parse()
@@ -123,5 +125,5 @@ def test_the_shipped_manifest_carries_the_guards_export_writes():
     if G.LEADER_HIP_MARGIN is not None:
         leader["hipMargin"] = G.LEADER_HIP_MARGIN
     if G.LEADER_KEEP_PLAN:
-        leader["keepPlan"] = True
+        leader["keepPlan"] = G.LEADER_KEEP_PLAN
     assert shipped["guard"] == follower and shipped["leaderGuard"] == leader

@@ -386,11 +386,13 @@ def test_the_followers_guard_judges_her_hips_from_further_up_while_he_lunges():
 
 
 def test_the_leaders_guard_keeps_his_lead_hand_to_a_requests_plan():
-    """guard.lead_hand_miss, nearest_plan and UprightGuard(keep_plan=True): while his input shows a
-    hands plan, every step draws the batch and takes the standing sample whose lead hand (the one the
-    plan puts higher) is nearest the plan's height one step on; with no plan, one sample as before."""
+    """guard.lead_hand_miss, nearest_plan, near_plan and UprightGuard(keep_plan=n): while his input
+    shows a hands plan, every step draws the batch and takes the standing sample whose lead hand (the
+    one the plan puts higher) is nearest the plan's height one step on, or with a chooser on the count
+    the one on the count among the n nearest; with no plan, one sample as before."""
     from training.mirror.guard import (HAND_HEIGHTS, HAND_PLAN_FIRST, HANDS_PLAN_SHOWN, POSE, UprightGuard,
-                                       drawn_joints, lead_hand_miss, nearest_plan)
+                                       drawn_joints, drawn_margin, lead_hand_miss, near_plan, nearest_plan)
+    from training.mirror.on_count import OnCount
     from training.mirror.skeleton import HANDS
 
     # A straight column of 20 cm bones, upright: every joint's drawn height is the hips' plus its depth.
@@ -439,3 +441,18 @@ def test_the_leaders_guard_keeps_his_lead_hand_to_a_requests_plan():
     assert UprightGuard(policy, r, samples=4, offsets=offsets)(x, 0.7, rng) is not None and calls[-1] == 1
     with pytest.raises(ValueError, match="bones"):
         UprightGuard(policy, r, samples=4, keep_plan=True)
+
+    # keep_plan=n with a chooser on the count: among the n standing samples whose hand is nearest
+    # the plan (near_plan), the one on the count. A fifth sample stands with its hips (and hand) 10 cm
+    # under the nearest one's: its drawn feet move less, which the count asks for here (the music
+    # block is zeros: the downbeat, footwork 0).
+    samples.append(output(hips[2] - 0.1))
+    joints = drawn_joints(np.stack(samples), offsets)
+    standing = drawn_margin(joints, r)
+    assert near_plan(joints, x, standing, 0.07, 1).tolist() == [False, False, True, False, False]
+    assert near_plan(joints, x, standing, 0.07, 2).tolist() == [False, False, True, False, True]
+    assert near_plan(joints, x, standing, 0.07, 5).tolist() == [True, False, True, False, True]   # 3 stand
+    for n, hip in ((1, hips[2]), (2, hips[2] - 0.1)):
+        calls.clear()
+        both = UprightGuard(policy, r, samples=5, margin=0.07, offsets=offsets, keep_plan=n, on_count=OnCount("leader", 5))
+        assert both(x, 0.7, rng)["output"][0][POSE.start + 1] == pytest.approx(hip) and calls == [5]

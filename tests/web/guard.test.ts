@@ -4,13 +4,13 @@
 
 import { describe, expect, it } from 'vitest';
 import { INPUT_SIZE, LEADER_INPUT_SIZE, OUTPUT_SIZE } from '../../web/mirror/features';
-import { HAND_HEIGHTS, HAND_PLAN_FIRST, HANDS_PLAN_SHOWN, PARTNER_HIPS, hipSlackFor, leadHandMiss, mostUpright, nearestPlan, showsPlan, slackFor, uprightMargin } from '../../web/mirror/guard';
+import { HAND_HEIGHTS, HAND_PLAN_FIRST, HANDS_PLAN_SHOWN, PARTNER_HIPS, hipSlackFor, leadHandMiss, mostUpright, nearPlan, nearestPlan, showsPlan, slackFor, uprightMargin } from '../../web/mirror/guard';
 import { expectClose, fixture } from './fixture';
 
 const data = fixture('rollout');
 const { outputs, ranges, margins, best, tight, tightMargins, slackMargins, hipSlackMargins, hipSlackBest, handsPlanShown, partnerHips, hipSlackFor: hipCases } =
   data.upright;
-const { handHeights, handPlanFirst, planInput, planMiss, planBest, planBestStanding } = data.upright;
+const { handHeights, handPlanFirst, planInput, planMiss, planBest, planBestStanding, nearPlan: nearPlanCases } = data.upright;
 const offsets = Float64Array.from(data.offsets.follower);
 
 describe('uprightMargin', () => {
@@ -98,5 +98,21 @@ describe('the leader guard keeps his lead hand to a request\'s plan', () => {
     expect(nearestPlan(out, planMiss.length, OUTPUT_SIZE, input, ranges, offsets, 0.05)).toBe(planBestStanding);
     // None standing: the most upright.
     expect(nearestPlan(out, planMiss.length, OUTPUT_SIZE, input, ranges, offsets, 5)).toBe(best);
+  });
+
+  it('marks the n standing samples nearest the plan, as Python does', () => {
+    const input = Float32Array.from(planInput);
+    const out = Float32Array.from(outputs);
+    const near: boolean[] = [];
+    for (const [margin, expected] of Object.entries(nearPlanCases as Record<string, boolean[][]>)) {
+      expected.forEach((marks, i) => {
+        nearPlan(out, planMiss.length, OUTPUT_SIZE, input, ranges, offsets, Number(margin), i + 1, near);
+        expect(near.slice(0, planMiss.length), `margin ${margin}, n ${i + 1}`).toEqual(marks);
+      });
+    }
+    // The cases hold a choice: one body, then two, at margin 0; at 0.05 the nearer does not stand.
+    const trues = (marks: boolean[]) => marks.filter(Boolean).length;
+    expect((nearPlanCases as Record<string, boolean[][]>)['0.0'].map(trues).slice(0, 2)).toEqual([1, 2]);
+    expect((nearPlanCases as Record<string, boolean[][]>)['0.05'][0]).not.toEqual((nearPlanCases as Record<string, boolean[][]>)['0.0'][0]);
   });
 });

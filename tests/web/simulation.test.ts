@@ -260,7 +260,7 @@ describe('createSimulation', () => {
     }
   });
 
-  it('with keepPlan, a request draws his samples at once and keeps the standing one whose lead hand is nearest the plan', async () => {
+  it('with keepPlan, a request draws his samples at once and keeps the standing one whose lead hand is nearest the plan, or the one on the count among the keepPlan nearest', async () => {
     const ranges = { hip_low: 0.7, head_above_hip_low: 0.4, feet_wide: 1.07, angle_high: [2.5, 0.59] };
     const keep = { leaderTemperature: 0.5, leaderGuard: { samples: 4, margin: 0.05, keepPlan: true }, plausibility: ranges };
     // Sample i stands 2 cm x i further to his side (the fake's spread): the samples differ, all stand.
@@ -281,6 +281,20 @@ describe('createSimulation', () => {
     await plain.sim.step(steer, 1);
     expect(plain.lead.runs).toBe(2);
     expect(plain.lead.batchSizes).toEqual([]);
+    // keepPlan 2 beside his chooser on the count: the same one batch a step, and while the request
+    // runs the count still chooses (among the two nearest the plan) where keepPlan 1 leaves it out.
+    const counted = async (keepPlan: number) => {
+      const both = simulation([{ role: 'follower' }], { role: 'leader', spread: 0.02 },
+        { ...keep, leaderGuard: { samples: 4, margin: 0.05, keepPlan }, onCount: { samples: 4, strength: 1, hips: 1 } }, false);
+      await both.sim.step(steer, 1);
+      const before = both.sim.guards().counted;
+      both.sim.askTurn(-1);
+      await both.sim.step(steer, 1);
+      expect(both.lead.batchSizes).toEqual([4, 4]);
+      return both.sim.guards().counted - before;
+    };
+    expect(await counted(1)).toBe(0);
+    expect(await counted(2)).toBe(1);
   });
 
   it('starts both dancers in world space: leader at the origin, follower 0.8 m ahead facing it', () => {

@@ -148,7 +148,7 @@ def leader_policy(policy, manifest: dict, args):
         return UprightGuard(policy, manifest["plausibility"], samples, None, float(settings.get("margin", 0.0)),
                             manifest["skeleton"]["offsets"]["leader"], None if head is None else float(head),
                             hip_margin=None if hips is None else float(hips),
-                            keep_plan=bool(settings.get("keepPlan", False)), on_count=on_count_for("leader", args))
+                            keep_plan=int(settings.get("keepPlan", 0)), on_count=on_count_for("leader", args))
     return policy
 
 

@@ -192,7 +192,7 @@ def write_manifest(out: Path, models: dict[str, StepModel], data: str, prepared:
         "leaderGuard": {"samples": LEADER_SAMPLES, "margin": LEADER_MARGIN,
                         **({} if LEADER_HEAD_MARGIN is None else {"headMargin": LEADER_HEAD_MARGIN}),
                         **({} if LEADER_HIP_MARGIN is None else {"hipMargin": LEADER_HIP_MARGIN}),
-                        **({"keepPlan": True} if LEADER_KEEP_PLAN else {})},
+                        **({"keepPlan": LEADER_KEEP_PLAN} if LEADER_KEEP_PLAN else {})},
         # Both guards choose, every step, the sample whose footwork follows the count
         # (training/mirror/on_count.py, web/mirror/on_count.ts).
         "onCount": {"samples": on_count.SAMPLES, "strength": on_count.STRENGTH, "hips": on_count.HIPS,

@@ -87,7 +87,13 @@ LEADER_HIP_MARGIN: float | None = 0.10    # m; None: the hips are judged from LE
 # chest); kept to it, after 98 %, and she turned within 2.5 s after 78 % of them against 71 %
 # (61-62 % at the same moments unasked; lead, 100 seeds; docs/results.md, "His lead hand kept to
 # the plan"). It only chooses among his own network's steps, and only while someone asks.
-LEADER_KEEP_PLAN = True
+# Taking the nearest alone, his feet lost the count while a figure ran: his steps on the beat +0.06
+# as drawn, steered (+0.11 on his network's body; +0.51 before the figure block). Of the
+# LEADER_KEEP_PLAN standing samples nearest the plan (near_plan), his chooser on the count takes the
+# one on the beat: with 2, +0.20 drawn (+0.25), his hand above 1.6 m after 40 % of 160 requests
+# against 46 % with the nearest, and she turns as often the asked way (63 % against 65 %); with 3,
+# his hand 34 % (docs/results.md, "Leading a turn"). 1: the nearest alone.
+LEADER_KEEP_PLAN = 2
 
 POSE = feat.block_slices(feat.OUTPUT_LAYOUT)["pose"]
 HANDS_PLAN_SHOWN = feat.block_slices(feat.LEADER_INPUT_LAYOUT)["hands_plan"].start   # 1 while a request runs
@@ -184,6 +190,17 @@ def nearest_plan(outputs: np.ndarray, x: np.ndarray, r: dict, offsets: np.ndarra
     return int(np.argmin(np.where(standing >= margin, drawn_miss(joints, x), np.inf)))
 
 
+def near_plan(joints: np.ndarray, x: np.ndarray, standing: np.ndarray, margin: float, n: int) -> np.ndarray:
+    """[B] bool: the n bodies drawn [B, 17, 3] standing at least `margin` inside the range (their
+    upright margins `standing` [B]) whose lead hand is nearest the plan (drawn_miss); fewer when
+    fewer stand."""
+    ok = np.asarray(standing) >= margin
+    order = np.argsort(np.where(ok, drawn_miss(joints, x), np.inf), kind="stable")[:n]
+    near = np.zeros(len(ok), dtype=bool)
+    near[order] = True
+    return near & ok
+
+
 def slack_for(x: np.ndarray, margin: float, head_margin: float | None) -> float:
     """Metres a guard lets off the head-over-hips part for input x: margin - head_margin; none
     when it has no head_margin, or while x is a leader's input that shows a hands plan (he leads)."""
@@ -223,7 +240,7 @@ class UprightGuard:
     def __init__(self, policy, ranges: dict, samples: int = SAMPLES, temperature: float | None = None,
                  margin: float = MARGIN, offsets: np.ndarray | None = None, head_margin: float | None = None,
                  hip_margin: float | None = None, partner_low: float | None = None,
-                 partner_low_hip_margin: float | None = None, keep_plan: bool = False,
+                 partner_low_hip_margin: float | None = None, keep_plan: int = 0,
                  on_count: OnCount | None = None):
         if samples < 2:
             raise ValueError("the guard needs at least 2 samples to choose from")
@@ -231,7 +248,7 @@ class UprightGuard:
         self.margin, self.offsets, self.head_margin = margin, offsets, head_margin
         self.hip_margin, self.partner_low, self.partner_low_hip_margin = hip_margin, partner_low, partner_low_hip_margin
         self.hip_slack = 0.0 if hip_margin is None else margin - hip_margin   # while he stands tall
-        self.keep_plan = keep_plan
+        self.keep_plan = int(keep_plan)
         if keep_plan and offsets is None:
             raise ValueError("keeping the hand to the plan needs the dancer's bones (offsets)")
         if on_count is not None and offsets is None:
@@ -245,7 +262,20 @@ class UprightGuard:
         hips = hip_slack_for(x, self.margin, self.hip_margin, self.partner_low, self.partner_low_hip_margin)
         if self.keep_plan and shows_plan(x):
             many = self.policy(np.repeat(np.atleast_2d(x), self.samples, 0), t, rng)
-            best = nearest_plan(many["output"], x, self.ranges, self.offsets, self.margin, slack, hips)
+            best = -1
+            if self.on_count is not None and self.keep_plan > 1:
+                # Among the keep_plan standing samples nearest the plan, the one on the count: his
+                # hand keeps to the lead and his feet to the beat.
+                joints = drawn_joints(many["output"], self.offsets)
+                standing = drawn_margin(joints, self.ranges, slack, hips)
+                near = near_plan(joints, x, standing, self.margin, self.keep_plan)
+                target = self.on_count.target(x)
+                steps = drawn_steps(many["output"], joints, x, self.on_count.role)
+                best = nearest_count(drawn_footwork(steps), hips_turn_back(steps, x, self.on_count.role), target,
+                                     np.where(near, standing, -np.inf), self.margin, self.on_count.hips,
+                                     self.on_count.keeps(many["output"]), self.on_count.prefers(many["output"], x))
+            if best < 0:
+                best = nearest_plan(many["output"], x, self.ranges, self.offsets, self.margin, slack, hips)
             self.kept += 1
             if upright_margin(many["output"][best], self.ranges, self.offsets, slack, hips)[0] < self.margin:
                 self.guarded += 1

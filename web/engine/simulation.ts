@@ -10,7 +10,7 @@ import { FIGURE_SIZE, FUTURE_OFFSETS, INPUT_SIZE, INTENTION_SIZE, KEYS, OUTPUT_S
 import { KEY_JOINTS, type Motion, N_JOINTS, POSITIONS_SIZE, ROTATIONS_SIZE } from '../mirror/skeleton';
 import { ContactLayer, HipGlide } from '../mirror/contact';
 import { FootLock } from '../mirror/footik';
-import { type GuardSettings, type Ranges, hipSlackFor, mostUpright, nearestPlan, showsPlan, slackFor, uprightBody, uprightMargin } from '../mirror/guard';
+import { type GuardSettings, type Ranges, hipSlackFor, mostUpright, nearPlan, nearestPlan, showsPlan, slackFor, uprightBody, uprightMargin } from '../mirror/guard';
 import { OnCount, STEPPED, drawnFootwork, drawnSteps, hipsTurnBack, nearestCount } from '../mirror/on_count';
 import { LeaderPlayback } from './playback';
 import { StepTimer } from './timing';
@@ -97,6 +97,8 @@ export class DuetSimulation implements Simulation {
   private keeps: boolean[] = [];
   /** Which of them the figure being led asks for (OnCount.prefers, from the dancer's input), outside a turn. */
   private prefers: boolean[] = [];
+  /** Which of his samples are among those nearest a request's hands plan (guard.ts nearPlan). */
+  private near: boolean[] = [];
   private readonly body = new Float64Array(3 * N_JOINTS);
   private readonly steps = new Float64Array(3 * STEPPED.length);
   /** The leader model's own variety (the manifest's); the slider sets the followers'. */
@@ -334,8 +336,8 @@ export class DuetSimulation implements Simulation {
   private nearestOnCount(
     onCount: OnCount, output: ArrayLike<number>, input: ArrayLike<number>, target: number | null, ranges: Ranges,
     offsets: ArrayLike<number>, slack: number, hipSlack: number, margin: number,
+    k = onCount.samples, only: boolean[] | null = null,
   ): number {
-    const k = onCount.samples;
     if (this.standing.length < k) {
       this.standing = new Float64Array(k);
       this.footwork = new Float64Array(k);
@@ -345,6 +347,7 @@ export class DuetSimulation implements Simulation {
     }
     for (let n = 0; n < k; n++) {
       this.standing[n] = uprightBody(output, n * OUTPUT_SIZE, ranges, offsets, slack, hipSlack, this.body);
+      if (only && !only[n]) this.standing[n] = -Infinity; // not among those the choice may take
       drawnSteps(output, n * OUTPUT_SIZE, this.body, input, onCount.role, this.steps);
       this.footwork[n] = drawnFootwork(this.steps);
       this.turnBack[n] = hipsTurnBack(this.steps, input, onCount.role);
@@ -370,8 +373,27 @@ export class DuetSimulation implements Simulation {
     const { margin, headMargin, hipMargin, keepPlan, samples: k } = guard.settings;
     const slack = slackFor(policy.input, margin, headMargin);
     const hipSlack = hipSlackFor(policy.input, margin, hipMargin);
-    const plan = keepPlan === true && showsPlan(policy.input);
-    const onCount = plan ? null : this.leaderOnCount;
+    const nearest = keepPlan === true ? 1 : Number(keepPlan ?? 0);
+    const plan = nearest > 0 && showsPlan(policy.input);
+    if (plan) {
+      // His lead: among the `nearest` standing samples whose hand is nearest the plan, the one on
+      // the count (guard.py UprightGuard: the hand keeps to the lead, the feet to the beat).
+      const { output } = await policy.runDraws(k, temperature);
+      const onCount = nearest > 1 ? this.leaderOnCount : null;
+      let best = -1;
+      if (onCount) {
+        if (this.near.length < k) this.near = new Array<boolean>(k).fill(false);
+        nearPlan(output, k, OUTPUT_SIZE, policy.input, guard.ranges, offsets, margin, nearest, this.near, slack, hipSlack);
+        const target = onCount.target(policy.input);
+        best = this.nearestOnCount(onCount, output, policy.input, target, guard.ranges, offsets, slack, hipSlack, margin, k, this.near);
+        if (best >= 0 && target !== null) this.counted++;
+      }
+      if (best < 0) best = nearestPlan(output, k, OUTPUT_SIZE, policy.input, guard.ranges, offsets, margin, slack, hipSlack);
+      this.leaderOutput.set(output.subarray(best * OUTPUT_SIZE, (best + 1) * OUTPUT_SIZE));
+      if (uprightMargin(this.leaderOutput, 0, guard.ranges, offsets, slack, hipSlack) < margin) this.upright++;
+      return;
+    }
+    const onCount = this.leaderOnCount;
     // His step on the count (on_count.ts): the standing sample whose footwork follows the beat and
     // whose hips go on; while he turns, the first standing one whose hips go on.
     const target = onCount ? onCount.target(policy.input) : null;
@@ -384,17 +406,15 @@ export class DuetSimulation implements Simulation {
         if (target !== null) this.counted++;
         return;
       }
-    } else if (!plan) {
+    } else {
       const result = await policy.run(temperature);
       this.leaderOutput.set(result.output);
       if (uprightMargin(this.leaderOutput, 0, guard.ranges, offsets, slack, hipSlack) >= margin) return;
     }
     const { output } = await policy.runDraws(k, temperature);
-    const best = plan
-      ? nearestPlan(output, k, OUTPUT_SIZE, policy.input, guard.ranges, offsets, margin, slack, hipSlack)
-      : mostUpright(output, k, OUTPUT_SIZE, guard.ranges, offsets, slack, hipSlack);
+    const best = mostUpright(output, k, OUTPUT_SIZE, guard.ranges, offsets, slack, hipSlack);
     this.leaderOutput.set(output.subarray(best * OUTPUT_SIZE, (best + 1) * OUTPUT_SIZE));
-    if (!plan || uprightMargin(this.leaderOutput, 0, guard.ranges, offsets, slack, hipSlack) < margin) this.upright++;
+    this.upright++;
   }
 
   /**

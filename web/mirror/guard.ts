@@ -14,8 +14,9 @@
 // she falls (guard.py, LEADER_HEAD_MARGIN and FOLLOWER_HIP_MARGIN); and while her input shows his
 // hips below guard.partnerLow (a lunge), from guard.partnerLowHipMargin (guard.py, PARTNER_LOW).
 // A manifest's leaderGuard.keepPlan keeps his lead hand to a request's hands plan: while his input
-// shows one, every step draws the samples and takes the standing one whose lead hand is nearest the
-// plan's height one step on (nearestPlan; guard.py, LEADER_KEEP_PLAN).
+// shows one, every step draws the samples and, among the keepPlan standing ones whose lead hand is
+// nearest the plan's height one step on (nearPlan), takes the one on the count (nearestPlan when
+// keepPlan is 1; guard.py, LEADER_KEEP_PLAN).
 
 import { FOLLOWER_INPUT_LAYOUT, INPUT_SIZE, KEY_STEP, LEADER_INPUT_LAYOUT, LEADER_INPUT_SIZE, N_JOINTS, OUTPUT_LAYOUT, blockSlices } from './features';
 import { MIN_ANKLE_HEIGHT, rotationsFromVectors } from './rollout';
@@ -46,8 +47,9 @@ export interface GuardSettings {
    *  from partnerLowHipMargin instead (she goes down with his lunge). */
   partnerLow?: number;
   partnerLowHipMargin?: number;
-  /** The leader's: while a request runs, keep his lead hand to its plan (nearestPlan). */
-  keepPlan?: boolean;
+  /** The leader's: while a request runs, keep his lead hand to its plan: the sample on the count
+   *  among the keepPlan standing ones nearest it (nearPlan; 1 or true: the nearest, nearestPlan). */
+  keepPlan?: number | boolean;
 }
 
 const POSE = blockSlices(OUTPUT_LAYOUT).pose;
@@ -165,6 +167,30 @@ export function nearestPlan(
     }
   }
   return best >= 0 ? best : mostUpright(output, count, size, r, offsets, headSlack, hipSlack);
+}
+
+const misses: number[] = [];
+
+/**
+ * near_plan in guard.py: marks in `near` [count] the `n` outputs standing at least `margin` inside
+ * the range whose lead hand is nearest the plan (fewer when fewer stand), the others false. Ties go
+ * to the earlier sample, as numpy's stable argsort does.
+ */
+export function nearPlan(
+  output: ArrayLike<number>, count: number, size: number, input: ArrayLike<number>, r: Ranges, offsets: ArrayLike<number>,
+  margin: number, n: number, near: boolean[], headSlack = 0, hipSlack = 0,
+): void {
+  for (let i = 0; i < count; i++) {
+    const lift = drawnJoints(output, i * size, offsets);
+    misses[i] = drawnMargin(lift, r, headSlack, hipSlack) >= margin ? drawnMiss(lift, input) : Infinity;
+    near[i] = false;
+  }
+  for (let picked = 0; picked < n; picked++) {
+    let best = -1;
+    for (let i = 0; i < count; i++) if (!near[i] && misses[i] < Infinity && (best < 0 || misses[i] < misses[best])) best = i;
+    if (best < 0) return;
+    near[best] = true;
+  }
 }
 
 /**
