@@ -10,9 +10,10 @@
 // manifest's leaderGuard.headMargin judges the leader's head over his hips from a smaller margin
 // (0.03 m shipped), except while he leads a turn, and its leaderGuard.hipMargin his hips from a
 // larger one (0.10 m: a crouch caught before it is too deep); its guard.hipMargin judges the
-// follower's hips from a larger one (0.15 m shipped): beside the leader who then lunges, her hips drop fast when
+// follower's hips from a larger one (0.20 m shipped): her hips drop fast when
 // she falls (guard.py, LEADER_HEAD_MARGIN and FOLLOWER_HIP_MARGIN); and while her input shows his
-// hips below guard.partnerLow (a lunge), from guard.partnerLowHipMargin (guard.py, PARTNER_LOW).
+// hips below guard.partnerLow (a lunge), from guard.partnerLowHipMargin, when the manifest has them
+// (guard.py, PARTNER_LOW; not shipped).
 // A manifest's leaderGuard.keepPlan keeps his lead hand to a request's hands plan: while his input
 // shows one, every step draws the samples and, among the keepPlan standing ones whose lead hand is
 // nearest the plan's height one step on (nearPlan), takes the one on the count (nearestPlan when
