@@ -123,6 +123,9 @@ describe('desktop', () => {
     // on a quiet machine; on a busy one it takes longer, and the test waits for the steps. In the
     // half-resolution browser (QUICK): it takes no picture.
     await steerAtRandom(page);
+    // The tests after this one dance in the full-resolution browser: this page would dance on
+    // beside them, at 4x, for nothing.
+    await page.goto('about:blank');
   });
 
   async function steerAtRandom(page) {
@@ -223,10 +226,10 @@ describe('phone', () => {
   let page;
 
   before(async () => {
-    // deviceScaleFactor 1: a phone's 3 draws at 2 (the page's cap), four times the pixels of 1,
-    // and software WebGL made the touch-steering checks wait minutes for their steps. These
-    // pictures check the layout (docs/ shows framing.test.mjs's phone pictures).
-    browser = await launch({ viewport: { width: 390, height: 844 }, deviceScaleFactor: 1, isMobile: true, hasTouch: true });
+    // Half resolution (QUICK): a phone's 3 draws at 2 (the page's cap), and software WebGL made
+    // the touch-steering checks wait minutes for their steps. These pictures check the layout,
+    // in CSS pixels; docs/ shows framing.test.mjs's phone pictures, not these.
+    browser = await launch({ viewport: { width: 390, height: 844 }, isMobile: true, hasTouch: true, ...QUICK });
     page = browser.page;
   });
 

@@ -3,8 +3,10 @@
 // folded and open, with 0 possible reactions (and 8 on the 390x844 phone): every frame drawn over 10 s of dance (led
 // with the keys or a finger, turns asked for), the top of each dancer's head and each shoe's toe
 // and heel (window.duet.leader/follower.outline) are on screen and under neither the title card
-// nor the panel; the same during and after 20 random wheel turns and drags (two-finger pinches
-// and turns on a phone), and a double-click or a double tap frames them again. Also: the words
+// nor the panel; with the pair alone, the same during and after 20 random wheel turns and drags
+// (two-finger pinches and turns on a phone), and a double-click or a double tap frames them again.
+// On the two phones whose pictures docs/ shows, also at the phone's own resolution, the settings
+// open (the picture taken then). Also: the words
 // the page shows (the help's varieties against the manifest, the turn buttons, the landscape
 // help's "more below"), a phone's title card in one row, and a number box that gives the arrow
 // keys back.
@@ -26,21 +28,31 @@ import { QUICK, ROOT, WAIT_MS, distance, duet, launch, saveScreen, sleep, startS
 // framing reads the pair alone: web/draw/framing.ts), so the view-dependent part, the pair whole
 // in each view's free part, is checked on every view with the pair alone, and the 8 possible
 // reactions once: on the tallest phone (where they spread widest), with the settings open (the
-// smaller free part), in a half-resolution browser of their own (QUICK: the pictures docs/ shows
-// are the pair alone).
-// `quick`: the view's pictures are not in docs/ (docs/testing.md, Pictures), so it draws at half
-// resolution (a quarter of the pixels that software WebGL fills); layout is in CSS pixels.
+// smaller free part), led for 10 s. The gestures and the double tap move the camera alone, which
+// reads the pair alone: they are checked on the same phone with the pair alone (the 0 run before
+// it), not again among the possible reactions, where each touch event waited on nine networks'
+// steps (20 gestures took 50-70 s there, the 10 s led 33-47 s).
+// Every view's framing runs draw at half resolution (QUICK: a quarter of the pixels that software
+// WebGL fills; what they check, the outline against the boxes, is in CSS pixels): the dance and the
+// camera are the same at any resolution, and at the phone's full resolution these runs were most
+// of this file's time. `picture`: docs/ shows this view's picture with the settings open
+// (docs/testing.md, Pictures: screenshot-phone.png, screenshot-landscape.png), so a browser at the
+// phone's own resolution serves the title-row test, and takes that picture
+// (framing-WxH-open-0.png) at its end, the settings open, after 1.5 s of dance checked whole on
+// every frame as the runs are.
 const VIEWS = [
-  { name: '360x640', width: 360, height: 640, phone: true, ghosts: [0], quick: true },
-  { name: '390x844', width: 390, height: 844, phone: true, ghosts: [0, 8] },
-  { name: '844x390', width: 844, height: 390, phone: true, ghosts: [0] },
-  { name: '1280x800', width: 1280, height: 800, phone: false, ghosts: [0], quick: true },
+  { name: '360x640', width: 360, height: 640, phone: true, ghosts: [0] },
+  { name: '390x844', width: 390, height: 844, phone: true, ghosts: [0, 8], picture: true },
+  { name: '844x390', width: 844, height: 390, phone: true, ghosts: [0], picture: true },
+  { name: '1280x800', width: 1280, height: 800, phone: false, ghosts: [0] },
 ];
 const PHONE = { isMobile: true, hasTouch: true, deviceScaleFactor: 1 };
 /** 10 s of dance, in steps (30 a second): counted in steps, so a slow machine dances it all. */
 const TEN_SECONDS = 300;
 /** Steps watched after the gestures. */
 const AFTER_GESTURES = 90;
+/** Steps danced, the settings open, before the picture docs/ keeps is taken (in the full-resolution browser). */
+const PICTURE_STEPS = 45;
 const GESTURES = 20;
 /** DEFAULT_ORBIT in web/draw/scene.ts: where a double-click or a double tap puts the camera. */
 const FIRST_VIEW = { azimuth: 35, polar: 70, distance: 5.2 };
@@ -242,76 +254,81 @@ async function gestures(page, phone, rand) {
 
 for (const view of VIEWS) {
   describe(view.name, () => {
-    let browser;
+    // `quick` dances the framing runs, and the other tests where the view keeps no picture; `full`
+    // (a view whose picture docs/ shows) the title-row test, its picture, and the help's test.
+    let quick;
+    let full;
     let page;
     const pictures = [];
+    const size = { viewport: { width: view.width, height: view.height }, ...(view.phone ? PHONE : {}) };
 
     before(async () => {
-      browser = await launch({ viewport: { width: view.width, height: view.height }, ...(view.phone ? PHONE : {}), ...(view.quick ? QUICK : {}) });
-      page = browser.page;
+      quick = await launch({ ...size, ...QUICK });
+      if (view.picture) full = await launch(size);
+      page = (full ?? quick).page;
     });
 
     after(async () => {
-      await browser?.close();
+      await quick?.close();
+      await full?.close();
     });
 
     for (const ghosts of view.ghosts) {
       const panels = ghosts ? [true] : [false, true];
-      test(`${ghosts} possible reactions: heads and feet in the free part every frame, ${ghosts ? 'open' : 'folded and open'}, led, zoomed, dragged`, { timeout: HANG_MS }, async () => {
-        const own = ghosts ? await launch({ viewport: { width: view.width, height: view.height }, ...(view.phone ? PHONE : {}), ...QUICK }) : null;
-        const { page } = own ?? browser;
-        try {
-          await page.goto(`${server.url}?seed=${ghosts + 1}&ghosts=${ghosts}`);
-          await waitReady(page);
-          await watch(page);
-          const rand = random(50 + view.width + ghosts);
-          for (const open of panels) {
-            const t0 = Date.now(), seconds = () => ((Date.now() - t0) / 1000).toFixed(0); // for the log only
-            const where = `${view.name}, settings ${open ? 'open' : 'folded'}, ${ghosts} possible reactions`;
-            await setPanel(page, open);
-            await resetFraming(page);
-            await recording(page, true);
-            await lead(page, view.phone, TEN_SECONDS, rand);
-            const led = await framing(page);
-            assertWhole(led, `${where}, 10 s led`);
-            const name = `framing-${view.name}-${open ? 'open' : 'folded'}-${ghosts}.png`;
-            pictures.push(saveScreen(name, await page.screenshot()));
-            console.log(`${where}: ${led.frames} frames, the pair ${led.smallest.toFixed(0)}-${led.largest.toFixed(0)} px tall on screen (${seconds()} s)`);
+      test(`${ghosts} possible reactions: heads and feet in the free part every frame, ${ghosts ? 'open, led' : 'folded and open, led, zoomed, dragged'}`, { timeout: HANG_MS }, async () => {
+        const { page } = quick;
+        await page.goto(`${server.url}?seed=${ghosts + 1}&ghosts=${ghosts}`);
+        await waitReady(page);
+        await watch(page);
+        const rand = random(50 + view.width + ghosts);
+        for (const open of panels) {
+          const t0 = Date.now(), seconds = () => ((Date.now() - t0) / 1000).toFixed(0); // for the log only
+          const where = `${view.name}, settings ${open ? 'open' : 'folded'}, ${ghosts} possible reactions`;
+          await setPanel(page, open);
+          await resetFraming(page);
+          await recording(page, true);
+          await lead(page, view.phone, TEN_SECONDS, rand);
+          const led = await framing(page);
+          assertWhole(led, `${where}, 10 s led`);
+          const name = `framing-${view.name}-${open ? 'open' : 'folded'}-${ghosts}.png`;
+          // The view's picture with the settings open is the full-resolution one (the title-row test).
+          if (!(view.picture && open && !ghosts)) pictures.push(saveScreen(name, await page.screenshot()));
+          console.log(`${where}: ${led.frames} frames, the pair ${led.smallest.toFixed(0)}-${led.largest.toFixed(0)} px tall on screen (${seconds()} s)`);
+          if (ghosts) continue; // the camera's gestures: with the pair alone (above)
 
-            await resetFraming(page);
-            await gestures(page, view.phone, rand);
-            console.log(`${where}: ${GESTURES} gestures made (${seconds()} s)`);
-            await waitSteps(page, AFTER_GESTURES);
-            const moved = await framing(page);
-            const camera = (await duet(page)).camera;
-            assertWhole(moved, `${where}, during and after ${GESTURES} gestures`);
-            console.log(`${where}: during and after the gestures ${moved.frames} frames, camera ${JSON.stringify(camera)} (${seconds()} s)`);
+          await resetFraming(page);
+          await gestures(page, view.phone, rand);
+          console.log(`${where}: ${GESTURES} gestures made (${seconds()} s)`);
+          await waitSteps(page, AFTER_GESTURES);
+          const moved = await framing(page);
+          const camera = (await duet(page)).camera;
+          assertWhole(moved, `${where}, during and after ${GESTURES} gestures`);
+          console.log(`${where}: during and after the gestures ${moved.frames} frames, camera ${JSON.stringify(camera)} (${seconds()} s)`);
 
-            // A double-click (a double tap on a phone) frames them again: the first view.
-            const at = await pairAt(page);
-            if (view.phone) await doubleTap(page, at);
-            else await page.mouse.dblclick(at[0], at[1]);
-            await page.waitForFunction(
-              (first) => {
-                const c = window.duet.camera;
-                return Math.abs(c.azimuth - first.azimuth) < 0.5 && Math.abs(c.polar - first.polar) < 0.5 && Math.abs(c.distance - first.distance) < 0.01;
-              },
-              FIRST_VIEW,
-              { timeout: WAIT_MS, polling: 50 },
-            );
-            await waitSteps(page, 10);
-            await recording(page, false);
-            assertWhole(await framing(page), `${where}, framed again`);
-          }
-          assert.deepEqual((own ?? browser).consoleErrors, []);
-        } finally {
-          await own?.close();
+          // A double-click (a double tap on a phone) frames them again: the first view.
+          const at = await pairAt(page);
+          if (view.phone) await doubleTap(page, at);
+          else await page.mouse.dblclick(at[0], at[1]);
+          await page.waitForFunction(
+            (first) => {
+              const c = window.duet.camera;
+              return Math.abs(c.azimuth - first.azimuth) < 0.5 && Math.abs(c.polar - first.polar) < 0.5 && Math.abs(c.distance - first.distance) < 0.01;
+            },
+            FIRST_VIEW,
+            { timeout: WAIT_MS, polling: 50 },
+          );
+          await waitSteps(page, 10);
+          await recording(page, false);
+          assertWhole(await framing(page), `${where}, framed again`);
         }
+        assert.deepEqual(quick.consoleErrors, []);
+        // The full-resolution browser's tests come next: this page would dance on beside them.
+        if (full) await page.goto('about:blank');
       });
     }
 
     if (view.phone) {
-      test('one row of buttons by the title, "resume" too; the open sheet leaves the dancers the band above it; a finger still leads', async () => {
+      test(`one row of buttons by the title, "resume" too; the open sheet leaves the dancers the band above it; a finger still leads${view.picture ? '; the picture with the settings open, the pair whole every frame at full resolution' : ''}`, async () => {
         await page.goto(`${server.url}?seed=1`);
         await waitReady(page);
         const row = async () =>
@@ -346,13 +363,26 @@ for (const view of VIEWS) {
         }
         const moved = distance(start, (await duet(page)).anchor);
         assert.ok(moved >= MIN_STEER_M, `${view.name}: a finger's drag carried the leader's spot ${moved.toFixed(2)} m`);
-        assert.deepEqual(browser.consoleErrors, []);
+        if (view.picture) {
+          // The picture docs/ shows (framing-WxH-open-0.png): the settings open, the pair checked
+          // whole on every frame drawn meanwhile, as in the framing runs.
+          await setPanel(page, true);
+          await watch(page);
+          await recording(page, true);
+          await waitSteps(page, PICTURE_STEPS);
+          await recording(page, false);
+          assertWhole(await framing(page), `${view.name}, settings open, full resolution`);
+          pictures.push(saveScreen(`framing-${view.name}-open-0.png`, await page.screenshot()));
+          await setPanel(page, false);
+        }
+        assert.deepEqual((full ?? quick).consoleErrors, []);
       });
     }
 
     if (view.name === '844x390') {
       test('the help held sideways says there is more below until its end is in view', async () => {
-        await page.goto(`${server.url}?seed=1`);
+        // The title-row test left this page at ?seed=1, dancing, the settings folded: no second load.
+        if (new URL(page.url()).search !== '?seed=1') await page.goto(`${server.url}?seed=1`);
         await waitReady(page);
         await page.locator('.help-button').click();
         const state = () =>
@@ -433,7 +463,7 @@ for (const view of VIEWS) {
         await page.keyboard.press('Enter');
         const after = await steer();
         assert.ok(after >= MIN_STEER_M, `after Enter, ArrowUp carried the spot ${after.toFixed(2)} m`);
-        assert.deepEqual(browser.consoleErrors, []);
+        assert.deepEqual(quick.consoleErrors, []);
       });
     }
 

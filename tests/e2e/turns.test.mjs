@@ -1,7 +1,8 @@
 // Leading a turn in the page (tests/e2e/turns.mjs says how the request is made and recorded).
 // Seed 8 at 1280×800: the duet dances 4 s (120 steps) with nobody steering, then the leader is
 // asked to lead a clockwise turn (−1, her right: what T does), and every step is
-// recorded for 3 s; the same seed without a request is the control. The same led turn on a phone
+// recorded for 3 s; the same seed without a request is the control (half resolution, 4x speed: it
+// takes no picture, and is compared step by step). The same led turn on a phone
 // (390×844, touch). Film strips from the request on, a frame every 0.5 s of dance time:
 // filmstrip-led-turn-desktop.png and filmstrip-led-turn-phone.png in runs/screens/ (harness.SCREENS).
 //
@@ -42,8 +43,13 @@ const DESKTOP = {
   name: 'desktop', launch: { viewport: { width: 1280, height: 800 } },
   crop: { x: 200, y: 110, width: 880, height: 600 }, scale: 0.5, file: 'filmstrip-led-turn-desktop.png',
 };
-/** The desktop at half resolution (QUICK), for the runs that take no picture. */
-const QUICK_DESKTOP = { ...DESKTOP, launch: { ...DESKTOP.launch, ...QUICK }, file: null };
+/**
+ * The desktop at half resolution (QUICK) and 4x speed, for the runs that take no picture: the
+ * dance is the same step by step at any speed and resolution (the control run is compared step by
+ * step with the asked one at 1x, full resolution), and a frame drawn every few steps rather than
+ * every step leaves the machine to the steps.
+ */
+const QUICK_DESKTOP = { ...DESKTOP, launch: { ...DESKTOP.launch, ...QUICK }, query: '&speed=4', file: null };
 const PHONE = {
   name: 'phone', launch: { viewport: { width: 390, height: 844 }, deviceScaleFactor: 2, isMobile: true, hasTouch: true },
   crop: { x: 0, y: 170, width: 390, height: 560 }, scale: 0.6, file: 'filmstrip-led-turn-phone.png',
@@ -72,15 +78,18 @@ after(async () => {
  * asks nothing; `view.file` also writes a strip. Returns the recording, the strip's snapshots and
  * variances, and the console errors.
  */
-async function runOnce(view, direction, strip, seed = SEED, until = UNTIL) {
-  const browser = await launch(view.launch);
+async function runOnce(view, direction, strip, seed = SEED, until = UNTIL, shared = null) {
+  const browser = shared ?? (await launch(view.launch));
+  const errorsBefore = browser.consoleErrors.length;
   try {
     const { page, consoleErrors } = browser;
     page.setDefaultTimeout(READY_MS);
     // figures=0: he leads only the turn asked for, so the control run leads none.
-    await page.goto(`${server.url}?seed=${seed}&figures=0`);
-    await waitReady(page);
+    await page.goto(`${server.url}?seed=${seed}&figures=0${view.query ?? ''}`);
+    // Armed as soon as the page's scripts are in, before its first step: at 4x speed the dance
+    // was past the request's step by the time a probe armed after `ready` was in.
     await armProbe(page, { askAt: ASK_AT, direction, until });
+    await waitReady(page);
     let capture = null;
     if (strip) {
       capture = page.evaluate(captureLedTurn, {
@@ -95,20 +104,20 @@ async function runOnce(view, direction, strip, seed = SEED, until = UNTIL) {
       shot = await capture;
       saveScreen(view.file, shot.png);
     }
-    return { probe, shot, consoleErrors: [...consoleErrors] };
+    return { probe, shot, consoleErrors: consoleErrors.slice(errorsBefore) };
   } catch (error) {
     if (/Execution context was destroyed|navigation/.test(String(error))) throw new Reloaded(String(error));
     throw error;
   } finally {
-    await browser.close();
+    if (!shared) await browser.close();
   }
 }
 
 /** The dev server reloads the page when someone edits its source under the test: run again. */
-async function run(view, direction, strip = false, seed = SEED, until = UNTIL) {
+async function run(view, direction, strip = false, seed = SEED, until = UNTIL, shared = null) {
   for (let attempt = 1; ; attempt++) {
     try {
-      return await runOnce(view, direction, strip, seed, until);
+      return await runOnce(view, direction, strip, seed, until, shared);
     } catch (error) {
       if (!(error instanceof Reloaded) || attempt >= 3) throw error;
     }
@@ -233,20 +242,26 @@ const MIN_TURNED = 6;
 const SEEDS = Array.from({ length: 16 }, (_, i) => i + 1);
 const REQUEST_SECONDS = 4;
 const WINDOW = REQUEST_SECONDS * FPS;
-/** The seeds' runs take no picture: drawn at half resolution (QUICK). */
+/** The seeds' runs take no picture: drawn at half resolution and 4x speed (QUICK_DESKTOP), one
+ *  page after another in one browser (a launch each cost seconds of a busy machine). */
 const SEEDS_VIEW = QUICK_DESKTOP;
 
 describe(`leading a turn in ${SEEDS.length} seeds`, () => {
   test(`she turns the asked way within ${REQUEST_SECONDS} s of T or Shift+T in most of them`, async () => {
     const rows = [];
-    for (const seed of SEEDS) {
-      const direction = seed % 2 === 1 ? 1 : -1;
-      const { probe, consoleErrors } = await run(SEEDS_VIEW, direction, false, seed, ASK_AT + WINDOW);
-      assert.deepEqual(consoleErrors, [], `seed ${seed}: console errors`);
-      assert.equal(probe.took, true, `seed ${seed}: the request was refused (${probe.via})`);
-      assert.ok(probe.steps[0].frame <= ASK_AT, `seed ${seed}: the recording began after the request`);
-      const found = followerTurns(probe.steps, ASK_AT, WINDOW);
-      rows.push({ seed, found, thatWay: found.some(([, d]) => d === direction) });
+    const browser = await launch(SEEDS_VIEW.launch);
+    try {
+      for (const seed of SEEDS) {
+        const direction = seed % 2 === 1 ? 1 : -1;
+        const { probe, consoleErrors } = await run(SEEDS_VIEW, direction, false, seed, ASK_AT + WINDOW, browser);
+        assert.deepEqual(consoleErrors, [], `seed ${seed}: console errors`);
+        assert.equal(probe.took, true, `seed ${seed}: the request was refused (${probe.via})`);
+        assert.ok(probe.steps[0].frame <= ASK_AT, `seed ${seed}: the recording began after the request`);
+        const found = followerTurns(probe.steps, ASK_AT, WINDOW);
+        rows.push({ seed, found, thatWay: found.some(([, d]) => d === direction) });
+      }
+    } finally {
+      await browser.close();
     }
     const turned = rows.filter((r) => r.thatWay);
     console.log(`led turns: ${rows.map((r) => `seed ${r.seed} ${r.found.length ? r.found.map(([t, d]) => `${d > 0 ? 'left' : 'right'} at ${t.toFixed(2)} s`).join(' ') : 'none'}${r.thatWay ? ' (the asked way)' : ''}`).join(', ')}; ` +
