@@ -63,7 +63,13 @@ try {
     const steps = await dance(seed);
     // start: where the page put the leader at its first step, his spot (simulation.ts starts him at the
     // floor's origin, and nobody steering he stays free within ANCHOR_FREE of it).
-    seeds.push({ seed, first: steps[0].frame, start: [0, 0], leader: steps.map((s) => s.leader), follower: steps.map((s) => s.follower) });
+    // beat: the count each step danced on, for the rhythm (page_figures reads it as rhythm.py does
+    // duet.soak_one's record); leaderOwn / followerOwn: the networks' bodies beside the drawn ones.
+    seeds.push({
+      seed, first: steps[0].frame, start: [0, 0], tempo: steps[0].tempo, beat: steps.map((s) => s.beat),
+      leader: steps.map((s) => s.leader), follower: steps.map((s) => s.follower),
+      leaderOwn: steps.map((s) => s.leaderOwn), followerOwn: steps.map((s) => s.followerOwn),
+    });
     console.log(`seed ${seed}: ${steps.length} steps (${((Date.now() - started) / 1000).toFixed(1)} s) [${i + 1}/${SEEDS.length}]`);
   }
 } finally {

@@ -35,7 +35,11 @@ export function armProbe(page, { askAt, direction, until, asks }) {
         // Where the leader's input holds the figure block and the hands plan, from the page's own
         // layout table (web/mirror/features.ts): figure 660-763, hands plan from 764.
         const features = await import('/web/mirror/features.ts');
+        const { NOW } = await import('/web/mirror/rollout.ts');
+        const { POSITIONS_SIZE } = await import('/web/mirror/skeleton.ts');
         const blocks = features.blockSlices(features.LEADER_INPUT_LAYOUT);
+        // The networks' own body of a dancer this step (before the contact layer): its track at NOW.
+        const ownBody = (dancer) => Array.from(dancer.track.positions.subarray(NOW * POSITIONS_SIZE, (NOW + 1) * POSITIONS_SIZE));
         const [figureAt, figureEnd, plannedAt] = [blocks.figure.start, blocks.figure.end, blocks.hands_plan.start];
         const step = proto.step;
         proto.step = async function (steer, temperature) {
@@ -56,8 +60,14 @@ export function armProbe(page, { askAt, direction, until, asks }) {
           if (probe && window.duet.frame + 1 <= probe.until) {
             probe.steps.push({
               frame: window.duet.frame + 1,
+              // As drawn (the views, after the contact layer), and the networks' own bodies.
               leader: Array.from(this.leader.positions),
               follower: Array.from(this.followers[0].positions),
+              leaderOwn: ownBody(this.duet.leader),
+              followerOwn: ownBody(this.duet.followers[0]),
+              // The count this step danced on (beats since the music started) and its tempo.
+              beat: this.beat,
+              tempo: this.tempo,
               leaderHeading: this.leader.heading,
               followerHeading: this.followers[0].heading,
               turnAsked: this.turnAsked,

@@ -328,6 +328,26 @@ def test_page_figures_measures_a_dump_as_figures_measures_the_recording(data3, t
     far = np.linalg.norm(take.lead.positions[:, 0, [0, 2]] - take.lead.positions[0, 0, [0, 2]], axis=-1).max()
     assert res["summary"]["leader_from_start_m"]["max"] == pytest.approx(far)
 
+    assert "rhythm" not in res                 # a dump without the count: no rhythm
+
+    # With the count each step danced on (as the probe records it) and the networks' bodies beside
+    # the drawn ones, the page's rhythm is rhythm.py's of the same take.
+    from training.evaluation import rhythm as R
+    counted = {**seed, "beat": take.lead.beat.tolist(), "tempo": R.bpm_of(take.lead.beat),
+               "leaderOwn": seed["leader"], "followerOwn": seed["follower"]}
+    dump.write_text(json.dumps({"fps": 30, "seconds": len(take.lead.positions) / 30, "seeds": [counted]}))
+    assert page_figures.main([str(dump), "--data", str(data3), "--takes", "06", "--out", str(tmp_path / "out")]) == 0
+    res = json.loads((tmp_path / "out" / "page_figures.json").read_text())
+    own = R.rhythm(take.lead.positions, take.follow.positions, take.lead.beat, R.bpm_of(take.lead.beat))
+    for body in R.BODIES:
+        for role in ("leader", "follower"):
+            assert res["rhythm"][body][role]["on_beat"] == pytest.approx(own[f"{role}_on_beat"])
+    assert "on the beat" in capsys.readouterr().out
+    counted["beat"] = counted["beat"][:-1]
+    dump.write_text(json.dumps({"fps": 30, "seeds": [counted]}))
+    assert page_figures.main([str(dump), "--data", str(data3), "--takes", "06"]) == 2
+    assert "steps of the count" in capsys.readouterr().err
+
     short = tmp_path / "short.json"
     short.write_text(json.dumps({"fps": 30, "seeds": [{**seed, "leader": seed["leader"][:20]}]}))
     assert page_figures.main([str(short), "--data", str(data3)]) == 2

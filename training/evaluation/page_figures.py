@@ -4,11 +4,14 @@
     python -m training.evaluation.page_figures runs/figures_probe.json
 
 The probe records both dancers' joints at every step as the page draws them (after the contact
-layer), nobody steering and nobody asking for a turn. This measures them with figures.py as
-training.evaluation.lead measures its "Dancing unasked" duets in Python: turns a minute, spin frames,
-body motion and travel of each dancer against the recorded couple of the test takes, the
-least-turning seed of each, and the leader's largest distance from his spot (where the page started
-him; lead measures it from where its duets start him).
+layer) and as the networks left them, and the count each step danced on, nobody steering and
+nobody asking for a turn. This measures them with figures.py as training.evaluation.lead measures
+its "Dancing unasked" duets in Python: turns a minute, spin frames, body motion and travel of each
+dancer against the recorded couple of the test takes, the least-turning seed of each, and the
+leader's largest distance from his spot (where the page started him; lead measures it from where
+its duets start him); and with rhythm.py as training.evaluation.rhythm measures its duets nobody
+steering: each dancer's footwork pulse, steps on the beat and the partners together, as drawn and
+on the networks' bodies.
 Issue 30 asks these in the page as well as in Python (items 1 and 4).
 """
 from __future__ import annotations
@@ -25,6 +28,7 @@ from ..data.folders import add_folder
 from ..mirror.skeleton import FPS
 from .evaluate_inputs import EvalError
 from .lead import dancing, dancing_summary, dancing_table, recording
+from .rhythm import BODIES, format_summary, recorded, rhythm, summarize
 
 ROLES = ("leader", "follower")
 
@@ -47,6 +51,11 @@ def load(path: Path) -> dict:
             if p.ndim != 2 or p.shape[1] != 51 or len(p) < 5 * FPS or not np.isfinite(p).all():
                 raise EvalError(f"{path}: seed {s['seed']}'s {who} is not at least 5 s of 17 finite joints "
                                 f"(shape {p.shape})")
+        if "beat" in s:    # the count: one per step, beside both bodies of both dancers
+            steps = {len(s.get(k, [])) for k in ("beat", "leader", "follower", "leaderOwn", "followerOwn")}
+            if len(steps) != 1 or not np.isfinite(np.asarray(s["beat"], float)).all() or not s.get("tempo", 0) > 0:
+                raise EvalError(f"{path}: seed {s['seed']}: the count, its tempo and both bodies of both dancers "
+                                f"need one entry a step each (steps of the count and the bodies: {sorted(steps)})")
     return dump
 
 
@@ -57,10 +66,34 @@ def one_seed(s: dict) -> dict:
     return {"seed": s["seed"], **dancing(lead, follow, s.get("start"))}
 
 
+def seed_rhythm(s: dict) -> dict[str, dict]:
+    """rhythm.rhythm of one seed, as drawn and on the networks' bodies (the probe's `leaderOwn` /
+    `followerOwn`), over the count each step danced on (`beat`), as rhythm.bodies_rhythm reads
+    duet.soak_one's record. {} when the dump holds no count (a probe before it recorded one)."""
+    if "beat" not in s:
+        return {}
+    beat = np.asarray(s["beat"], float)
+    out = {}
+    for body, suffix in (("drawn", ""), ("networks", "Own")):
+        lead, follow = (np.asarray(s[who + suffix], float).reshape(-1, 17, 3) for who in ROLES)
+        out[body] = {"seed": s["seed"], **rhythm(lead, follow, beat, float(s["tempo"]))}
+    return out
+
+
 def markdown(res: dict) -> str:
-    return "\n".join([f"# The page's duets, nobody steering: {len(res['per_seed'])} seeds × {res['seconds']:g} s "
-                      f"(scripts/figures_probe.mjs, as drawn after the contact layer), against the recording "
-                      f"of takes {', '.join(res['takes'])}", "", *dancing_table(res["summary"], res["recording"])]) + "\n"
+    lines = [f"# The page's duets, nobody steering: {len(res['per_seed'])} seeds × {res['seconds']:g} s "
+             f"(scripts/figures_probe.mjs, as drawn after the contact layer), against the recording "
+             f"of takes {', '.join(res['takes'])}", "", *dancing_table(res["summary"], res["recording"])]
+    if res.get("rhythm"):
+        ref = res["rhythm_reference"]
+        lines += ["", f"## Their rhythm at {res['tempo']:g} beats a minute (the page's silent count; Python's own: "
+                      f"`rhythm --steer nobody --tempos {res['tempo']:g} --seconds {res['seconds']:g} --seeds N`)", "",
+                  f"the recorded couples: pulse leader {ref['leader_pulse']:.2f} follower {ref['follower_pulse']:.2f}, "
+                  f"together {ref['together']:.2f}, on the beat leader {ref['leader_on_beat']:+.2f} "
+                  f"follower {ref['follower_on_beat']:+.2f}", ""]
+        for body, what in BODIES.items():
+            lines += [format_summary(f"the page, {what}", res["rhythm"][body], ref), ""]
+    return "\n".join(lines) + "\n"
 
 
 def run(args) -> dict:
@@ -68,8 +101,18 @@ def run(args) -> dict:
     takes = [t for t in args.takes.split(",") if t]
     per_seed = [one_seed(s) for s in dump["seeds"]]
     ref = recording(args.data, takes)
-    return {"takes": takes, "recording": ref, "seconds": dump.get("seconds", 0), "per_seed": per_seed,
-            "summary": dancing_summary(per_seed, ref)}
+    res = {"takes": takes, "recording": ref, "seconds": dump.get("seconds", 0), "per_seed": per_seed,
+           "summary": dancing_summary(per_seed, ref)}
+    rhythms = [seed_rhythm(s) for s in dump["seeds"]]
+    if all(rhythms):
+        tempos = {float(s["tempo"]) for s in dump["seeds"]}
+        if len(tempos) != 1:
+            raise EvalError(f"{args.dump}: the seeds danced at {sorted(tempos)} beats a minute, not one tempo")
+        reference = recorded(args.data)
+        res.update(tempo=tempos.pop(), rhythm_reference=reference,
+                   rhythm={body: summarize([r[body] for r in rhythms], reference) for body in BODIES},
+                   rhythm_per_seed=rhythms)
+    return res
 
 
 def main(argv=None) -> int:
