@@ -14,14 +14,14 @@
 // - the request reaches both dancers through the figure they read: his input holds her turn, the
 //   asked way, while it is danced, and no figure before the request;
 // - the request raises his hand: his higher hand goes above LEAD_HAND m within 2.5 s (in the
-//   recording it passes 1.6 m in 84 % of her turns; in Python after 37 % of requests, so seed 8 is
+//   recording it passes 1.6 m in 84 % of her turns; in Python after 34 % of requests, so seed 8 is
 //   one where it does: docs/results.md, "Leading a turn");
 // - the page keeps dancing through the turn: a step every 1/30 s of dance, both hips above 0.5 m,
 //   no error; the phone dances the same steps as the desktop;
 // - the strips' frames are not blank.
 // Whether the follower completes a turn is printed, not asserted: she is not told. Seed 8 is the
-// strip's because she completes the led turn there, the asked way (534° to her right within 2.5 s,
-// the first full turn 1.50 s after the request; 12° unasked): what a led turn looks like when it works.
+// strip's because she completes the led turn there, the asked way (568° to her right within 2.5 s,
+// the first full turn 1.10 s after the request; 37° unasked): what a led turn looks like when it works.
 //
 // Run: node --test tests/e2e/turns.test.mjs (DUET_TURN_SEED, DUET_TURN_DIRECTION: another seed, +1 her left)
 
