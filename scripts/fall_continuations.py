@@ -13,8 +13,8 @@ in 100 rollouts of 10 minutes), so this is how guard settings are compared at th
 matters, in minutes instead of a 40-minute soak each.
 
 A variant is `base` (the manifest as it is) or options joined by `+`: an evaluation option by its
-attribute name (guard, guard_margin, guard_hip_margin, guard_partner_low,
-guard_partner_low_hip_margin, leader_guard, on_count, on_count_strength, on_count_hips:
+attribute name (guard, guard_margin, guard_hip_margin, leader_guard, on_count, on_count_strength,
+on_count_hips:
 training/evaluation/options.py) or a leader guard
 field of the manifest as `leader.FIELD` (margin, headMargin, hipMargin), or `follower=FILE.onnx` /
 `leader=FILE.onnx`: another network dances on from the same moments (the duet up to them is the
@@ -38,7 +38,7 @@ from training.mirror.rollout import NOW, OnnxPolicy, start_duet, step
 from training.mirror.skeleton import FPS
 
 OPTIONS = ("temperature", "follower_temperature", "guard", "guard_margin", "guard_hip_margin",
-           "guard_partner_low", "guard_partner_low_hip_margin", "leader_guard",
+           "leader_guard",
            "on_count", "on_count_strength", "on_count_hips")
 WHOLE = ("guard", "leader_guard", "on_count")   # options that count samples
 

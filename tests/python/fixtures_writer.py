@@ -442,18 +442,9 @@ def dancer_state(d: ro.Dancer) -> dict:
 
 
 def hip_slack_cases() -> list[dict]:
-    """guard.hip_slack_for on inputs that show his hips at a few heights: a follower's, and a
-    leader's input of his own size (never judged by her partner's hips), with and without the rule."""
-    out = []
-    for size, hips, settings in ((feat.INPUT_SIZE, 0.85, (0.05, 0.15, 0.88, 0.2)), (feat.INPUT_SIZE, 0.95, (0.05, 0.15, 0.88, 0.2)),
-                                 (feat.INPUT_SIZE, 0.85, (0.05, 0.15, None, None)), (feat.INPUT_SIZE, 0.85, (0.05, None, 0.88, 0.2)),
-                                 (feat.INPUT_SIZE, 0.95, (0.05, None, None, None)), (feat.LEADER_INPUT_SIZE, 0.85, (0.07, None, 0.88, 0.2))):
-        x = np.zeros(size)
-        x[G.PARTNER_HIPS] = hips
-        margin, hip_margin, low, low_margin = settings
-        out.append({"size": size, "hips": hips, "margin": margin, "hipMargin": hip_margin, "partnerLow": low,
-                    "partnerLowHipMargin": low_margin, "slack": G.hip_slack_for(x, margin, hip_margin, low, low_margin)})
-    return out
+    """guard.hip_slack_for with and without a hip margin."""
+    return [{"margin": margin, "hipMargin": hip_margin, "slack": G.hip_slack_for(margin, hip_margin)}
+            for margin, hip_margin in ((0.05, 0.2), (0.05, 0.15), (0.07, 0.1), (0.05, None))]
 
 
 def on_count_cases(rng: np.random.Generator, outputs: np.ndarray, ranges: dict, offsets) -> dict:
@@ -774,8 +765,8 @@ def rollout_fixture(rng: np.random.Generator, lead: Track, follow: Track, lead_o
                    "hipSlackMargins": out7(G.upright_margin(outputs, ranges, follow_offsets, 0.0, -0.1)),
                    "hipSlackBest": G.most_upright(outputs, ranges, follow_offsets, 0.0, -0.1),
                    "handsPlanShown": G.HANDS_PLAN_SHOWN,
-                   # Her hips' slack from what her input shows of his hips (guard.hip_slack_for).
-                   "partnerHips": G.PARTNER_HIPS, "hipSlackFor": hip_slack_cases(),
+                   # The hips' slack from a guard's hip margin (guard.hip_slack_for).
+                   "hipSlack": hip_slack_cases(),
                    # The leader's lead hand kept to a request's plan (guard.lead_hand_miss, nearest_plan),
                    # on the same bodies: the plan raises his right hand 0.4 m by the first key. At margin 0
                    # the second body's hand is nearest; at 0.05 it does not stand, and the first is taken.

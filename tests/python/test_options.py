@@ -41,21 +41,6 @@ def test_defaults_come_from_the_manifest():
     args = parse("--guard-hip-margin", "0.05")
     assert O.resolve(args, hips) is None and O.follower_policy(policy, hips, args, 0.5).hip_slack == 0.0
     assert "--guard-hip-margin" in O.resolve(parse("--guard-hip-margin", "-1"), hips)
-    low = manifest(leaderTemperature=0.5, guard={"samples": 32, "margin": 0.05, "hipMargin": 0.15,
-                                                 "partnerLow": 0.88, "partnerLowHipMargin": 0.2})
-    args = parse()
-    assert O.resolve(args, low) is None and (args.guard_partner_low, args.guard_partner_low_hip_margin) == (0.88, 0.2)
-    f = O.follower_policy(policy, low, args, args.temperature)
-    assert (f.samples, f.partner_low, f.partner_low_hip_margin) == (32, 0.88, 0.2)
-    hips_only = parse()
-    assert O.resolve(hips_only, hips) is None and O.follower_policy(policy, hips, hips_only, 0.5).partner_low is None
-    args = parse("--guard-partner-low", "0")                   # 0: never
-    assert O.resolve(args, low) is None and O.follower_policy(policy, low, args, 0.5).partner_low is None
-    args = parse("--guard-partner-low", "0.9", "--guard-partner-low-hip-margin", "0.25")
-    assert O.resolve(args, low) is None
-    assert (O.follower_policy(policy, low, args, 0.5).partner_low, O.follower_policy(policy, low, args, 0.5).partner_low_hip_margin) == (0.9, 0.25)
-    assert "--guard-partner-low" in O.resolve(parse("--guard-partner-low", "-1"), low)
-    assert "partnerLowHipMargin" in O.resolve(parse("--guard-partner-low", "0.9"), hips)
 
 
 def test_options_override_the_manifest_and_an_old_manifest_has_no_guard():
@@ -117,8 +102,6 @@ def test_the_shipped_manifest_carries_the_guards_export_writes():
     follower = {"samples": G.SAMPLES, "margin": G.MARGIN}
     if G.FOLLOWER_HIP_MARGIN is not None:
         follower["hipMargin"] = G.FOLLOWER_HIP_MARGIN
-    if G.PARTNER_LOW is not None:
-        follower.update(partnerLow=G.PARTNER_LOW, partnerLowHipMargin=G.PARTNER_LOW_HIP_MARGIN)
     leader = {"samples": G.LEADER_SAMPLES, "margin": G.LEADER_MARGIN}
     if G.LEADER_HEAD_MARGIN is not None:
         leader["headMargin"] = G.LEADER_HEAD_MARGIN

@@ -341,50 +341,6 @@ def test_the_followers_guard_judges_her_hips_from_their_own_margin():
     assert chosen["output"][0][POSE.start + 1] == pytest.approx(0.90)
 
 
-def test_the_followers_guard_judges_her_hips_from_further_up_while_he_lunges():
-    """guard.hip_slack_for and UprightGuard(partner_low=...): while her input shows his hips below
-    partner_low, her hips are judged from partner_low_hip_margin; with him standing tall, from her
-    hip margin; a leader's input is never judged by it."""
-    from training.mirror.guard import PARTNER_HIPS, POSE, UprightGuard, hip_slack_for
-
-    def showing(hips: float, size: int = feat.INPUT_SIZE) -> np.ndarray:
-        x = np.zeros(size)
-        x[PARTNER_HIPS] = hips
-        return x
-
-    assert PARTNER_HIPS == feat.block_slices(feat.FOLLOWER_INPUT_LAYOUT)["partner_pose"].start + 1
-    assert hip_slack_for(showing(0.85), 0.05, 0.15, 0.88, 0.2) == pytest.approx(-0.15)
-    assert hip_slack_for(showing(0.95), 0.05, 0.15, 0.88, 0.2) == pytest.approx(-0.10)
-    assert hip_slack_for(showing(0.85), 0.05, None, 0.88, 0.2) == pytest.approx(-0.15)
-    assert hip_slack_for(showing(0.85), 0.05, 0.15) == pytest.approx(-0.10)       # no such rule
-    assert hip_slack_for(showing(0.85), 0.05, None) == 0.0
-    assert hip_slack_for(showing(0.85, feat.LEADER_INPUT_SIZE), 0.07, None, 0.88, 0.2) == 0.0
-
-    r = {"hip_low": 0.7, "head_above_hip_low": 0.3, "feet_wide": 1.0, "angle_high": [3.0, 0.6]}
-
-    def output(hips: float) -> np.ndarray:     # the feet together at the hips' place: only the hips can bind
-        out = np.zeros(feat.OUTPUT_SIZE, np.float32)
-        pose = out[POSE].reshape(feat.N_JOINTS, 12)
-        pose[:, 1] = hips
-        pose[2, 1], pose[4, 1] = hips + 0.4, hips + 0.7     # chest, head
-        out[POSE] = pose.reshape(-1)
-        return out
-
-    calls = []
-
-    def policy(x, temperature, rng):
-        calls.append(len(np.atleast_2d(x)))
-        return {"output": np.stack([output(0.88)] + [output(0.86 + 0.03 * i) for i in range(1, len(np.atleast_2d(x)))])}
-
-    guard = UprightGuard(policy, r, samples=4, margin=0.05, hip_margin=0.15, partner_low=0.88, partner_low_hip_margin=0.2)
-    rng = np.random.default_rng(0)
-    assert guard(showing(0.95), 0.5, rng)["output"][0][POSE.start + 1] == pytest.approx(0.88)
-    assert guard.guarded == 0 and calls == [1]         # 0.18 m up: outside her 0.15 m hip margin
-    chosen = guard(showing(0.85), 0.5, rng)             # he lunges: judged from 0.2 m, the batch
-    assert guard.guarded == 1 and calls == [1, 1, 4]
-    assert chosen["output"][0][POSE.start + 1] == pytest.approx(0.95)
-
-
 def test_the_leaders_guard_keeps_his_lead_hand_to_a_requests_plan():
     """guard.lead_hand_miss, nearest_plan, near_plan and UprightGuard(keep_plan=n): while his input
     shows a hands plan, every step draws the batch and takes the standing sample whose lead hand (the

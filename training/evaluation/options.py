@@ -35,12 +35,6 @@ def add_options(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--guard-hip-margin", type=float, default=None, metavar="M",
                     help="the follower's guard judges her hips from M metres before the range's edge "
                          "(default: the manifest's guard.hipMargin, else the guard's margin)")
-    ap.add_argument("--guard-partner-low", type=float, default=None, metavar="H",
-                    help="while her input shows the leader's hips below H metres, her guard judges her hips "
-                         "from --guard-partner-low-hip-margin (default: the manifest's guard.partnerLow; 0: never)")
-    ap.add_argument("--guard-partner-low-hip-margin", type=float, default=None, metavar="M",
-                    help="metres before the hips' edge her guard acts while his hips are low "
-                         "(default: the manifest's guard.partnerLowHipMargin)")
     ap.add_argument("--on-count", type=int, default=None, metavar="K",
                     help="both dancers' guards choose, every step, the one of K samples whose footwork follows "
                          "the count (training/mirror/on_count.py; 0: off; default: the manifest's onCount.samples)")
@@ -77,16 +71,6 @@ def resolve(args, manifest: dict) -> str | None:
         args.guard_hip_margin = guard.get("hipMargin")
     if args.guard_hip_margin is not None and args.guard_hip_margin < 0:
         return f"--guard-hip-margin {args.guard_hip_margin}: metres, 0 or more"
-    if getattr(args, "guard_partner_low", None) is None:
-        args.guard_partner_low = guard.get("partnerLow")
-    if getattr(args, "guard_partner_low_hip_margin", None) is None:
-        args.guard_partner_low_hip_margin = guard.get("partnerLowHipMargin")
-    if args.guard_partner_low is not None and args.guard_partner_low < 0:
-        return f"--guard-partner-low {args.guard_partner_low}: metres, 0 (never) or more"
-    if args.guard_partner_low and args.guard_partner_low_hip_margin is None:
-        return "the guard's partnerLow needs a partnerLowHipMargin (--guard-partner-low-hip-margin)"
-    if args.guard_partner_low_hip_margin is not None and args.guard_partner_low_hip_margin < 0:
-        return f"--guard-partner-low-hip-margin {args.guard_partner_low_hip_margin}: metres, 0 or more"
     if getattr(args, "leader_guard", None) is None:
         args.leader_guard = int((manifest.get("leaderGuard") or {}).get("samples", 0))
     if args.leader_guard < 0 or args.leader_guard == 1:
@@ -121,17 +105,12 @@ def resolve(args, manifest: dict) -> str | None:
 
 def follower_policy(policy, manifest: dict, args, leader_temperature: float):
     """The follower's policy as the (resolved) options ask: guarded (judging the body the follower's
-    bones draw, her hips from the guard's hipMargin when it has one, and from its partnerLowHipMargin
-    while she sees his hips below partnerLow), at its own variety, or as it is."""
+    bones draw, her hips from the guard's hipMargin when it has one), at its own variety, or as it is."""
     temperature = None if args.follower_temperature == leader_temperature else args.follower_temperature
     if args.guard:
         hips = getattr(args, "guard_hip_margin", None)
-        low = getattr(args, "guard_partner_low", None) or None          # 0: never
-        low_margin = getattr(args, "guard_partner_low_hip_margin", None)
         return UprightGuard(policy, manifest["plausibility"], args.guard, temperature, args.guard_margin,
                             manifest["skeleton"]["offsets"]["follower"], hip_margin=None if hips is None else float(hips),
-                            partner_low=None if low is None else float(low),
-                            partner_low_hip_margin=None if low is None or low_margin is None else float(low_margin),
                             on_count=on_count_for("follower", args))
     return policy if temperature is None else Variety(policy, temperature)
 

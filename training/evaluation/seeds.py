@@ -183,8 +183,6 @@ def run(args) -> dict:
                      "seconds": args.seconds, "temperature": args.temperature,
                      "follower_temperature": args.follower_temperature, "guard": args.guard,
                      "guard_margin": args.guard_margin, "guard_hip_margin": args.guard_hip_margin,
-                     "guard_partner_low": args.guard_partner_low,
-                     "guard_partner_low_hip_margin": args.guard_partner_low_hip_margin,
                      "on_count": args.on_count, "on_count_strength": args.on_count_strength,
                      "on_count_hips": args.on_count_hips,
                      "wall_seconds": time.time() - t0}

@@ -141,9 +141,7 @@ def main(argv=None) -> int:
     print(f"{args.rollouts} rollouts x {frames} frames ({args.minutes:g} min at {FPS} Hz), "
           f"follower {args.follower}, variety: leader {temperature:g}, follower {args.follower_temperature:g}, " +
           (f"upright guard of {args.guard} samples, margin {args.guard_margin:g} m" +
-           (f" (her hips {args.guard_hip_margin:g} m)" if args.guard_hip_margin is not None else "") +
-           (f" (her hips {args.guard_partner_low_hip_margin:g} m while his are below {args.guard_partner_low:g} m)"
-            if args.guard_partner_low else "")
+           (f" (her hips {args.guard_hip_margin:g} m)" if args.guard_hip_margin is not None else "")
            if args.guard else "no upright guard"))
     print(" seed  nonfinite  max dist m  bone err mm  min foot cm  frozen L  frozen F  resets  result")
     for i in tqdm(range(args.rollouts), desc="soak", unit="rollout", leave=False):

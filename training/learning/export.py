@@ -35,7 +35,7 @@ from ..data.prepared import TrainError
 from .runs import fingerprint, load_run
 from .stamp import PAGE_MODELS, eval_file, write_stamp
 from ..mirror.skeleton import FPS, JOINT_NAMES, KEY_JOINTS, PARENTS
-from ..mirror.guard import FOLLOWER_HIP_MARGIN, LEADER_HEAD_MARGIN, LEADER_HIP_MARGIN, LEADER_KEEP_PLAN, PARTNER_LOW, PARTNER_LOW_HIP_MARGIN, LEADER_MARGIN, LEADER_SAMPLES, MARGIN as GUARD_MARGIN, SAMPLES as GUARD_SAMPLES
+from ..mirror.guard import FOLLOWER_HIP_MARGIN, LEADER_HEAD_MARGIN, LEADER_HIP_MARGIN, LEADER_KEEP_PLAN, LEADER_MARGIN, LEADER_SAMPLES, MARGIN as GUARD_MARGIN, SAMPLES as GUARD_SAMPLES
 from .train import SHIPPED
 
 MANIFEST_VERSION = 1
@@ -186,8 +186,7 @@ def write_manifest(out: Path, models: dict[str, StepModel], data: str, prepared:
         "leaderTemperature": LEADER_TEMPERATURE,
         # The follower's upright guard (training/mirror/guard.py, web/mirror/guard.ts).
         "guard": {"samples": GUARD_SAMPLES, "margin": GUARD_MARGIN,
-                  **({} if FOLLOWER_HIP_MARGIN is None else {"hipMargin": FOLLOWER_HIP_MARGIN}),
-                  **({} if PARTNER_LOW is None else {"partnerLow": PARTNER_LOW, "partnerLowHipMargin": PARTNER_LOW_HIP_MARGIN})},
+                  **({} if FOLLOWER_HIP_MARGIN is None else {"hipMargin": FOLLOWER_HIP_MARGIN})},
         # ... and the leader's (the same guard with its own margin).
         "leaderGuard": {"samples": LEADER_SAMPLES, "margin": LEADER_MARGIN,
                         **({} if LEADER_HEAD_MARGIN is None else {"headMargin": LEADER_HEAD_MARGIN}),

@@ -51,12 +51,10 @@ MARGIN = 0.05   # m
 # rhythm as before; from 0.25 m 0 of 18, but her footwork pulse halved (docs/results.md, tried).
 # None: the hips judged from MARGIN like the rest.
 FOLLOWER_HIP_MARGIN: float | None = 0.20   # m
-# While her input shows his hips below PARTNER_LOW (his lunge), her hips are judged from
-# PARTNER_LOW_HIP_MARGIN instead: with her hips judged from 0.15 m, every fall left in the soak came
-# a second or two after his lunge. Judged from 0.20 m always, she needs no such rule (0.25 m while
-# he is low: 2 of 18 fell, against 1 of 17 without it). None: no such rule.
-PARTNER_LOW: float | None = None   # m, his hip height in her input
-PARTNER_LOW_HIP_MARGIN = 0.20      # m
+# With her hips judged from 0.15 m every fall left in the soak came a second or two after his lunge,
+# and while her input showed his hips below 0.88 m they were judged from 0.20 m instead. Judged from
+# 0.20 m always, she needs no such rule (0.25 m while he is low: 2 of 18 fell, against 1 of 17
+# without it; docs/results.md, tried).
 # The leader trained on his own rollouts dances (steered, body motion 0.54 m/s over 100 seeds against 0.33 before) but,
 # steered, a few seeds had a second with his hips low. The same guard, acting from LEADER_MARGIN
 # before the range's edge (40 steered seeds): 0.05 m acted in 3.9 % of his steps and left 1 seed
@@ -101,8 +99,6 @@ HANDS_PLAN_SHOWN = feat.block_slices(feat.LEADER_INPUT_LAYOUT)["hands_plan"].sta
 # move to the first future key (the hands plan's first key, y), left then right.
 HAND_HEIGHTS = [feat.block_slices(feat.LEADER_INPUT_LAYOUT)["self_pose"].start + 12 * h + 1 for h in HANDS]
 HAND_PLAN_FIRST = [HANDS_PLAN_SHOWN + 1 + 3 * k + 1 for k in range(len(HANDS))]
-# The partner's hip height in a follower's input (the pose block's first joint, y, in her root space).
-PARTNER_HIPS = feat.block_slices(feat.FOLLOWER_INPUT_LAYOUT)["partner_pose"].start + 1
 
 
 def drawn_joints(outputs: np.ndarray, offsets: np.ndarray) -> np.ndarray:
@@ -210,15 +206,9 @@ def slack_for(x: np.ndarray, margin: float, head_margin: float | None) -> float:
     return margin - head_margin
 
 
-def hip_slack_for(x: np.ndarray, margin: float, hip_margin: float | None, partner_low: float | None = None,
-                  partner_low_hip_margin: float | None = None) -> float:
-    """Metres a guard adds to the hips' part for input x (negative: they are judged from a larger
-    margin): margin - partner_low_hip_margin while x is a follower's input showing her partner's
-    hips below partner_low, else margin - hip_margin; none without either."""
-    first = np.atleast_2d(x)[0]
-    if (partner_low is not None and partner_low_hip_margin is not None and len(first) == feat.INPUT_SIZE
-            and first[PARTNER_HIPS] < partner_low):
-        return margin - partner_low_hip_margin
+def hip_slack_for(margin: float, hip_margin: float | None) -> float:
+    """Metres a guard adds to the hips' part (negative: they are judged from a larger margin):
+    margin - hip_margin; none without a hip margin."""
     return 0.0 if hip_margin is None else margin - hip_margin
 
 
@@ -227,10 +217,10 @@ class UprightGuard:
     in which it picked another sample (reset it per duet). `temperature` overrides the one the
     duet's step asks for (the follower's own variety; the leader keeps the duet's). `head_margin`
     (the leader's): the head over the hips is judged from that margin instead, except while his
-    input shows a hands plan. `hip_margin` (both dancers'): the hips are judged from that margin;
-    `partner_low`, `partner_low_hip_margin` (hers): from that one while her input shows his hips
-    below that height. `keep_plan` (his): while his input shows a hands plan, every step draws the samples and takes
-    the standing one whose lead hand is nearest the plan (nearest_plan); `kept` counts those
+    input shows a hands plan. `hip_margin` (both dancers'): the hips are judged from that margin.
+    `keep_plan` (his): while his input shows a hands plan, every step draws the samples and takes
+    the standing one whose lead hand is nearest the plan (nearest_plan), or with `on_count` and
+    keep_plan > 1 the one on the count of the keep_plan nearest (near_plan); `kept` counts those
     steps, `guarded` the ones among them where none stood. `on_count` (both dancers', an
     on_count.OnCount): every step draws its samples and takes the standing one whose footwork
     follows the count, one whose hips turn back passed over (while the dancer turns: the first
@@ -239,15 +229,14 @@ class UprightGuard:
 
     def __init__(self, policy, ranges: dict, samples: int = SAMPLES, temperature: float | None = None,
                  margin: float = MARGIN, offsets: np.ndarray | None = None, head_margin: float | None = None,
-                 hip_margin: float | None = None, partner_low: float | None = None,
-                 partner_low_hip_margin: float | None = None, keep_plan: int = 0,
+                 hip_margin: float | None = None, keep_plan: int = 0,
                  on_count: OnCount | None = None):
         if samples < 2:
             raise ValueError("the guard needs at least 2 samples to choose from")
         self.policy, self.ranges, self.samples, self.temperature = policy, ranges, samples, temperature
         self.margin, self.offsets, self.head_margin = margin, offsets, head_margin
-        self.hip_margin, self.partner_low, self.partner_low_hip_margin = hip_margin, partner_low, partner_low_hip_margin
-        self.hip_slack = 0.0 if hip_margin is None else margin - hip_margin   # while he stands tall
+        self.hip_margin = hip_margin
+        self.hip_slack = hip_slack_for(margin, hip_margin)
         self.keep_plan = int(keep_plan)
         if keep_plan and offsets is None:
             raise ValueError("keeping the hand to the plan needs the dancer's bones (offsets)")
@@ -259,7 +248,7 @@ class UprightGuard:
     def __call__(self, x: np.ndarray, temperature: float, rng: np.random.Generator) -> dict:
         t = temperature if self.temperature is None else self.temperature
         slack = slack_for(x, self.margin, self.head_margin)
-        hips = hip_slack_for(x, self.margin, self.hip_margin, self.partner_low, self.partner_low_hip_margin)
+        hips = self.hip_slack
         if self.keep_plan and shows_plan(x):
             many = self.policy(np.repeat(np.atleast_2d(x), self.samples, 0), t, rng)
             best = -1

@@ -276,8 +276,8 @@ export class DuetSimulation implements Simulation {
 
   /**
    * The upright guard (web/mirror/guard.ts) on follower i's output of this step: when the body it
-   * would draw comes within the margin of the recording's range (her hips within the hipMargin, or
-   * the partnerLowHipMargin while she sees his hips low), draw fresh samples of the same input
+   * would draw comes within the margin of the recording's range (her hips within the hipMargin),
+   * draw fresh samples of the same input
    * (runDraws: the encoders once) and keep the most upright (each one step on from the same state:
    * no jump).
    */
@@ -286,8 +286,8 @@ export class DuetSimulation implements Simulation {
     if (!guard) return;
     const offsets = this.duet.followers[i].offsets;
     const policy = this.followerPolicies[i];
-    const { margin, hipMargin, partnerLow, partnerLowHipMargin } = guard.settings;
-    const hipSlack = hipSlackFor(policy.input, margin, hipMargin, partnerLow, partnerLowHipMargin);
+    const { margin, hipMargin } = guard.settings;
+    const hipSlack = hipSlackFor(margin, hipMargin);
     if (uprightMargin(this.followerOutputs[i], 0, guard.ranges, offsets, 0, hipSlack) >= guard.settings.margin) return;
     const k = guard.settings.samples;
     const { output, intention } = await policy.runDraws(k, temperature);
@@ -312,8 +312,8 @@ export class DuetSimulation implements Simulation {
     const policy = this.followerPolicies[i];
     const target = onCount.target(policy.input);
     if (target === null && !(onCount.hips > 0)) return false; // she turns: her own sample, as any step
-    const { margin, hipMargin, partnerLow, partnerLowHipMargin } = guard.settings;
-    const hipSlack = hipSlackFor(policy.input, margin, hipMargin, partnerLow, partnerLowHipMargin);
+    const { margin, hipMargin } = guard.settings;
+    const hipSlack = hipSlackFor(margin, hipMargin);
     const k = onCount.samples;
     const { output, intention } = await policy.runDraws(k, temperature);
     if (intention) this.followerIntentions[i]?.set(intention);
@@ -372,7 +372,7 @@ export class DuetSimulation implements Simulation {
     const policy = this.leaderPolicy;
     const { margin, headMargin, hipMargin, keepPlan, samples: k } = guard.settings;
     const slack = slackFor(policy.input, margin, headMargin);
-    const hipSlack = hipSlackFor(policy.input, margin, hipMargin);
+    const hipSlack = hipSlackFor(margin, hipMargin);
     const nearest = keepPlan === true ? 1 : Number(keepPlan ?? 0);
     const plan = nearest > 0 && showsPlan(policy.input);
     if (plan) {

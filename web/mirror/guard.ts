@@ -11,15 +11,13 @@
 // (0.03 m shipped), except while he leads a turn, and its leaderGuard.hipMargin his hips from a
 // larger one (0.10 m: a crouch caught before it is too deep); its guard.hipMargin judges the
 // follower's hips from a larger one (0.20 m shipped): her hips drop fast when
-// she falls (guard.py, LEADER_HEAD_MARGIN and FOLLOWER_HIP_MARGIN); and while her input shows his
-// hips below guard.partnerLow (a lunge), from guard.partnerLowHipMargin, when the manifest has them
-// (guard.py, PARTNER_LOW; not shipped).
+// she falls (guard.py, LEADER_HEAD_MARGIN and FOLLOWER_HIP_MARGIN).
 // A manifest's leaderGuard.keepPlan keeps his lead hand to a request's hands plan: while his input
 // shows one, every step draws the samples and, among the keepPlan standing ones whose lead hand is
 // nearest the plan's height one step on (nearPlan), takes the one on the count (nearestPlan when
 // keepPlan is 1; guard.py, LEADER_KEEP_PLAN).
 
-import { FOLLOWER_INPUT_LAYOUT, INPUT_SIZE, KEY_STEP, LEADER_INPUT_LAYOUT, LEADER_INPUT_SIZE, N_JOINTS, OUTPUT_LAYOUT, blockSlices } from './features';
+import { KEY_STEP, LEADER_INPUT_LAYOUT, LEADER_INPUT_SIZE, N_JOINTS, OUTPUT_LAYOUT, blockSlices } from './features';
 import { MIN_ANKLE_HEIGHT, rotationsFromVectors } from './rollout';
 import { FEET, HANDS, HEAD, forwardKinematicsReduced } from './skeleton';
 
@@ -44,10 +42,6 @@ export interface GuardSettings {
   /** Metres before the edge of the hips it acts: hers drop fast once she falls, his in a crouch
    *  that no sample brings back up once it is low (guard.py, LEADER_HIP_MARGIN). */
   hipMargin?: number;
-  /** The follower's: while her input shows his hips below this height (m), her hips are judged
-   *  from partnerLowHipMargin instead (she goes down with his lunge). */
-  partnerLow?: number;
-  partnerLowHipMargin?: number;
   /** The leader's: while a request runs, keep his lead hand to its plan: the sample on the count
    *  among the keepPlan standing ones nearest it (nearPlan; 1 or true: the nearest, nearestPlan). */
   keepPlan?: number | boolean;
@@ -60,8 +54,6 @@ export const HANDS_PLAN_SHOWN = blockSlices(LEADER_INPUT_LAYOUT).hands_plan.star
 export const HAND_HEIGHTS: readonly number[] = HANDS.map((h) => blockSlices(LEADER_INPUT_LAYOUT).self_pose.start + 12 * h + 1);
 /** ... and its planned move to the first future key (the hands plan's first key, y). */
 export const HAND_PLAN_FIRST: readonly number[] = HANDS.map((_, k) => HANDS_PLAN_SHOWN + 1 + 3 * k + 1);
-/** The partner's hip height in a follower's input (the pose block's first joint, y, in her root space). */
-export const PARTNER_HIPS = blockSlices(FOLLOWER_INPUT_LAYOUT).partner_pose.start + 1;
 const forward = new Float64Array(3 * N_JOINTS);
 const up = new Float64Array(3 * N_JOINTS);
 const rotations = new Float64Array(9 * N_JOINTS);
@@ -204,17 +196,9 @@ export function slackFor(input: ArrayLike<number>, margin: number, headMargin?: 
   return margin - headMargin;
 }
 
-/**
- * Metres a guard adds to the hips' part for this input (negative: they are judged from a larger
- * margin): margin - partnerLowHipMargin while it is a follower's input showing her partner's hips
- * below partnerLow, else margin - hipMargin; none without either.
- */
-export function hipSlackFor(
-  input: ArrayLike<number>, margin: number, hipMargin?: number, partnerLow?: number, partnerLowHipMargin?: number,
-): number {
-  if (partnerLow !== undefined && partnerLowHipMargin !== undefined && input.length === INPUT_SIZE && input[PARTNER_HIPS] < partnerLow) {
-    return margin - partnerLowHipMargin;
-  }
+/** Metres a guard adds to the hips' part (negative: they are judged from a larger margin):
+ *  margin - hipMargin; none without a hipMargin (guard.py hip_slack_for). */
+export function hipSlackFor(margin: number, hipMargin?: number): number {
   return hipMargin === undefined ? 0 : margin - hipMargin;
 }
 
