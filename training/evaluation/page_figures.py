@@ -28,7 +28,7 @@ from ..data.folders import add_folder
 from ..mirror.skeleton import FPS
 from .evaluate_inputs import EvalError
 from .lead import dancing, dancing_summary, dancing_table, recording
-from .rhythm import BODIES, format_summary, recorded, rhythm, summarize
+from .rhythm import BODIES, bodies_rhythm, format_summary, recorded, summarize
 
 ROLES = ("leader", "follower")
 
@@ -67,17 +67,16 @@ def one_seed(s: dict) -> dict:
 
 
 def seed_rhythm(s: dict) -> dict[str, dict]:
-    """rhythm.rhythm of one seed, as drawn and on the networks' bodies (the probe's `leaderOwn` /
-    `followerOwn`), over the count each step danced on (`beat`), as rhythm.bodies_rhythm reads
-    duet.soak_one's record. {} when the dump holds no count (a probe before it recorded one)."""
+    """One seed's rhythm as drawn and on the networks' bodies (the probe's `leaderOwn` /
+    `followerOwn`) over the count each step danced on: rhythm.bodies_rhythm of the seed as
+    duet.soak_one's record holds a duet. {} when the dump holds no count (a probe before it recorded one)."""
     if "beat" not in s:
         return {}
-    beat = np.asarray(s["beat"], float)
-    out = {}
-    for body, suffix in (("drawn", ""), ("networks", "Own")):
-        lead, follow = (np.asarray(s[who + suffix], float).reshape(-1, 17, 3) for who in ROLES)
-        out[body] = {"seed": s["seed"], **rhythm(lead, follow, beat, float(s["tempo"]))}
-    return out
+    record = {"beat": np.asarray(s["beat"], float)}
+    for who in ROLES:
+        record[f"{who}_shown"] = np.asarray(s[who], float).reshape(-1, 17, 3)
+        record[who] = np.asarray(s[who + "Own"], float).reshape(-1, 17, 3)
+    return bodies_rhythm(record, float(s["tempo"]), s["seed"])
 
 
 def markdown(res: dict) -> str:

@@ -49,6 +49,7 @@ MARGIN = 0.05   # m
 # (0.913 m, between her recorded hips' 1st and 2.5th percentiles, 0.898 and 0.921 m), 1 of 17, her
 # guard choosing in 0.19 % of her steps (2.45 % from 0.15 m: caught earlier, she falls less) and her
 # rhythm as before; from 0.25 m 0 of 18, but her footwork pulse halved (docs/results.md, tried).
+# It does not end her falls: 6 of 12 ten-minute steered rollouts still fell (docs/reliability.md).
 # None: the hips judged from MARGIN like the rest.
 FOLLOWER_HIP_MARGIN: float | None = 0.20   # m
 # With her hips judged from 0.15 m every fall left in the soak came a second or two after his lunge,
@@ -86,7 +87,7 @@ LEADER_HIP_MARGIN: float | None = 0.10    # m; None: the hips are judged from LE
 # (61-62 % at the same moments unasked; lead, 100 seeds; docs/results.md, "His lead hand kept to
 # the plan"). It only chooses among his own network's steps, and only while someone asks.
 # Taking the nearest alone, his feet lost the count while a figure ran: his steps on the beat +0.06
-# as drawn, steered (+0.11 on his network's body; +0.51 before the figure block). Of the
+# as drawn, steered (+0.11 on his network's body; the recording +0.27). Of the
 # LEADER_KEEP_PLAN standing samples nearest the plan (near_plan), his chooser on the count takes the
 # one on the beat: with 2, +0.20 drawn (+0.25), his hand above 1.6 m after 40 % of 160 requests
 # against 46 % with the nearest, and she turns as often the asked way (63 % against 65 %); with 3,
