@@ -275,7 +275,7 @@ for (const view of VIEWS) {
 
     for (const ghosts of view.ghosts) {
       const panels = ghosts ? [true] : [false, true];
-      test(`${ghosts} possible reactions: heads and feet in the free part every frame, ${ghosts ? 'open, led' : 'folded and open, led, zoomed, dragged'}`, { timeout: HANG_MS }, async () => {
+      test(`${ghosts} possible reactions: heads and feet in the free part every frame, ${ghosts ? 'open, led' : 'folded and open, led; open, zoomed and dragged'}`, { timeout: HANG_MS }, async () => {
         const { page } = quick;
         await page.goto(`${server.url}?seed=${ghosts + 1}&ghosts=${ghosts}`);
         await waitReady(page);
@@ -294,7 +294,10 @@ for (const view of VIEWS) {
           // The view's picture with the settings open is the full-resolution one (the title-row test).
           if (!(view.picture && open && !ghosts)) pictures.push(saveScreen(name, await page.screenshot()));
           console.log(`${where}: ${led.frames} frames, the pair ${led.smallest.toFixed(0)}-${led.largest.toFixed(0)} px tall on screen (${seconds()} s)`);
-          if (ghosts) continue; // the camera's gestures: with the pair alone (above)
+          // The camera's gestures: with the pair alone (above), and once a view, with the settings
+          // open (the smaller free part): folded, the same gestures move the same camera, and each
+          // pass took 30-40 s of the file.
+          if (ghosts || !open) continue;
 
           await resetFraming(page);
           await gestures(page, view.phone, rand);
