@@ -21,7 +21,6 @@ class ModelConfig:
     role: str = "follower"            # "follower" or "leader" (the leader's input ends with control)
     intention: bool = True            # False: plain codebook matching (the CCM baseline)
     hidden: int = 512                 # codebook-matching MLP width
-    decoder_hidden: int | None = None  # the decoder's width (None: hidden); it runs once per sample drawn
     intention_hidden: int = 256
     channels: int = 8                 # C categorical channels ...
     classes: int = 32                 # ... of D classes each
@@ -124,8 +123,7 @@ class CodebookMatching(nn.Module):
         h, extra = cfg.hidden, (cfg.intention_size if cfg.intention else 0)
         self.input_encoder = mlp([cfg.input_size + extra, h, h, cfg.latent], cfg.dropout)
         self.output_encoder = mlp([cfg.output_size + cfg.input_size + extra, h, h, cfg.latent], cfg.dropout)
-        hd = cfg.decoder_hidden or h
-        self.decoder = mlp([cfg.latent + len(cfg.state_columns), hd, hd, cfg.output_size], cfg.dropout)
+        self.decoder = mlp([cfg.latent + len(cfg.state_columns), h, h, cfg.output_size], cfg.dropout)
         self.register_buffer("state_columns", torch.tensor(cfg.state_columns, dtype=torch.long), persistent=False)
 
     def decode(self, code, x, state_keep: torch.Tensor | None = None):

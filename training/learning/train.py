@@ -715,7 +715,6 @@ OVERRIDES = {
     "intention_dropout": lambda c, v: replace(c, intention_dropout=v),
     "intention_weight_decay": lambda c, v: replace(c, intention_weight_decay=v),
     "hidden": lambda c, v: replace(c, model=replace(c.model, hidden=v)),
-    "decoder_hidden": lambda c, v: replace(c, model=replace(c.model, decoder_hidden=v)),
     "intention_hidden": lambda c, v: replace(c, model=replace(c.model, intention_hidden=v)),
     "intention_best": lambda c, v: replace(c, intention_best=True),
 }
@@ -746,7 +745,6 @@ def main(argv=None) -> int:
     ap.add_argument("--intention-dropout", type=float, help="override the intention predictor's dropout")
     ap.add_argument("--intention-weight-decay", type=float, help="override the predictor's weight decay")
     ap.add_argument("--hidden", type=int, help="override the codebook-matching width (encoders and decoder)")
-    ap.add_argument("--decoder-hidden", type=int, help="override the decoder's width")
     ap.add_argument("--intention-hidden", type=int, help="override the predictor's width")
     ap.add_argument("--intention-best", action="store_true",
                     help="keep the predictor's epoch with the lowest validation MSE (early stopping)")
