@@ -12,7 +12,7 @@ import { cpSync, mkdirSync, readFileSync, rmSync, symlinkSync, renameSync, write
 import { join } from 'node:path';
 import { build as viteBuild } from 'vite';
 import { serve } from '../../scripts/serve.mjs';
-import { BUILT, ROOT, sleep } from './harness.mjs';
+import { BUILT, ROOT, WAIT_MS, sleep } from './harness.mjs';
 
 /** Build the site into `outDir`, with public/ replaced by `publicDir` when given. */
 async function buildInto(outDir, publicDir) {
@@ -59,8 +59,9 @@ export async function twoBuilds(dir) {
   return { url: server.url, deploy, up: () => up, stop: () => server.stop() };
 }
 
-/** Wait until this origin's service worker has stored the wasm and the first two models of `version`. */
-export async function waitCached(page, version, timeoutMs = 30_000) {
+/** Wait until this origin's service worker has stored the wasm and the first two models of `version`:
+ * up to DUET_WAIT_MS, as every wait (on a busy 2-core machine 30 s were once not enough). */
+export async function waitCached(page, version, timeoutMs = WAIT_MS) {
   const deadline = Date.now() + timeoutMs;
   for (;;) {
     const held = await page.evaluate(async (name) => {
