@@ -99,7 +99,7 @@ def test_codebook_error_comes_from_the_exported_files(result, exported, data3):
     from training.learning.runs import load_run
     _, r = result
     take = load_eval_takes(str(data3), [SMALL_TAKES["test"]], FRAMES, None)[0]
-    x = follower_input(take.lead, take.follow, take.frames).astype(np.float32)
+    x = follower_input(take.lead, take.follow, take.frames, take.figure(take.frames)).astype(np.float32)   # as evaluate reads it
     y = output_features(take.follow, take.frames).astype(np.float32)
     run = load_run(exported["runs"] / "follower", str(exported["prepared"]))
     with torch.no_grad():
