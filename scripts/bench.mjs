@@ -20,6 +20,7 @@
 //   npm run bench                 # threads 1 and 2
 //   node scripts/bench.mjs --seconds 20 --json
 //   npm run bench -- --leading    # the same, T pressed every 2 s: every step leads her turn
+//   npm run bench -- --threads 1 --dist /tmp/dist-old   # a site built before (A/B runs of two builds)
 //   npm run bench -- --count-cost # each thread count also without the manifest's onCount, alternating:
 //                                 # what choosing on the count costs a step, as a ratio in one run
 //   npm run bench -- --viewport 320x240   # a smaller window: less software drawing beside the networks
@@ -163,11 +164,18 @@ async function pageRun(url, threads, { leading, viewport }, withoutCount = false
   }
 }
 
+/** The built site to serve: --dist DIR (built before, for A/B runs of two builds), else a fresh build in dist/. */
+async function site() {
+  const dist = option('dist', null);
+  if (!dist) await build('dist');
+  else if (!existsSync(`${dist}/index.html`)) throw new Error(`--dist ${dist}: no index.html there (build one with: npx vite build --outDir ${dist})`);
+  return dist ?? 'dist';
+}
+
 async function pageBench() {
   const options = pageOptions();
   const { threadCounts, leading, countCost, viewport } = options;
-  await build('dist');
-  const server = await startServer({ mode: 'preview', outDir: 'dist' });
+  const server = await startServer({ mode: 'preview', outDir: await site() });
   const results = [];
   try {
     for (const threads of threadCounts) {
@@ -460,10 +468,7 @@ async function framesPerSecond(page, url, ms = 4000) {
 async function phoneBench() {
   const bootOnly = args.includes('--boot-only');
   const query = option('query', '');
-  const dist = option('dist', null);
-  if (!dist) await build('dist');
-  else if (!existsSync(`${dist}/index.html`)) throw new Error(`--dist ${dist}: no index.html there (build one with: npx vite build --outDir ${dist})`);
-  const server = await serve({ dir: dist ?? 'dist' });
+  const server = await serve({ dir: await site() });
   const browser = await launch(PHONE);
   const result = {};
   try {

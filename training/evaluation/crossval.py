@@ -42,10 +42,11 @@ from ..data.folders import add_folder
 from ..data.prepare import TEMPOS
 
 # Method name -> (run name = ONNX stem, recipe in train.MODELS, trained on the tempo copies): the
-# shipped pair's recipes, intention or not, all else alike.
+# shipped pair's recipes, intention or not, all else alike, at the width of their teachers: the
+# shipped networks are distilled from teachers that saw every take, a fold's test takes too.
 METHODS = {
-    "ours": ("follower", "follower", True),
-    "ccm": ("follower_ccm", "follower_ccm", True),
+    "ours": ("follower", "follower_wide", True),
+    "ccm": ("follower_ccm", "follower_ccm_wide", True),
 }
 # implausible / worst second: the free-running follower's frames with its body low, folded or split,
 # against the fold's own training range (evaluate's plausibility; n/a for evaluations without it).

@@ -32,6 +32,7 @@ from ..data.folders import add_folder
 from ..evaluation.figures import HAND_RAISED
 from ..evaluation.loss_plot import plot_history
 from .models import CodebookMatching, Discriminator, IntentionPredictor, ModelConfig, StepModel, code_logits, sample_codes
+from .distill import teacher_from_onnx
 from .own_rollouts import load_couples, own_rollout_samples
 from ..mirror.on_count import planned_turn
 from ..data.prepared import (TrainError, load_mirror_flags, load_offsets, load_split, load_stats, normalize,
@@ -134,6 +135,13 @@ class TrainConfig:
     own_rollouts_horizon: int = 8
     own_rollouts_stride: int = 4
     own_rollouts_temperatures: tuple[float, ...] = (0.5, 1.0)
+    # Distillation (distill.py): an ONNX step model of this role and code size, a wider network
+    # as export wrote it. Each batch then also asks the student's predictor for the teacher's
+    # intention, its input encoder for the teacher's code distribution (KL per channel) and its
+    # decoder for what the teacher's decoder makes of a code drawn from it, each at weight
+    # lambda_distill beside the recipe's own terms on the recorded frames.
+    teacher: str | None = None
+    lambda_distill: float = 1.0
     seed: int = 1
 
 
@@ -188,7 +196,7 @@ def steady(cfg: TrainConfig) -> TrainConfig:
 # tables on this data") compares them with: bash scripts/evaluate_all.sh trains those and measures
 # all. What was tried and not shipped is a row of docs/results.md's tried table, whose commit
 # holds its recipe.
-MODELS = {
+WIDE = {
     # Her intention predictor fits training frames better than new ones (MSE 0.14 vs 0.23): noise
     # of the size of that gap keeps the encoders from trusting its training-set accuracy, which
     # buys FID and Diversity on the test takes (docs/results.md, w/o intention noise).
@@ -225,6 +233,30 @@ MODELS = {
     "leader": replace(steady(LEADER), hands_plan_dropout=0.5, state_dropout=0.5,
                       own_rollouts_from=10, lambda_foot_contact=100.0, recorded_contacts=True,
                       contact_spare_turning=120.0, tempo_copies=True, seed=2),
+}
+# The teachers: the wide networks above as trained by their recipe (runs "follower_wide" and so on)
+# and exported, kept beside the code because distilling needs them and a retrain of a wide one
+# is not the same network twice (docs/training.md).
+TEACHERS = "models/teacher"
+
+
+def distilled(name: str) -> TrainConfig:
+    """The recipe WIDE[name] at width 256 (its intention predictor 128), distilled from the wide
+    network's shipped file. Trained from the recording alone at that width the leader stopped
+    turning and a request stopped making her turn; distilled they dance as the wide pair at about
+    half its step (docs/measurements.md, "Lighter networks")."""
+    cfg = WIDE[name]
+    return replace(cfg, model=replace(cfg.model, hidden=256, intention_hidden=128),
+                   teacher=f"{TEACHERS}/{name}.onnx")
+
+
+MODELS = {
+    # The shipped three, distilled.
+    **{name: distilled(name) for name in WIDE},
+    # Their teachers' recipes: what crossval trains in each fold (a fold's teacher would have to
+    # be trained first), and how a teacher is remade (export --runs R --models DIR, then copy
+    # DIR/NAME_wide.onnx to models/teacher/NAME.onnx).
+    **{f"{name}_wide": cfg for name, cfg in WIDE.items()},
     # The paper's ablations, on the recipe without the partner terms (docs/results.md, "The paper's
     # tables on this data"): a smaller follower (hidden 256), CCM with three times the code channels
     # (CCM (L)), no adversarial term (w/o GAN), no noise on the intention, and the intention
@@ -423,7 +455,8 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
     history = {"intention_train": [], "intention_val": [], "reconstruction": [], "codebook": [], "own_rollout_samples": [],
                "generator": [], "discriminator": [], "val_mse": [], "val_codebook": [],
                "val_mpjpe_cm": [], **{k: [] for k, w in partner_weights.items() if w},
-               **({"proximity": []} if cfg.lambda_proximity else {})}
+               **({"proximity": []} if cfg.lambda_proximity else {}),
+               **({"distill_codes": [], "distill_decoder": []} if cfg.teacher else {})}
     stage, epoch, seconds = "intention", 0, 0.0
     if resume and ckpt_path.exists():
         ck = load_checkpoint(ckpt_path)
@@ -449,6 +482,15 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
     elif ckpt_path.exists() and not resume and rank == 0 and not quiet:
         print(f"{name}: {ckpt_path} exists; training from scratch over it (use --resume to continue)")
     broadcast_parameters([predictor, matching, disc], world)
+    teacher = None
+    if cfg.teacher is not None:
+        teacher = teacher_from_onnx(cfg.teacher, mcfg).to(device)
+        for p in teacher.parameters():
+            p.requires_grad_(False)
+        if (teacher.input_mean.to(device) != stats["input_mean"].to(device)).any():
+            raise TrainError(f"{cfg.teacher}: normalized with other prepared data than {data}")
+        if rank == 0 and not quiet:
+            print(f"{name}: distilled from {cfg.teacher} (width {teacher.cfg.hidden})")
 
     gen = torch.Generator().manual_seed(cfg.seed + 1000 * rank)
     n = len(xr)
@@ -521,7 +563,13 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
             for i, idx in enumerate(bar):
                 for g in opt_p.param_groups:
                     g["lr"] = cosine(epoch * steps_per_epoch + i, total, cfg.lr)
-                loss = F.mse_loss(predictor(inputs(idx)[0]), j[idx].to(device))
+                x = inputs(idx)[0]
+                if teacher is None:
+                    target = j[idx].to(device)
+                else:
+                    with torch.no_grad():
+                        target = teacher.predictor(x)
+                loss = F.mse_loss(predictor(x), target)
                 opt_p.zero_grad(); loss.backward(); average_gradients([predictor], world); opt_p.step()
                 losses.append(loss.item())
                 bar.set_postfix(mse=f"{np.mean(losses[-50:]):.4f}")
@@ -583,6 +631,7 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
         bar = tqdm(batches(10_000 + epoch), total=steps_per_epoch, disable=quiet or rank > 0,
                    desc=f"{name} matching {epoch + 1}/{cfg.epochs}", leave=False)
         sums = {"reconstruction": [], "codebook": [], "generator": [], "discriminator": [],
+                **({"distill_codes": [], "distill_decoder": []} if teacher is not None else {}),
                 **{k: [] for k, w in partner_weights.items() if w}, **({"proximity": []} if cfg.lambda_proximity else {})}
         p_pred = epoch / cfg.epochs   # scheduled sampling: share of predicted intentions
         for i, idx in enumerate(bar):
@@ -620,6 +669,10 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
                 w = w / w.mean()
                 l_r, l_c = (w * (recon - yb) ** 2).mean(), (w * (code - code_hat) ** 2).mean()
             loss = cfg.lambda_reconstruction * l_r + cfg.lambda_codebook * l_c + extra
+            if teacher is not None:
+                l_kl, l_dec = distill_terms(teacher, matching, x, intention)
+                loss = loss + cfg.lambda_distill * (l_kl + l_dec)
+                sums["distill_codes"].append(l_kl.item()); sums["distill_decoder"].append(l_dec.item())
             if any(partner_weights.values()):
                 keep = slice(None) if altered is None else ~altered.to(device)   # recorded relations only
                 off = offsets[mirrored[idx]]
@@ -666,7 +719,8 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
             print(f"{name} matching {epoch}/{cfg.epochs}  rec {history['reconstruction'][-1]:.4f}  "
                   f"cb {history['codebook'][-1]:.4f}  G {history['generator'][-1]:.3f}  "
                   f"val mse {val_mse:.4f}  val cb {val_cb:.4f}  val mpjpe {val_mpjpe:.2f} cm  "
-                  + "".join(f"{k} {history[k][-1]:.2e}  " for k, w in partner_weights.items() if w) +
+                  + "".join(f"{k} {history[k][-1]:.2e}  " for k, w in partner_weights.items() if w)
+                  + "".join(f"{k} {history[k][-1]:.3f}  " for k in ("distill_codes", "distill_decoder") if k in sums) +
                   f"({time.time() - t0:.1f} s)")
         save("matching", epoch)
     stage = "done"
@@ -677,6 +731,25 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
             if cfg.intention_best and history["intention_val"] else {}
         (run / "history.json").write_text(json.dumps({"seconds": seconds, **kept, **history}, indent=1))
     return {"name": name, "seconds": seconds, "val_mse": history["val_mse"][-1] if history["val_mse"] else None}
+
+
+def distill_terms(teacher: StepModel, matching: CodebookMatching, x: torch.Tensor,
+                  intention: torch.Tensor | None) -> tuple[torch.Tensor, torch.Tensor]:
+    """The student's distance from the teacher on a batch of normalized inputs: the KL divergence
+    of its input encoder's code distribution from the teacher's (per channel, nats), and the MSE
+    between its decoder's and the teacher's on one code drawn from the teacher's distribution
+    (Gumbel-max at temperature 1: every code the page's varieties draw, in proportion). Every
+    sample weighs alike: weighted by the turn weights, the leader turned less (the tried table)."""
+    c = teacher.cfg.channels
+    with torch.no_grad():
+        t_logits, _, _ = code_logits(teacher.predictor, teacher.matching, x)
+        t_code = sample_codes(t_logits, c, 1.0)
+        t_out = teacher.matching.decode(t_code, x)
+    s_logits = matching.estimate_logits(x, intention)
+    t_log = F.log_softmax(t_logits.reshape(len(x), c, -1), -1)
+    s_log = F.log_softmax(s_logits.reshape(len(x), c, -1), -1)
+    kl = (t_log.exp() * (t_log - s_log)).sum(-1).mean()
+    return kl, F.mse_loss(matching.decode(t_code, x), t_out)
 
 
 @torch.no_grad()
@@ -701,7 +774,7 @@ def validate(predictor, matching, mcfg, xv, yv, device, stats, batch=4096):
 
 def smoke(cfg: TrainConfig) -> TrainConfig:
     """A configuration that exercises every code path in seconds (CI)."""
-    return replace(cfg, intention_epochs=1, epochs=2,
+    return replace(cfg, intention_epochs=1, epochs=2, teacher=None,
                    model=replace(cfg.model, hidden=32, intention_hidden=32, channels=2, classes=4))
 
 
@@ -717,6 +790,8 @@ OVERRIDES = {
     "hidden": lambda c, v: replace(c, model=replace(c.model, hidden=v)),
     "intention_hidden": lambda c, v: replace(c, model=replace(c.model, intention_hidden=v)),
     "intention_best": lambda c, v: replace(c, intention_best=True),
+    "teacher": lambda c, v: replace(c, teacher=v),
+    "lambda_distill": lambda c, v: replace(c, lambda_distill=v),
 }
 
 
@@ -748,6 +823,9 @@ def main(argv=None) -> int:
     ap.add_argument("--intention-hidden", type=int, help="override the predictor's width")
     ap.add_argument("--intention-best", action="store_true",
                     help="keep the predictor's epoch with the lowest validation MSE (early stopping)")
+    ap.add_argument("--teacher", metavar="FILE", help="distill from FILE, a wider network's step model as "
+                    "export wrote it (training/learning/distill.py)")
+    ap.add_argument("--lambda-distill", type=float, help="override the weight of the teacher's terms")
     ap.add_argument("--smoke", action="store_true", help="tiny sizes and 2 epochs (CI)")
     ap.add_argument("--resume", action="store_true", help="continue from RUNS/NAME/checkpoint.pt")
     ap.add_argument("--init-from", metavar="DIR", help="fine-tune: start from the weights of the run in DIR "
