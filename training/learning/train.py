@@ -244,7 +244,7 @@ def distilled(name: str) -> TrainConfig:
     """The recipe WIDE[name] at width 256 (its intention predictor 128), distilled from the wide
     network's shipped file. Trained from the recording alone at that width the leader stopped
     turning and a request stopped making her turn; distilled they dance as the wide pair at about
-    half its step (docs/measurements.md, "Lighter networks")."""
+    half its step (docs/measurements.md, "The step")."""
     cfg = WIDE[name]
     return replace(cfg, model=replace(cfg.model, hidden=256, intention_hidden=128),
                    teacher=f"{TEACHERS}/{name}.onnx")
