@@ -1,5 +1,5 @@
 """A shipped step model read back from its int8 ONNX file as a float network: the teacher a
-narrower network is distilled from (train --teacher DIR).
+narrower network is distilled from (train --teacher FILE).
 
 Trained from the recording by the shipped recipe, a narrower leader stopped turning and a request
 stopped making her turn (docs/measurements.md, the tried table): the recorded frames alone do not
@@ -39,7 +39,7 @@ def teacher_from_onnx(path: str | Path, student: ModelConfig) -> StepModel:
     from onnx import numpy_helper
     path = Path(path)
     if not path.exists():
-        raise TrainError(f"{path}: no teacher model there (a models folder as export writes it)")
+        raise TrainError(f"{path}: no teacher model there (a step model file as export writes it)")
     graph = onnx.load(str(path)).graph
     inits = {i.name: numpy_helper.to_array(i).copy() for i in graph.initializer}
     if "matching.decoder.0.bias" not in inits:

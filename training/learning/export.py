@@ -46,11 +46,11 @@ OPSET = 18
 # 11.5 at 0.5 (the recording: 25.9). Lower varieties then let a follower sink beside our steered
 # leader, so the page kept 1; the followers trained on their own rollouts (train.py) sink in none
 # of 20 steered seeds down to 0.35, and turn 25.9 times a minute at 0.5 beside the recorded leader
-# (5.9 at 1): the page runs them at 0.5 (docs/results.md, "Salsa turns"). The leader runs at 0.7:
+# (5.9 at 1): the page runs them at 0.5 (docs/results.md, "Salsa turns"). The wide leader ran at 0.7:
 # with his hips guarded, nobody steering, his body motion, travel and own turns reach 0.77x, 0.87x
 # and 0.72x the recorded leader's (0.55x, 0.83x, 0.78x at 0.5), steered 0.80x body motion with no
 # bad second in 100 seeds and no failure in the full soak (docs/results.md, "His variety"). The
-# distilled leader (train.distilled) runs at 0.6: its code distribution is a little flatter than its
+# distilled leader the page ships (train.distilled) runs at 0.6: its code distribution is a little flatter than its
 # teacher's (1.68 against 1.60 nats a channel on the validation take), and at 0.7 he turned 4.0
 # times a minute nobody steering against his teacher's 7.0 at 0.7; at 0.6, 7.6 (docs/measurements.md).
 DEFAULT_TEMPERATURE = 0.5
