@@ -371,3 +371,34 @@ def test_his_own_turn_turns_his_planned_path_a_full_turn_without_a_side_step():
     assert np.allclose(t.heading[keys] - heading[keys], -2 * np.pi * share)
     assert np.array_equal(t.root, root)
     assert ro.hands_input(duet) is None                    # his own turn raises no lead hand
+
+
+def test_a_branch_leaves_the_choosers_on_the_count_as_it_found_them(exported):
+    """The policies are not copied with a duet: a branch (the asked or the unasked window) puts back
+    what the choosers on the count saw, so the unasked window dances as if no asked one came first."""
+    import argparse
+
+    from training.evaluation import options as O
+    from training.evaluation.evaluate_inputs import find_models, load_onnx
+
+    manifest, onnx, leader_path = find_models(exported["models"])
+    args = argparse.Namespace(temperature=None, follower_temperature=None, guard=4, guard_margin=None,
+                              leader_guard=4, on_count=4)
+    assert O.resolve(args, manifest) is None
+    leader = O.leader_policy(load_onnx(leader_path), manifest, args)
+    follower = O.follower_policy(load_onnx(onnx["ours"]), manifest, args, args.temperature)
+    assert leader.on_count is not None and follower.on_count is not None
+    duet = ro.start_duet(manifest, figures=False, seed=3)
+    rng = np.random.default_rng(3)
+    for _ in range(FPS):
+        ro.step(duet, leader, follower, np.zeros(2), args.temperature, rng)
+    seen = (leader.on_count.mean, follower.on_count.mean)
+
+    def unasked():
+        return lead.branch(duet, leader, follower, args.temperature, np.random.default_rng(7), None, FPS)[0]
+
+    alone = unasked()
+    assert (leader.on_count.mean, follower.on_count.mean) == seen
+    lead.branch(duet, leader, follower, args.temperature, np.random.default_rng(7), 1, FPS)
+    assert (leader.on_count.mean, follower.on_count.mean) == seen
+    assert np.array_equal(unasked(), alone)

@@ -56,6 +56,10 @@ def branch(duet, leader, follower, temperature: float, rng: np.random.Generator,
     root space; None without), the highest his hands went (m above the floor), how his higher hand
     wound (winding) and how far his own facing turned (degrees, counterclockwise seen from above)."""
     d = copy.deepcopy(duet)
+    # The policies are not copied with the duet: a chooser on the count keeps a running mean of its
+    # dancer's footwork (on_count.OnCount), and a branch that moved it on handed its 4 s to the
+    # next branch and to the duet itself, so the unasked branch danced on after the asked one.
+    kept = count_state(leader, follower)
     if direction is not None:
         ask_turn(d, direction)
     out = np.zeros((frames + 1, 17, 3))
@@ -72,8 +76,21 @@ def branch(duet, leader, follower, temperature: float, rng: np.random.Generator,
         hands[f] = feat.to_root_space_points(d.leader.track.positions[NOW][HANDS], d.leader.root, d.leader.heading)
         if with_body:
             body[f] = C.leader_body(d.follower.track, d.leader.track, now)[0]
+    put_count_state(kept)
     facing = Fg.facing(his)
     return out, body, hand, winding(hands), float(np.degrees(facing[-1] - facing[0]))
+
+
+def count_state(*policies) -> list[tuple[object, dict]]:
+    """What each policy's chooser on the count has seen (on_count.OnCount's fields), to put back
+    with put_count_state."""
+    choosers = [getattr(p, "on_count", None) for p in policies]
+    return [(c, dict(vars(c))) for c in choosers if c is not None]
+
+
+def put_count_state(kept: list[tuple[object, dict]]) -> None:
+    for chooser, fields in kept:
+        vars(chooser).update(fields)
 
 
 def winding(hands: np.ndarray) -> float:
