@@ -648,7 +648,17 @@ def figures_fixture(manifest: dict) -> dict:
     led = ro.Led("her_turn", -1, 20, 56)
     share = [{"frame": f, "share": ro.figure_share(led, f), "raised": ro.raised(led, f)}
              for f in (0, 19, 20, 21, 26, 32, 38, 50, 56, 57, 64, 71, 72, 100)]
+    # leading and leader_variety: a figure asked for from frame 40 to 76 and one of his own from 100
+    # to 136, the leader at 0.6, leading at 0.9
+    lead_in = ro.start_duet(manifest)
+    lead_in.figures.led = [ro.Led("her_turn", 1, 40, 76, True), ro.Led("her_turn", -1, 100, 136, False)]
+    lead_in.leading_temperature = 0.9
+    leading = []
+    for f in (0, 9, 10, 40, 76, 77, 90, 110):
+        lead_in.frame = f
+        leading.append({"frame": f, "leading": ro.leading(lead_in), "variety": ro.leader_variety(lead_in, 0.6)})
     return {"tempo": 183.0, "beat": 0.61, "draws": draws.numbers, "drawn": draws.used, "asks": SCHEDULE_ASKS,
+            "LEAD_IN": ro.LEAD_IN, "leading": {"led": led_state(lead_in.figures), "frames": leading},
             "ownOff": list(SCHEDULE_OWN_OFF), "steps": steps,
             "FIGURE_BEATS": ro.FIGURE_BEATS, "OWN_GAP_BEATS": list(ro.OWN_GAP_BEATS), "HIS_SHARE": ro.HIS_SHARE,
             "RAISE": list(ro.RAISE),

@@ -35,9 +35,12 @@ def test_the_figure_block_reads_each_figure_over_the_past_and_next_second():
     assert feat.LEADER_INPUT_SIZE == feat.INPUT_SIZE + feat.HANDS_PLAN_SIZE
 
 
-def manifest_duet(**kw):
+def manifest_duet(leading_temperature: float | None = None, **kw):
     offsets = np.zeros((17, 3)).tolist()
-    return ro.start_duet({"skeleton": {"offsets": {"leader": offsets, "follower": offsets}}, "startPose": START_POSE}, **kw)
+    manifest = {"skeleton": {"offsets": {"leader": offsets, "follower": offsets}}, "startPose": START_POSE}
+    if leading_temperature is not None:
+        manifest["leadingTemperature"] = leading_temperature
+    return ro.start_duet(manifest, **kw)
 
 
 def run_steps(duet, n):
@@ -111,6 +114,25 @@ def test_hands_moves_are_where_his_hands_go_less_where_they_are():
     block = feat.hands_plan_block(moves[None], 1)[0]
     assert block[0] == 1 and np.allclose(block[1:], moves.ravel())
     assert np.all(feat.hands_plan_block(None, 2) == 0)
+
+
+def test_he_draws_at_the_leading_variety_from_lead_in_before_an_asked_figure_to_its_end():
+    duet = manifest_duet(figures=False)
+    assert ro.leader_variety(duet, 0.6) == 0.6             # no figure: his own variety
+    ro.ask_turn(duet, 1)
+    led = duet.figures.led[0]
+    seen = []
+    for f in (led.start - ro.LEAD_IN - 1, led.start - ro.LEAD_IN, led.start, led.end, led.end + 1):
+        duet.frame = f
+        duet.leading_temperature = None
+        alone = ro.leader_variety(duet, 0.6)
+        duet.leading_temperature = 0.9
+        seen.append((ro.leading(duet), alone, ro.leader_variety(duet, 0.6)))
+    assert seen == [(False, 0.6, 0.6), (True, 0.6, 0.9), (True, 0.6, 0.9), (True, 0.6, 0.9), (False, 0.6, 0.6)]
+    led.asked = False                                      # his own figure: his own variety
+    duet.frame = led.start
+    assert not ro.leading(duet) and ro.leader_variety(duet, 0.6) == 0.6
+    assert manifest_duet(0.8).leading_temperature == 0.8 and manifest_duet().leading_temperature is None
 
 
 def test_a_figure_raises_his_lead_hand_and_lowers_it():

@@ -26,6 +26,7 @@ describe('the help, against the manifest and the page', () => {
     expect(facts.fps).toBe(manifest.fps);
     expect(facts.variety).toBe(manifest.defaultTemperature);
     expect(facts.leaderVariety).toBe(manifest.leaderTemperature ?? null);
+    expect(facts.leadingVariety).toBe(manifest.leadingTemperature ?? null);
     expect(facts.uprightSamples).toBe(manifest.guard && manifest.plausibility ? manifest.guard.samples : null);
   });
 
@@ -39,6 +40,9 @@ describe('the help, against the manifest and the page', () => {
     expect(other).toContain('it starts at 0.35');
     expect(other).toContain('the leader model keeps 0.85');
     expect(researchText(helpFacts({ ...manifest, leaderTemperature: undefined }, 0.35))).toContain('the leader model dances with the same');
+    if (manifest.leadingTemperature !== undefined) expect(research).toContain(`${manifest.leadingTemperature} while he leads a turn you asked for`);
+    expect(researchText(helpFacts({ ...manifest, leadingTemperature: 0.95 }, 0.35))).toContain('0.95 while he leads a turn you asked for');
+    expect(researchText(helpFacts({ ...manifest, leadingTemperature: undefined }, 0.35))).not.toContain('while he leads');
   });
 
   it('every number it states is one the page has', () => {
@@ -46,6 +50,7 @@ describe('the help, against the manifest and the page', () => {
       manifest.fps,
       variety,
       ...(facts.leaderVariety === null ? [] : [facts.leaderVariety]),
+      ...(facts.leadingVariety === null ? [] : [facts.leadingVariety]),
       ...(facts.uprightSamples === null ? [] : [facts.uprightSamples]),
       CLIP_SECONDS,
       ...LIMITS.tempo,

@@ -38,7 +38,7 @@ function standingLeader(): R.Dancer {
 function duetAt(frame: number, led: R.Led[], leader = standingLeader()): R.Duet {
   const figures = new R.Figures(false, () => Number.NaN);
   figures.led = led;
-  return { leader, followers: [leader], startPose: data.startPose, steering: new R.Steering(), frame, figures, tempo: 170, beat: 0 };
+  return { leader, followers: [leader], startPose: data.startPose, steering: new R.Steering(), frame, figures, tempo: 170, beat: 0, leadingTemperature: null };
 }
 
 const led = (name: FigureName, way: number, start: number, end: number, hands: number[] | null = null): R.Led =>
@@ -123,6 +123,7 @@ describe('the duet loop, step by step', () => {
     figures: new R.Figures(true, stepDraws.rng),
     tempo: data.tempo,
     beat: data.beat,
+    leadingTemperature: null,
   };
   const nan = (values: (number | null)[]) => Float32Array.from(values, (v) => (v === null ? NaN : v));
 
@@ -184,6 +185,19 @@ describe('the figures', () => {
       expect(R.figureShare(led(name, way, start, end), c.frame), `share at ${c.frame}`).toBeCloseTo(c.share, 12);
       expect(R.raised(led(name, way, start, end), c.frame), `raised at ${c.frame}`).toBeCloseTo(c.raised, 12);
     }
+  });
+
+  it('leading from LEAD_IN before an asked figure to its end (not his own), and the leader\'s variety then', () => {
+    expect(R.LEAD_IN).toBe(f.LEAD_IN);
+    const figures = (f.leading.led as [FigureName, number, number, number, boolean][]).map(([name, way, start, end, asked]) => ({ ...led(name, way, start, end), asked }));
+    for (const c of f.leading.frames) {
+      const duet = duetAt(c.frame, figures);
+      expect(R.leading(duet), `leading at ${c.frame}`).toBe(c.leading);
+      expect(R.leaderVariety(duet, 0.6), 'no leadingTemperature: his own').toBe(0.6);
+      duet.leadingTemperature = 0.9;
+      expect(R.leaderVariety(duet, 0.6), `variety at ${c.frame}`).toBe(c.variety);
+    }
+    expect(f.leading.frames.map((c: Json) => c.leading)).toEqual([false, false, true, true, true, false, false, false]);
   });
 
   it(`askTurn and planFigures: the same schedule as Python's over ${f.steps.length} steps`, () => {

@@ -665,3 +665,20 @@ describe('foot locking (drawn pose only)', () => {
     expect(shown[1]).toBeCloseTo(model[1], 6);
   });
 });
+
+describe('the leading variety', () => {
+  it('the leader draws at the leading variety while he leads a figure, at his own before and after', async () => {
+    const { sim, lead } = simulation([{ role: 'follower' }], { role: 'leader' }, { leaderTemperature: 0.5, leadingTemperature: 0.9 }, false);
+    for (let i = 0; i < 10; i++) await sim.step(steer, 0.3);
+    sim.askTurn(1);
+    while (sim.turnAsked !== 0) await sim.step(steer, 0.3);
+    for (let i = 0; i < 5; i++) await sim.step(steer, 0.3);
+    // 10 steps before, then every step from the request (the figure starts within LEAD_IN) to its
+    // end, then his own (from the step that lets the request go: the figure has ended).
+    const leading = lead.temperatures.slice(10, -6);
+    expect(lead.temperatures.slice(0, 10)).toEqual(Array(10).fill(0.5));
+    expect(leading.length).toBeGreaterThan(30);
+    expect(leading).toEqual(Array(leading.length).fill(0.9));
+    expect(lead.temperatures.slice(-6)).toEqual(Array(6).fill(0.5));
+  });
+});

@@ -24,6 +24,9 @@ def add_options(ap: argparse.ArgumentParser) -> None:
                     help="the music's tempo the duet dances to, beats a minute (default: the manifest's music.tempo)")
     ap.add_argument("--temperature", type=float, default=None,
                     help="the leader's variety (default: the manifest's leaderTemperature, else defaultTemperature)")
+    ap.add_argument("--leading-temperature", type=float, default=None,
+                    help="the leader's variety while he leads a figure (rollout.leader_variety; default: the manifest's "
+                         "leadingTemperature, else his own throughout)")
     ap.add_argument("--follower-temperature", type=float, default=None,
                     help="the follower's variety (default: the manifest's defaultTemperature, the page's slider)")
     ap.add_argument("--guard", type=int, default=None, metavar="K",
@@ -63,6 +66,13 @@ def resolve(args, manifest: dict) -> str | None:
         args.temperature = manifest.get("leaderTemperature", manifest["defaultTemperature"])
     if args.follower_temperature is None:
         args.follower_temperature = manifest["defaultTemperature"]
+    # Read by rollout.start_duet from the manifest the duets start from: asked for, it is written there.
+    if getattr(args, "leading_temperature", None) is None:
+        args.leading_temperature = manifest.get("leadingTemperature")
+    elif args.leading_temperature < 0:
+        return "a temperature (variety) cannot be negative"
+    else:
+        manifest["leadingTemperature"] = args.leading_temperature
     if args.guard is None:
         args.guard = int(guard.get("samples", 0))
     if args.guard_margin is None:

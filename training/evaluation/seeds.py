@@ -83,6 +83,8 @@ _WORKER: dict = {}
 
 def _init(models: str, method: str, data: str, test: list[str], r: dict, options: dict):
     manifest, onnx, leader = find_models(models)
+    if options.get("leading_temperature") is not None:   # as resolve wrote it in the parent's manifest
+        manifest["leadingTemperature"] = options["leading_temperature"]
     if method == "motion_matching":   # no sampling, nothing to guard
         follower = build(load_tracks(training_takes(data, exclude=test)), "follower")
     else:

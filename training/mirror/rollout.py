@@ -281,6 +281,29 @@ def plan_figures(duet: "Duet") -> None:
     f.led.append(figure_from(duet, max(start, duet.frame + 1), name, way, False))
 
 
+# A figure is led from LEAD_IN frames before it starts (the figure block shows it a second ahead:
+# his preparation) to its end.
+LEAD_IN = FPS
+
+
+def leading(duet: "Duet") -> bool:
+    """Whether the leader leads a figure the visitor asked for this step: one runs, or starts
+    within LEAD_IN frames. His own figures do not count: drawn more freely through them too, she
+    turned more (0.90x the recording's turns a minute against 0.80x) but her steered steps landed
+    on the beat at +0.34 against +0.40 (docs/results.md, "Leading a turn")."""
+    return any(f.asked and f.start - LEAD_IN <= duet.frame <= f.end for f in duet.figures.led)
+
+
+def leader_variety(duet: "Duet", temperature: float) -> float:
+    """The leader's variety this step: the manifest's leadingTemperature while he leads a figure
+    the visitor asked for (`leading`), else `temperature` (his own, options.py). Drawn at his
+    everyday variety, his samples seldom raised the lead hand for the hands plan; drawn more freely,
+    his guard's choice near the plan has more to choose from."""
+    if duet.leading_temperature is not None and leading(duet):
+        return duet.leading_temperature
+    return temperature
+
+
 def figure_share(led: Led, frame: float) -> float:
     """How much of the figure's turn is planned done at `frame`, 0 to 1 (smoothstep over it)."""
     u = min(1.0, max(0.0, (frame - led.start) / max(led.end - led.start, 1)))
@@ -402,6 +425,9 @@ class Duet:
     # the page reads it from the audio clock instead (what the listener hears now).
     tempo: float = music.DEFAULT_TEMPO
     beat: float = 0.0
+    # The leader's variety while he leads a figure the visitor asked for (the manifest's
+    # leadingTemperature; None: his own throughout). leader_variety reads it.
+    leading_temperature: float | None = None
 
 
 def show(duet: Duet) -> None:
@@ -433,7 +459,8 @@ def start_duet(manifest: dict, tempo: float | None = None, figures: bool = True,
     if not np.isfinite(bpm) or bpm <= 0:
         raise ValueError(f"tempo must be a positive number of beats a minute, got {tempo}")
     return Duet(leader, follower, sp, Steering(anchor=leader.root.copy()), tempo=bpm,
-                figures=Figures(own=figures, rng=np.random.default_rng([seed, 1])))
+                figures=Figures(own=figures, rng=np.random.default_rng([seed, 1])),
+                leading_temperature=manifest.get("leadingTemperature"))
 
 
 def music_input(duet: Duet) -> np.ndarray:
@@ -499,7 +526,7 @@ def step(duet: Duet, leader_policy, follower_policy, stick, temperature: float,
     steer_plan(duet.leader, duet.steering, np.asarray(stick, float))
     lead_plan(duet)
     xl, xf = step_inputs(duet)
-    ol = leader_policy(xl, temperature, rng)
+    ol = leader_policy(xl, leader_variety(duet, temperature), rng)
     of = follower_policy(xf, temperature, rng)
     finish_step(duet, ol["output"][0], of["output"][0],
                 of["intention"][0] if "intention" in of else None)

@@ -16,7 +16,7 @@ import { LeaderPlayback } from './playback';
 import { StepTimer } from './timing';
 import { createUniform } from './random';
 import {
-  Dancer, type Duet, NOW, applyOutput, askTurn, finishStep, leadPlan, musicInput, outputIsAbsurd, planFigures, startDuet, steerPlan, stepInputs,
+  Dancer, type Duet, NOW, applyOutput, askTurn, finishStep, leadPlan, leaderVariety, musicInput, outputIsAbsurd, planFigures, startDuet, steerPlan, stepInputs,
 } from '../mirror/rollout';
 import type { DancerView, FigureView, Simulation, SimulationOptions, StepPolicy, Steer } from './types';
 
@@ -252,7 +252,7 @@ export class DuetSimulation implements Simulation {
     }
     this.shownBeat = duet.beat;
     stepInputs(duet, playing ? null : this.leaderPolicy.input, this.followerInputs);
-    if (!playing) await this.stepLeader(this.leaderTemperature ?? temperature);
+    if (!playing) await this.stepLeader(leaderVariety(duet, this.leaderTemperature ?? temperature));
     for (let i = 0; i < this.followerPolicies.length; i++) {
       if (await this.followerOnTheCount(i, temperature)) continue;
       const result = await this.followerPolicies[i].run(temperature);

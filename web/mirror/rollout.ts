@@ -493,6 +493,30 @@ export function planFigures(duet: Duet): void {
   f.led.push(figureFrom(duet, Math.max(start, duet.frame + 1), name, way, false));
 }
 
+/** A figure is led from LEAD_IN frames before it starts (the figure block shows it a second ahead:
+ *  his preparation) to its end. */
+export const LEAD_IN = FPS;
+
+/**
+ * Whether the leader leads a figure the visitor asked for this step: one runs, or starts within
+ * LEAD_IN frames. His own figures do not count: drawn more freely through them too, she turned
+ * more (0.90x the recording's turns a minute against 0.80x) but her steered steps landed on the
+ * beat at +0.34 against +0.40 (docs/results.md, "Leading a turn").
+ */
+export function leading(duet: Duet): boolean {
+  return duet.figures.led.some((f) => f.asked && f.start - LEAD_IN <= duet.frame && duet.frame <= f.end);
+}
+
+/**
+ * The leader's variety this step: the manifest's leadingTemperature while he leads a figure the
+ * visitor asked for (`leading`), else `temperature` (his own). Drawn at his everyday variety, his
+ * samples seldom raised the lead hand for the hands plan; drawn more freely, his guard's choice near
+ * the plan has more to choose from.
+ */
+export function leaderVariety(duet: Duet, temperature: number): number {
+  return duet.leadingTemperature !== null && leading(duet) ? duet.leadingTemperature : temperature;
+}
+
 /** How much of the figure's turn is planned done at `frame`, 0 to 1 (smoothstep over it). */
 export function figureShare(led: Led, frame: number): number {
   const u = Math.min(1, Math.max(0, (frame - led.start) / Math.max(led.end - led.start, 1)));
@@ -580,6 +604,9 @@ export interface Duet {
    */
   tempo: number;
   beat: number;
+  /** The leader's variety while he leads a figure the visitor asked for (the manifest's
+   *  leadingTemperature; null: his own throughout). leaderVariety reads it. */
+  leadingTemperature: number | null;
 }
 
 /** The parts of manifest.json a duet starts from. */
@@ -587,6 +614,7 @@ export interface DuetManifest {
   skeleton: { offsets: { leader: number[][]; follower: number[][] } };
   startPose: unknown;
   music?: { tempo?: number };
+  leadingTemperature?: number;
 }
 
 /** The music's tempo a duet dances to when none is asked for: the manifest's, else DEFAULT_TEMPO. */
@@ -636,6 +664,7 @@ export function startDuet(
     startDancer(offsets.follower.flat(), startPose.follower, 0, START_DISTANCE, Math.PI));
   const duet: Duet = {
     leader, followers, startPose, steering: new Steering(), frame: 0, figures: new Figures(figures, random), tempo: bpm, beat: 0,
+    leadingTemperature: manifest.leadingTemperature ?? null,
   };
   setAnchor(duet);
   return duet;

@@ -35,6 +35,8 @@ export interface HelpFacts {
   variety: number;
   /** The leader model's own variety (manifest.leaderTemperature); null: he takes the partner's. */
   leaderVariety: number | null;
+  /** His variety while he leads a figure (manifest.leadingTemperature); null: his own throughout. */
+  leadingVariety: number | null;
   /** The upright guard's fresh samples (manifest.guard.samples); null: no guard. */
   uprightSamples: number | null;
 }
@@ -47,6 +49,7 @@ export function helpFacts(manifest: Manifest, variety: number): HelpFacts {
     fps: manifest.fps,
     variety,
     leaderVariety: manifest.leaderTemperature ?? null,
+    leadingVariety: manifest.leadingTemperature ?? null,
     // The upright guard acts where simulation.ts starts it: samples to choose from, and the range.
     uprightSamples: guard && guard.samples >= 2 && manifest.plausibility ? guard.samples : null,
   };
@@ -75,7 +78,8 @@ export function keysText(): string {
 
 /** The research names behind the plain ones (in the "more" fold). */
 export function researchText(facts: HelpFacts): string {
-  const leader = facts.leaderVariety === null ? 'the leader model dances with the same' : `the leader model keeps ${facts.leaderVariety}`;
+  const own = facts.leaderVariety === null ? 'the leader model dances with the same' : `the leader model keeps ${facts.leaderVariety}`;
+  const leader = facts.leadingVariety === null ? own : `${own}, and ${facts.leadingVariety} while he leads a turn you asked for`;
   const upright = facts.uprightSamples === null ? '' :
     '; an "upright choice" is a step in which the partner\'s sampled pose would have left the recorded dancers\' range (hips low, ' +
     `torso tipping) and the page took the most upright of ${facts.uprightSamples} fresh samples instead`;
