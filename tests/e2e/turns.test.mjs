@@ -15,7 +15,7 @@
 //   asked way, while it is danced, and no figure before the request;
 // - the request raises his hand: his higher hand goes above LEAD_HAND m within 2.5 s (in the
 //   recording it passes 1.6 m in 84 % of her turns; in Python within 4 s after 59 % of requests,
-//   in the page after 45 % of 20, so seed 8 is one where it does: docs/results.md, "Leading a turn");
+//   in the page after 48 % of 40, so seed 8 is one where it does: docs/results.md, "Leading a turn");
 // - the page keeps dancing through the turn: a step every 1/30 s of dance, both hips above 0.5 m,
 //   no error; the phone dances the same steps as the desktop;
 // - the strips' frames are not blank.
