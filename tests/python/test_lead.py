@@ -135,6 +135,20 @@ def test_he_draws_at_the_leading_variety_from_lead_in_before_an_asked_figure_to_
     assert manifest_duet(0.8).leading_temperature == 0.8 and manifest_duet().leading_temperature is None
 
 
+def test_his_own_figures_keep_his_own_variety():
+    """Nobody asking, every step is drawn at his own variety: a duet without a request (the soak,
+    the seeds, rhythm) dances as it did before the leading variety."""
+    duet = manifest_duet(0.9, figures=True)
+    own = 0
+    for _ in range(30 * FPS):
+        ro.plan_figures(duet)
+        own += any(f.start <= duet.frame <= f.end for f in duet.figures.led)
+        assert ro.leader_variety(duet, 0.6) == 0.6
+        duet.frame += 1
+        duet.beat += ro.music.beats_per_step(duet.tempo)
+    assert own > 10 * FPS                                   # his own figures ran through a third of it
+
+
 def test_a_figure_raises_his_lead_hand_and_lowers_it():
     duet = manifest_duet(figures=False)
     ro.ask_turn(duet, -1)                                  # her turn to the right: his right hand leads
