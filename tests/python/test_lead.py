@@ -141,11 +141,9 @@ def test_his_own_figures_keep_his_own_variety():
     duet = manifest_duet(0.9, figures=True)
     own = 0
     for _ in range(30 * FPS):
-        ro.plan_figures(duet)
         own += any(f.start <= duet.frame <= f.end for f in duet.figures.led)
         assert ro.leader_variety(duet, 0.6) == 0.6
-        duet.frame += 1
-        duet.beat += ro.music.beats_per_step(duet.tempo)
+        run_steps(duet, 1)
     assert own > 10 * FPS                                   # his own figures ran through a third of it
 
 

@@ -25,7 +25,7 @@ def add_options(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--temperature", type=float, default=None,
                     help="the leader's variety (default: the manifest's leaderTemperature, else defaultTemperature)")
     ap.add_argument("--leading-temperature", type=float, default=None,
-                    help="the leader's variety while he leads a figure (rollout.leader_variety; default: the manifest's "
+                    help="the leader's variety while he leads a figure the visitor asked for (rollout.leader_variety; default: the manifest's "
                          "leadingTemperature, else his own throughout)")
     ap.add_argument("--follower-temperature", type=float, default=None,
                     help="the follower's variety (default: the manifest's defaultTemperature, the page's slider)")

@@ -183,7 +183,7 @@ export interface Manifest {
   defaultTemperature: number;
   /** The leader model's own variety; absent in older exports (then the slider's, as the followers). */
   leaderTemperature?: number;
-  /** The leader's variety while he leads a figure (rollout.ts leaderVariety); absent: his own throughout. */
+  /** The leader's variety while he leads a figure the visitor asked for (rollout.ts leaderVariety); absent: his own throughout. */
   leadingTemperature?: number;
   /** The followers' upright guard (web/mirror/guard.ts); absent: no guard. */
   guard?: GuardSettings;

@@ -35,7 +35,7 @@ export interface HelpFacts {
   variety: number;
   /** The leader model's own variety (manifest.leaderTemperature); null: he takes the partner's. */
   leaderVariety: number | null;
-  /** His variety while he leads a figure (manifest.leadingTemperature); null: his own throughout. */
+  /** His variety while he leads a figure the visitor asked for (manifest.leadingTemperature); null: his own throughout. */
   leadingVariety: number | null;
   /** The upright guard's fresh samples (manifest.guard.samples); null: no guard. */
   uprightSamples: number | null;
