@@ -447,6 +447,9 @@ def hip_slack_cases() -> list[dict]:
             for margin, hip_margin in ((0.05, 0.2), (0.05, 0.15), (0.07, 0.1), (0.05, None))]
 
 
+_CONTACTS_OUT = feat.block_slices(feat.OUTPUT_LAYOUT)["contacts"]
+
+
 def on_count_cases(rng: np.random.Generator, outputs: np.ndarray, ranges: dict, offsets) -> dict:
     """training/mirror/on_count.py on inputs of each role whose music block is a count (random
     otherwise), three steps of each dancer's chooser, and the choice among the upright fixture's
@@ -457,13 +460,18 @@ def on_count_cases(rng: np.random.Generator, outputs: np.ndarray, ranges: dict, 
     for role, size in (("leader", feat.LEADER_INPUT_SIZE), ("follower", feat.INPUT_SIZE)):
         chooser = OC.OnCount(role, 4, 0.8)
         steps = []
-        # facing 5 frames ago, turned by 0.05 rad (a step), 0.2 rad (a slow walk round) and 1.2 rad (a spin)
-        for beat, turned in ((3.37, 0.05), (3.39, 0.2), (3.41, 1.2)):
+        # facing 5 frames ago, turned by 0.05 rad (a step), 0.2 rad (a slow walk round) and 1.2 rad (a
+        # spin); each step taken plants its left foot, its right, then neither (her next footwork now
+        # counts a planted foot still: on_count.PLANTED_STILL)
+        for beat, turned, contacts in ((3.37, 0.05, (0.9, 0.1)), (3.39, 0.2, (0.2, 0.7)), (3.41, 1.2, (0.5, 0.3))):
             x = rng.normal(0, 0.7, size)
             x[OC.LAST_FACING[role]:OC.LAST_FACING[role] + 2] = np.sin(turned), np.cos(turned)
             x[-music.MUSIC_SIZE:] = music.music_block(np.array(beat), np.array(2.9))
             target = chooser.target(x)
-            steps.append({"input": exact(x), "footwork": out7(OC.footwork_now(x, role)),
+            took = outputs[0].copy()
+            took[_CONTACTS_OUT] = contacts
+            chooser.took(took)
+            steps.append({"input": exact(x), "footwork": out7(OC.footwork_now(x, role)), "took": exact(took),
                           "count": out7(OC.count_next(x)), "turnRate": out7(OC.turn_rate(x, role)),
                           "turnNow": out7(OC.turn_now(x, role)),
                           "target": None if target is None else out7(target), "mean": out7(chooser.mean)})
@@ -482,6 +490,9 @@ def on_count_cases(rng: np.random.Generator, outputs: np.ndarray, ranges: dict, 
     s0, s1 = steps[0, 0], steps[1, 0]
     x[OC.HIP_VELOCITY_IN["follower"]] = (s1 / np.linalg.norm(s1) - s0 / np.linalg.norm(s0)) * 0.01 * FPS
     footwork, back = OC.drawn_footwork(steps), OC.hips_turn_back(steps, x, "follower")
+    # the same steps, each body planting its left foot, its right, both, neither
+    planting = outputs.copy()
+    planting[:, _CONTACTS_OUT] = np.resize(np.array([[0.8, 0.2], [0.4, 0.9], [0.6, 0.7], [0.5, 0.1]]), (len(outputs), 2))
     standing = G.upright_margin(outputs, ranges, offsets)
     target = float(0.55 * footwork[0] + 0.45 * footwork[1])   # nearer the first, unless its hips count
     # Her spin at 3.2 rad/s clockwise, the same bodies turning on it (the first), slowing to half
@@ -507,7 +518,8 @@ def on_count_cases(rng: np.random.Generator, outputs: np.ndarray, ranges: dict, 
             "bestPreferred": {f"{m}/{d}": OC.nearest_count(footwork, back, target, standing, m, 1.0, None, np.array(starts[f"{d}"]))
                               for m in (-9.0, 0.0, 0.05, 9.0) for d in (60.0, 180.0, 400.0)},
             "steps": out7(steps.reshape(len(outputs), -1)),
-            "footwork": out7(footwork), "turnBack": back.tolist(), "standing": out7(standing), "target": out7(target),
+            "footwork": out7(footwork), "turnBack": back.tolist(), "planting": exact(planting),
+            "planted": OC.planted(planting).tolist(), "footworkStill": out7(OC.drawn_footwork(steps, OC.planted(planting))), "standing": out7(standing), "target": out7(target),
             "best": {f"{m}/{h}": OC.nearest_count(footwork, back, target, standing, m, h)
                      for m in (-9.0, 0.0, 0.05, 9.0) for h in (0.0, 1.0)},
             "spin": out7(spin), "keeps": keeps,

@@ -247,6 +247,12 @@ class UprightGuard:
         self.guarded = self.kept = 0
 
     def __call__(self, x: np.ndarray, temperature: float, rng: np.random.Generator) -> dict:
+        out = self._step(x, temperature, rng)
+        if self.on_count is not None:   # the feet it plants, for the next step's footwork now
+            self.on_count.took(out["output"])
+        return out
+
+    def _step(self, x: np.ndarray, temperature: float, rng: np.random.Generator) -> dict:
         t = temperature if self.temperature is None else self.temperature
         slack = slack_for(x, self.margin, self.head_margin)
         hips = self.hip_slack
@@ -261,7 +267,8 @@ class UprightGuard:
                 near = near_plan(joints, x, standing, self.margin, self.keep_plan)
                 target = self.on_count.target(x)
                 steps = drawn_steps(many["output"], joints, x, self.on_count.role)
-                best = nearest_count(drawn_footwork(steps), hips_turn_back(steps, x, self.on_count.role), target,
+                best = nearest_count(drawn_footwork(steps, self.on_count.still(many["output"])),
+                                     hips_turn_back(steps, x, self.on_count.role), target,
                                      np.where(near, standing, -np.inf), self.margin, self.on_count.hips,
                                      self.on_count.keeps(many["output"]), self.on_count.prefers(many["output"], x))
             if best < 0:
@@ -276,7 +283,8 @@ class UprightGuard:
             joints = drawn_joints(many["output"], self.offsets)
             standing = drawn_margin(joints, self.ranges, slack, hips)
             steps = drawn_steps(many["output"], joints, x, self.on_count.role)
-            best = nearest_count(drawn_footwork(steps), hips_turn_back(steps, x, self.on_count.role), target, standing,
+            best = nearest_count(drawn_footwork(steps, self.on_count.still(many["output"])),
+                                 hips_turn_back(steps, x, self.on_count.role), target, standing,
                                  self.margin, self.on_count.hips, self.on_count.keeps(many["output"]),
                                  self.on_count.prefers(many["output"], x))
             if best >= 0:

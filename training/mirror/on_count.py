@@ -43,6 +43,17 @@ requests (`lead --seeds 40`); chosen at 120 degrees, 50 % / 74 % (69 % the asked
 Over seeds 0-19 alone: at 90 degrees 45 % / 68 %, at 120 38 % / 78 %, at 180 52 % / 78 %
 (--on-count-figure DEG); seeds 20-39 at 120 gave 62 % / 70 %, so 20 seeds do not tell them apart.
 
+The follower's feet are read as the contact layer draws them (PLANTED_STILL): a foot her network
+calls planted (its contact above footik.CONTACT_THRESHOLD, where the layer locks it) counts as
+still, in each candidate and in her footwork now (the feet planted in the step she last took,
+OnCount.took). Her network's feet move about 1 m/s in the frames it calls planted (docs/music.md),
+so a choice that read only where it drew them timed her steps by feet the page holds still: her
+drawn steps landed at +0.40 / +0.37 on the beat (steered / nobody steering) against her network's
++0.46 / +0.43; read as drawn, +0.45 / +0.47, and her drawn footwork repeats more strongly (0.64x /
+0.68x the recorded follower's pulse, against 0.56x / 0.53x; `rhythm --seeds 5 --seconds 40 --tempos
+170`). His choice reads his feet as his network draws them: read as the layer draws them his drawn
+steps nobody steering landed at +0.06 against +0.12 (docs/results.md, tried).
+
 OnCount's `spin_keep` and `turn_start` (keeps_spin, starts_turn) are two choices measured and not
 shipped: no manifest and no option sets them, and tests/fixtures/features.json pins them in both
 languages. docs/results.md's tried table has what they did ("Her spins on the count", "Her turn
@@ -54,6 +65,7 @@ import numpy as np
 
 from . import features as feat
 from .music import MUSIC_OFFSETS, MUSIC_SIZE
+from .footik import CONTACT_THRESHOLD
 from .skeleton import FEET, FPS
 
 SAMPLES = 8           # candidates each step (one batched run of the network)
@@ -66,6 +78,8 @@ HIPS = 1.0            # m/s added to the footwork's miss of a candidate whose hi
 STILL = 0.002         # m a frame (6 cm/s): a shorter step of the hips stands still, and turns no way
 FIGURE_TURN = 120.0   # degrees over the next second: a candidate whose planned path turns this much starts a turn
 FIGURE_AHEAD = 2      # future keys (of KEY_STEP frames) within which a figure coming counts as running
+# Whose feet the choice reads as the contact layer draws them: a foot its network calls planted counts as still.
+PLANTED_STILL = {"leader": False, "follower": True}
 
 # Where each role's input holds its own ankles' velocity (pose block: position, velocity, forward,
 # up per joint; the step into this frame as drawn, so the footwork now and the drawn footwork of a
@@ -88,6 +102,7 @@ POSITION_IN = {role: np.array([[feat.block_slices(layout)["self_pose"].start + _
                for role, layout in (("leader", feat.LEADER_INPUT_LAYOUT), ("follower", feat.FOLLOWER_INPUT_LAYOUT))}
 HIP_VELOCITY_IN = {role: POSITION_IN[role][0] + 3 for role in POSITION_IN}
 _ROOT_UPDATE_OUT = feat.block_slices(feat.OUTPUT_LAYOUT)["root_update"].start
+_CONTACTS_OUT = feat.block_slices(feat.OUTPUT_LAYOUT)["contacts"]
 # Where each role's input holds the figure block, and the figure kinds that are the dancer's own
 # turn: hers for the follower, his own for the leader (features.FIGURE_KINDS).
 FIGURE_IN = {role: feat.block_slices(layout)["figure"].start
@@ -96,9 +111,17 @@ OWN_TURN = {"leader": "his_turn", "follower": "her_turn"}
 _NOW_FIGURE_KEY = int(np.nonzero(feat.FIGURE_OFFSETS == 0)[0][0])
 
 
-def footwork_now(x: np.ndarray, role: str) -> float:
-    """The dancer's footwork now (m/s: the summed speed of both ankles) from its input [I]."""
-    return float(sum(np.linalg.norm(x[c:c + 3]) for c in ANKLE_VELOCITY_IN[role]))
+def planted(outputs: np.ndarray) -> np.ndarray:
+    """Which feet (left, right) each output [B, 323] plants [B, 2]: its contact above the contact
+    layer's CONTACT_THRESHOLD, where footik.FootLock locks the drawn foot."""
+    return np.atleast_2d(outputs)[:, _CONTACTS_OUT] > CONTACT_THRESHOLD
+
+
+def footwork_now(x: np.ndarray, role: str, still: np.ndarray | None = None) -> float:
+    """The dancer's footwork now (m/s: the summed speed of both ankles) from its input [I]; a foot
+    `still` [2] says is planted counts 0."""
+    return float(sum(np.linalg.norm(x[c:c + 3]) for k, c in enumerate(ANKLE_VELOCITY_IN[role])
+                     if still is None or not still[k]))
 
 
 def drawn_steps(outputs: np.ndarray, joints: np.ndarray, x: np.ndarray, role: str) -> np.ndarray:
@@ -113,9 +136,11 @@ def drawn_steps(outputs: np.ndarray, joints: np.ndarray, x: np.ndarray, role: st
     return nxt - x[POSITION_IN[role]]
 
 
-def drawn_footwork(steps: np.ndarray) -> np.ndarray:
-    """The footwork [B] (m/s) of the steps drawn_steps gives: the summed speed of both ankles."""
-    return np.linalg.norm(steps[:, 1:], axis=-1).sum(-1) * FPS
+def drawn_footwork(steps: np.ndarray, still: np.ndarray | None = None) -> np.ndarray:
+    """The footwork [B] (m/s) of the steps drawn_steps gives: the summed speed of both ankles, a
+    foot `still` [B, 2] says is planted counting 0."""
+    speed = np.linalg.norm(steps[:, 1:], axis=-1)
+    return (speed if still is None else np.where(still, 0.0, speed)).sum(-1) * FPS
 
 
 def hips_turn_back(steps: np.ndarray, x: np.ndarray, role: str) -> np.ndarray:
@@ -204,6 +229,7 @@ class OnCount:
             raise ValueError(f"figure_turn must be more than 0 degrees, got {figure_turn}")
         self.spin_keep, self.turn_start, self.figure_turn = spin_keep, turn_start, figure_turn
         self.mean: float | None = None
+        self.feet: np.ndarray | None = None   # [2] the feet planted in the step last taken (took)
         self.spin: float | None = None   # rad/s (turn_now) while this step's target is a spin's
         self.turning = False             # this step the dancer turns faster than its TURNING
 
@@ -212,7 +238,7 @@ class OnCount:
         None while the dancer turns faster than its TURNING (its footwork is left to the network),
         unless it keeps spins (spin_keep): then `spin` holds the turn the candidates are to keep."""
         x = np.atleast_2d(x)[0]
-        now = footwork_now(x, self.role)
+        now = footwork_now(x, self.role, self.feet if PLANTED_STILL[self.role] else None)
         self.mean = now if self.mean is None else self.mean + (now - self.mean) / (MEAN_SECONDS * FPS)
         turn = turn_now(x, self.role)
         self.spin = None
@@ -222,6 +248,16 @@ class OnCount:
                 return None
             self.spin = turn
         return self.mean * (1.0 - self.strength * np.cos(2 * np.pi * count_next(x)))
+
+    def took(self, output: np.ndarray) -> None:
+        """The step the dancer took (its output [323]): the feet it plants count as still in the
+        footwork now of the next step's target, where PLANTED_STILL."""
+        self.feet = planted(output)[0]
+
+    def still(self, outputs: np.ndarray) -> np.ndarray | None:
+        """Which feet of each candidate [B, 323] the choice counts as still (planted), where
+        PLANTED_STILL; None otherwise (the feet read as the network draws them)."""
+        return planted(outputs) if PLANTED_STILL[self.role] else None
 
     def keeps(self, outputs: np.ndarray) -> np.ndarray | None:
         """While this step's target is a spin's, which candidates [B, 323] keep it (keeps_spin);

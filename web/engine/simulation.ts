@@ -97,6 +97,8 @@ export class DuetSimulation implements Simulation {
   private keeps: boolean[] = [];
   /** Which of them the figure being led asks for (OnCount.prefers, from the dancer's input), outside a turn. */
   private prefers: boolean[] = [];
+  /** The feet of one candidate the chooser counts as still (OnCount.still). */
+  private still: boolean[] = [false, false];
   /** Which of his samples are among those nearest a request's hands plan (guard.ts nearPlan). */
   private near: boolean[] = [];
   private readonly body = new Float64Array(3 * N_JOINTS);
@@ -260,6 +262,9 @@ export class DuetSimulation implements Simulation {
       if (result.intention) this.followerIntentions[i]?.set(result.intention);
       await this.keepUpright(i, temperature);
     }
+    // The feet each chooser's dancer plants in the step it took: still in the next step's footwork now.
+    if (!playing) this.leaderOnCount?.took(this.leaderOutput);
+    this.followerOutputs.forEach((output, i) => this.followerOnCount[i]?.took(output));
     if (this.playback) this.playback.advance(duet.leader.track, duet.leader.contacts);
     finishStep(duet, playing ? null : this.leaderOutput, this.followerOutputs, this.followerIntentions);
     this.updateViews(false);
@@ -349,7 +354,7 @@ export class DuetSimulation implements Simulation {
       this.standing[n] = uprightBody(output, n * OUTPUT_SIZE, ranges, offsets, slack, hipSlack, this.body);
       if (only && !only[n]) this.standing[n] = -Infinity; // not among those the choice may take
       drawnSteps(output, n * OUTPUT_SIZE, this.body, input, onCount.role, this.steps);
-      this.footwork[n] = drawnFootwork(this.steps);
+      this.footwork[n] = drawnFootwork(this.steps, onCount.still(output, n * OUTPUT_SIZE, this.still));
       this.turnBack[n] = hipsTurnBack(this.steps, input, onCount.role);
     }
     const spinning = onCount.keeps(output, k, OUTPUT_SIZE, this.keeps);

@@ -18,13 +18,18 @@
 // more its way are preferred; while no figure runs or comes, those that turn less either way. Read by
 // the networks alone, the figure moved her turns little (on_count.py has the numbers). OnCount's spinKeep
 // and turnStart (keepsSpin, startsTurn) are two choices measured and not shipped, which the page
-// never sets (on_count.py says why they stay). Every candidate is the network's own reaction from
+// never sets (on_count.py says why they stay). The follower's feet are read as the contact layer draws
+// them (PLANTED_STILL): a foot her network calls planted, which the layer locks, counts as still, in
+// each candidate and in her footwork now (the feet of the step she last took, OnCount.took); her
+// network's feet move while it calls them planted, and a choice that read them where it drew them
+// timed her steps by feet the page holds still (on_count.py has the numbers). Every candidate is the network's own reaction from
 // the same state: nothing jumps, and nobody's input changes.
 
 import {
   FIGURE_KINDS, FIGURE_OFFSETS, FOLLOWER_INPUT_LAYOUT, type FigureName, KEY_STEP, KEYS, LEADER_INPUT_LAYOUT, OUTPUT_LAYOUT, POSE_SIZE,
   blockSlices,
 } from './features';
+import { CONTACT_THRESHOLD } from './footik';
 import { MUSIC_OFFSETS, MUSIC_SIZE } from './music';
 import { FEET, FPS, N_JOINTS } from './skeleton';
 
@@ -42,6 +47,8 @@ export const STILL = 0.002;
 export const FIGURE_TURN = 120.0;
 /** Future keys (of KEY_STEP frames) within which a figure coming counts as running. */
 export const FIGURE_AHEAD = 2;
+/** Whose feet the choice reads as the contact layer draws them: a foot its network calls planted counts as still. */
+export const PLANTED_STILL: Readonly<Record<Role, boolean>> = { leader: false, follower: true };
 
 /** The manifest's "onCount": samples each step, how far the footwork aimed at swings (0-1), what
  *  a candidate whose hips turn back adds to its miss (m/s; HIPS when absent), and the turn (degrees)
@@ -74,6 +81,7 @@ export const POSITION_IN: Readonly<Record<Role, readonly number[]>> = {
   follower: STEPPED.map((j) => blockSlices(FOLLOWER_INPUT_LAYOUT).self_pose.start + POSE_JOINT * j),
 };
 const ROOT_UPDATE_OUT = blockSlices(OUTPUT_LAYOUT).root_update.start;
+const CONTACTS_OUT = blockSlices(OUTPUT_LAYOUT).contacts.start;
 /** Where each role's input holds the figure block (features.ts figureBlock). */
 export const FIGURE_IN: Readonly<Record<Role, number>> = {
   leader: blockSlices(LEADER_INPUT_LAYOUT).figure.start,
@@ -87,10 +95,21 @@ function speedAt(x: ArrayLike<number>, c: number): number {
   return Math.hypot(x[c], x[c + 1], x[c + 2]);
 }
 
-/** The dancer's footwork now (m/s: the summed speed of both ankles) from its input. */
-export function footworkNow(input: ArrayLike<number>, role: Role): number {
+/** Which feet (left, right) output[at..] plants, into `feet`: its contact above the contact layer's
+ *  CONTACT_THRESHOLD, where footik.ts FootLock locks the drawn foot. */
+export function planted(output: ArrayLike<number>, at: number, feet: boolean[]): boolean[] {
+  feet[0] = output[at + CONTACTS_OUT] > CONTACT_THRESHOLD;
+  feet[1] = output[at + CONTACTS_OUT + 1] > CONTACT_THRESHOLD;
+  return feet;
+}
+
+/** The dancer's footwork now (m/s: the summed speed of both ankles) from its input; a foot `still`
+ *  says is planted counts 0. */
+export function footworkNow(input: ArrayLike<number>, role: Role, still: ArrayLike<boolean> | null = null): number {
   let sum = 0;
-  for (const c of ANKLE_VELOCITY_IN[role]) sum += speedAt(input, c);
+  ANKLE_VELOCITY_IN[role].forEach((c, k) => {
+    if (still === null || !still[k]) sum += speedAt(input, c);
+  });
   return sum;
 }
 
@@ -118,9 +137,12 @@ export function drawnSteps(
   return steps;
 }
 
-/** The footwork (m/s) of the steps drawnSteps gives: the summed speed of both ankles. */
-export function drawnFootwork(steps: ArrayLike<number>): number {
-  return (Math.hypot(steps[3], steps[4], steps[5]) + Math.hypot(steps[6], steps[7], steps[8])) * FPS;
+/** The footwork (m/s) of the steps drawnSteps gives: the summed speed of both ankles, a foot `still`
+ *  says is planted counting 0. */
+export function drawnFootwork(steps: ArrayLike<number>, still: ArrayLike<boolean> | null = null): number {
+  const left = still !== null && still[0] ? 0 : Math.hypot(steps[3], steps[4], steps[5]);
+  const right = still !== null && still[1] ? 0 : Math.hypot(steps[6], steps[7], steps[8]);
+  return (left + right) * FPS;
 }
 
 /** Whether the steps drawnSteps gives take the hips back the way they came: more than 90 degrees
@@ -204,6 +226,8 @@ export function countNext(input: ArrayLike<number>): number {
  *  (prefers). */
 export class OnCount {
   mean: number | null = null;
+  /** The feet planted in the step last taken (took); null before the first. */
+  feet: boolean[] | null = null;
   /** rad/s (turnNow) while this step's target is a spin's; null otherwise. */
   spin: number | null = null;
   /** This step the dancer turns faster than its TURNING. */
@@ -228,7 +252,7 @@ export class OnCount {
    *  the dancer turns faster than its TURNING (its footwork is left to the network), unless it keeps
    *  spins (spinKeep): then `spin` holds the turn the candidates are to keep. */
   target(input: ArrayLike<number>): number | null {
-    const now = footworkNow(input, this.role);
+    const now = footworkNow(input, this.role, PLANTED_STILL[this.role] ? this.feet : null);
     this.mean = this.mean === null ? now : this.mean + (now - this.mean) / (MEAN_SECONDS * FPS);
     const turn = turnNow(input, this.role);
     this.spin = null;
@@ -238,6 +262,18 @@ export class OnCount {
       this.spin = turn;
     }
     return this.mean * (1 - this.strength * Math.cos(2 * Math.PI * countNext(input)));
+  }
+
+  /** The step the dancer took (output[at..]): the feet it plants count as still in the footwork now
+   *  of the next step's target, where PLANTED_STILL. */
+  took(output: ArrayLike<number>, at = 0): void {
+    this.feet = planted(output, at, this.feet ?? [false, false]);
+  }
+
+  /** Which feet of the candidate at output[at..] the choice counts as still (planted), into `feet`,
+   *  where PLANTED_STILL; null otherwise (the feet read as the network draws them). */
+  still(output: ArrayLike<number>, at: number, feet: boolean[]): boolean[] | null {
+    return PLANTED_STILL[this.role] ? planted(output, at, feet) : null;
   }
 
   /** While this step's target is a spin's, which of `count` candidates laid one after another in
