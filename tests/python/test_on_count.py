@@ -183,6 +183,9 @@ def test_her_planted_feet_count_still_as_the_page_draws_them(role):
     chooser.mean = 1.0
     chooser.target(x)
     assert chooser.mean == pytest.approx(1.0 + ((0.5 if follower else 1.0) - 1.0) / (OC.MEAN_SECONDS * FPS))
+    # a new duet forgets both (each seed of `seeds` and rollout of `soak` dances as if alone)
+    O.restart_count(guard)
+    assert chooser.mean is None and chooser.feet is None
 
 
 def parse(*argv):

@@ -50,6 +50,8 @@ describe('the footwork each dancer aims at on the count', () => {
     expect(rightOnly).toBeLessThan(footworkNow(x, 'follower'));
     expectClose([her.mean as number], [meanBefore + (rightOnly - meanBefore) / (MEAN_SECONDS * FPS)], 'her mean from her free foot');
     expect(PLANTED_STILL).toEqual({ leader: false, follower: true });
+    her.restart(); // a new duet forgets both
+    expect([her.mean, her.feet]).toEqual([null, null]);
   });
 
   it('leaves a turn to the network: the last step of each role turns faster than TURNING', () => {

@@ -164,4 +164,4 @@ def restart_count(policy) -> None:
     if hasattr(policy, "guarded"):
         policy.guarded = 0
     if getattr(policy, "on_count", None) is not None:
-        policy.on_count.mean = None
+        policy.on_count.restart()

@@ -249,6 +249,10 @@ class OnCount:
             self.spin = turn
         return self.mean * (1.0 - self.strength * np.cos(2 * np.pi * count_next(x)))
 
+    def restart(self) -> None:
+        """Forget the dancer's footwork and feet before a new duet (its first step starts the mean)."""
+        self.mean, self.feet = None, None
+
     def took(self, output: np.ndarray) -> None:
         """The step the dancer took (its output [323]): the feet it plants count as still in the
         footwork now of the next step's target, where PLANTED_STILL."""

@@ -168,7 +168,7 @@ export class DuetSimulation implements Simulation {
     this.ghostBranched = []; // the possible reactions branch again from the new start
     this.upright = 0;
     this.counted = 0;
-    for (const c of [this.leaderOnCount, ...this.followerOnCount]) if (c) c.mean = null;
+    for (const c of [this.leaderOnCount, ...this.followerOnCount]) c?.restart();
     this.playback?.start(this.duet.leader.track);
     this.timer.clear();
     this.updateViews(true);

@@ -264,6 +264,12 @@ export class OnCount {
     return this.mean * (1 - this.strength * Math.cos(2 * Math.PI * countNext(input)));
   }
 
+  /** Forget the dancer's footwork and feet before a new duet (its first step starts the mean). */
+  restart(): void {
+    this.mean = null;
+    this.feet = null;
+  }
+
   /** The step the dancer took (output[at..]): the feet it plants count as still in the footwork now
    *  of the next step's target, where PLANTED_STILL. */
   took(output: ArrayLike<number>, at = 0): void {
