@@ -461,8 +461,8 @@ def on_count_cases(rng: np.random.Generator, outputs: np.ndarray, ranges: dict, 
         chooser = OC.OnCount(role, 4, 0.8)
         steps = []
         # facing 5 frames ago, turned by 0.05 rad (a step), 0.2 rad (a slow walk round) and 1.2 rad (a
-        # spin); each step taken plants its left foot, its right, then neither (her next footwork now
-        # counts a planted foot still: on_count.PLANTED_STILL)
+        # spin); each step taken plants its left foot, its right, then neither (the next footwork now
+        # counts a planted foot still: OnCount.took)
         for beat, turned, contacts in ((3.37, 0.05, (0.9, 0.1)), (3.39, 0.2, (0.2, 0.7)), (3.41, 1.2, (0.5, 0.3))):
             x = rng.normal(0, 0.7, size)
             x[OC.LAST_FACING[role]:OC.LAST_FACING[role] + 2] = np.sin(turned), np.cos(turned)

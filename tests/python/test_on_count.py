@@ -158,31 +158,29 @@ def planting(footwork: float, contacts=(0.9, 0.9)) -> np.ndarray:
 
 
 @pytest.mark.parametrize("role", ["leader", "follower"])
-def test_her_planted_feet_count_still_as_the_page_draws_them(role):
+def test_planted_feet_count_still_as_the_page_draws_them(role):
     """Just before a beat (target about 0), of a sample gliding its feet at 0.9 m/s and one at 1.0
-    m/s whose network plants both feet: she takes the planted one, whose feet the contact layer
-    holds still; he reads his feet as his network draws them and takes the slower. The feet of the
-    step taken count still in her footwork now (OnCount.took), not in his."""
+    m/s whose network plants both feet, the dancer takes the planted one: the contact layer holds
+    its feet still. The feet of the step taken count still in the footwork now (OnCount.took)."""
     def policy(x, temperature, rng):
         return {"output": np.stack([output(0.9), planting(1.0)]), "code": np.arange(2)[:, None]}
 
     chooser = OC.OnCount(role, samples=2, strength=1.0)
     guard = UprightGuard(policy, RANGES, samples=4, margin=0.05, offsets=OFFSETS, on_count=chooser)
     got = guard(input_at(role, -2.9 / FPS, 0.5), 1.0, np.random.default_rng(0))
-    follower = role == "follower"
-    assert got["code"][0, 0] == (1 if follower else 0)
-    assert chooser.feet.tolist() == ([True, True] if follower else [False, False])
-    assert (chooser.still(np.stack([output(0.9), planting(1.0, (0.9, 0.2))])) is None) != follower
-    if follower:
-        assert chooser.still(planting(1.0, (0.9, 0.2))).tolist() == [[True, False]]
-    # her footwork now leaves the planted feet out; a foot at the threshold is free (the layer locks above it)
+    assert got["code"][0, 0] == 1
+    assert chooser.feet.tolist() == [True, True]
+    # read where the network draws them (no foot planted), the slower glide is nearer
+    assert OC.drawn_footwork(np.zeros((1, 3, 3)) + 0.01, OC.planted(output(0.9))).tolist() == pytest.approx(
+        [2 * np.sqrt(3) * 0.01 * FPS])
+    # the footwork now leaves the planted feet out; a foot at the threshold is free (the layer locks above it)
     x = input_at(role, 0.0, 0.5)
     assert OC.footwork_now(x, role, np.array([True, False])) == pytest.approx(0.5)
     assert OC.planted(planting(1.0, (0.5, 0.51))).tolist() == [[False, True]]
     chooser.took(planting(1.0, (0.9, 0.2)))
     chooser.mean = 1.0
     chooser.target(x)
-    assert chooser.mean == pytest.approx(1.0 + ((0.5 if follower else 1.0) - 1.0) / (OC.MEAN_SECONDS * FPS))
+    assert chooser.mean == pytest.approx(1.0 + (0.5 - 1.0) / (OC.MEAN_SECONDS * FPS))
     # a new duet forgets both (each seed of `seeds` and rollout of `soak` dances as if alone)
     O.restart_count(guard)
     assert chooser.mean is None and chooser.feet is None

@@ -1,14 +1,14 @@
 // web/mirror/on_count.ts against training/mirror/on_count.py: each dancer's footwork and count read
 // from its input, the footwork its next step aims at over three steps (the mean carried between
 // them), each sample's drawn steps, footwork and hips, and the choice among samples where all, some
-// and none of them stand, a sample's hips weighed and not; the follower's planted feet counted still; the figure being led read from the input
+// and none of them stand, a sample's hips weighed and not; the planted feet counted still; the figure being led read from the input
 // (figureWay) and the candidates it prefers (OnCount.prefers with figureTurn).
 
 import { describe, expect, it } from 'vitest';
 import { FIGURE_SIZE, INPUT_SIZE, LEADER_INPUT_SIZE, OUTPUT_SIZE } from '../../web/mirror/features';
 import { uprightBody } from '../../web/mirror/guard';
 import {
-  FIGURE_AHEAD, FIGURE_IN, FIGURE_TURN, MEAN_SECONDS, OWN_TURN, OnCount, PLANTED_STILL, TURNING, countNext, figureWay, drawnFootwork, drawnSteps, footworkNow, hipsTurnBack, keepsSpin, nearestCount,
+  FIGURE_AHEAD, FIGURE_IN, FIGURE_TURN, MEAN_SECONDS, OWN_TURN, OnCount, TURNING, countNext, figureWay, drawnFootwork, drawnSteps, footworkNow, hipsTurnBack, keepsSpin, nearestCount,
   planted, plannedTurn, startsTurn, turnNow, turnRate,
 } from '../../web/mirror/on_count';
 import { FPS } from '../../web/mirror/skeleton';
@@ -35,24 +35,25 @@ describe('the footwork each dancer aims at on the count', () => {
     });
   }
 
-  it('counts the feet the follower planted as still in her footwork now, not the leader\'s', () => {
-    // each step taken plants the left foot, then the right (fixtures_writer.py): her next target
-    // leaves that foot out of the footwork it moves the mean on by; his reads both feet
-    const [first, second] = data.roles.follower;
-    const her = new OnCount('follower', 4, 0.8);
-    her.target(Float32Array.from(first.input));
-    const meanBefore = her.mean as number;
-    her.took(Float32Array.from(first.took));
-    expect(her.feet).toEqual([true, false]);
-    her.target(Float32Array.from(second.input));
-    const x = Float32Array.from(second.input);
-    const rightOnly = footworkNow(x, 'follower', [true, false]);
-    expect(rightOnly).toBeLessThan(footworkNow(x, 'follower'));
-    expectClose([her.mean as number], [meanBefore + (rightOnly - meanBefore) / (MEAN_SECONDS * FPS)], 'her mean from her free foot');
-    expect(PLANTED_STILL).toEqual({ leader: false, follower: true });
-    her.restart(); // a new duet forgets both
-    expect([her.mean, her.feet]).toEqual([null, null]);
-  });
+  for (const role of ['leader', 'follower'] as const) {
+    it(`counts the feet the ${role} planted as still in the footwork now`, () => {
+      // each step taken plants the left foot, then the right (fixtures_writer.py): the next target
+      // leaves that foot out of the footwork it moves the mean on by
+      const [first, second] = data.roles[role];
+      const chooser = new OnCount(role, 4, 0.8);
+      chooser.target(Float32Array.from(first.input));
+      const meanBefore = chooser.mean as number;
+      chooser.took(Float32Array.from(first.took));
+      expect(chooser.feet).toEqual([true, false]);
+      chooser.target(Float32Array.from(second.input));
+      const x = Float32Array.from(second.input);
+      const rightOnly = footworkNow(x, role, [true, false]);
+      expect(rightOnly).toBeLessThan(footworkNow(x, role));
+      expectClose([chooser.mean as number], [meanBefore + (rightOnly - meanBefore) / (MEAN_SECONDS * FPS)], `${role} mean from the free foot`);
+      chooser.restart(); // a new duet forgets both
+      expect([chooser.mean, chooser.feet]).toEqual([null, null]);
+    });
+  }
 
   it('leaves a turn to the network: the last step of each role turns faster than TURNING', () => {
     for (const role of ['leader', 'follower'] as const) {
@@ -98,9 +99,7 @@ describe('nearestCount', () => {
       const feet = planted(Float64Array.from(data.planting), i * OUTPUT_SIZE, [false, false]);
       expect(feet, `planted ${i}`).toEqual(data.planted[i]);
       expectClose([drawnFootwork(steps, feet)], [data.footworkStill[i]], `footwork, planted feet still, ${i}`);
-      const chooser = new OnCount('follower', 4, 0.8);
-      expect(chooser.still(Float64Array.from(data.planting), i * OUTPUT_SIZE, [false, false]), `her still ${i}`).toEqual(data.planted[i]);
-      expect(new OnCount('leader', 4, 0.8).still(Float64Array.from(data.planting), i * OUTPUT_SIZE, [false, false]), `his still ${i}`).toBeNull();
+
       expect(hipsTurnBack(steps, input, 'follower'), `hips of ${i}`).toBe(data.turnBack[i]);
     }
     // the case the fixture is for: the first sample's hips turn back, the second's go on

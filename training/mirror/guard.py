@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import features as feat
-from .on_count import OnCount, drawn_footwork, drawn_steps, hips_turn_back, nearest_count
+from .on_count import OnCount, drawn_footwork, drawn_steps, hips_turn_back, nearest_count, planted
 from .rollout import MIN_ANKLE_HEIGHT, rotations_from_vectors
 from .skeleton import FEET, HANDS, HEAD, forward_kinematics_reduced
 from ..evaluation.plausibility import CHEST
@@ -267,7 +267,7 @@ class UprightGuard:
                 near = near_plan(joints, x, standing, self.margin, self.keep_plan)
                 target = self.on_count.target(x)
                 steps = drawn_steps(many["output"], joints, x, self.on_count.role)
-                best = nearest_count(drawn_footwork(steps, self.on_count.still(many["output"])),
+                best = nearest_count(drawn_footwork(steps, planted(many["output"])),
                                      hips_turn_back(steps, x, self.on_count.role), target,
                                      np.where(near, standing, -np.inf), self.margin, self.on_count.hips,
                                      self.on_count.keeps(many["output"]), self.on_count.prefers(many["output"], x))
@@ -283,7 +283,7 @@ class UprightGuard:
             joints = drawn_joints(many["output"], self.offsets)
             standing = drawn_margin(joints, self.ranges, slack, hips)
             steps = drawn_steps(many["output"], joints, x, self.on_count.role)
-            best = nearest_count(drawn_footwork(steps, self.on_count.still(many["output"])),
+            best = nearest_count(drawn_footwork(steps, planted(many["output"])),
                                  hips_turn_back(steps, x, self.on_count.role), target, standing,
                                  self.margin, self.on_count.hips, self.on_count.keeps(many["output"]),
                                  self.on_count.prefers(many["output"], x))

@@ -43,16 +43,14 @@ requests (`lead --seeds 40`); chosen at 120 degrees, 50 % / 74 % (69 % the asked
 Over seeds 0-19 alone: at 90 degrees 45 % / 68 %, at 120 38 % / 78 %, at 180 52 % / 78 %
 (--on-count-figure DEG); seeds 20-39 at 120 gave 62 % / 70 %, so 20 seeds do not tell them apart.
 
-The follower's feet are read as the contact layer draws them (PLANTED_STILL): a foot her network
-calls planted (its contact above footik.CONTACT_THRESHOLD, where the layer locks it) counts as
-still, in each candidate and in her footwork now (the feet planted in the step she last took,
-OnCount.took). Her network's feet move about 1 m/s in the frames it calls planted (docs/music.md),
-so a choice that read only where it drew them timed her steps by feet the page holds still: her
-drawn steps landed at +0.40 / +0.37 on the beat (steered / nobody steering) against her network's
-+0.46 / +0.43; read as drawn, +0.45 / +0.47, and her drawn footwork repeats more strongly (0.64x /
-0.68x the recorded follower's pulse, against 0.56x / 0.53x; `rhythm --seeds 5 --seconds 40 --tempos
-170`). His choice reads his feet as his network draws them: read as the layer draws them his drawn
-steps nobody steering landed at +0.06 against +0.12 (docs/results.md, tried).
+The feet are read as the contact layer draws them: a foot the network calls planted (its contact
+above footik.CONTACT_THRESHOLD, where the layer locks it) counts as still, in each candidate and in
+the dancer's footwork now (the feet planted in the step last taken, OnCount.took). The networks'
+feet move about 1 m/s in the frames they call planted (docs/music.md), so a choice that read only
+where the network drew them timed the steps by feet the page holds still. Read as drawn, over 15
+seeds x 40 s at 170 (`rhythm --seeds 15 --seconds 40 --tempos 170`), nobody steering, her drawn
+steps land on the beat at +0.45 against +0.38 and his at +0.14 against +0.09, his drawn footwork
+repeats at 0.75x the recorded leader's pulse against 0.62x, hers 0.58x against 0.52x.
 
 OnCount's `spin_keep` and `turn_start` (keeps_spin, starts_turn) are two choices measured and not
 shipped: no manifest and no option sets them, and tests/fixtures/features.json pins them in both
@@ -78,8 +76,6 @@ HIPS = 1.0            # m/s added to the footwork's miss of a candidate whose hi
 STILL = 0.002         # m a frame (6 cm/s): a shorter step of the hips stands still, and turns no way
 FIGURE_TURN = 120.0   # degrees over the next second: a candidate whose planned path turns this much starts a turn
 FIGURE_AHEAD = 2      # future keys (of KEY_STEP frames) within which a figure coming counts as running
-# Whose feet the choice reads as the contact layer draws them: a foot its network calls planted counts as still.
-PLANTED_STILL = {"leader": False, "follower": True}
 
 # Where each role's input holds its own ankles' velocity (pose block: position, velocity, forward,
 # up per joint; the step into this frame as drawn, so the footwork now and the drawn footwork of a
@@ -238,7 +234,7 @@ class OnCount:
         None while the dancer turns faster than its TURNING (its footwork is left to the network),
         unless it keeps spins (spin_keep): then `spin` holds the turn the candidates are to keep."""
         x = np.atleast_2d(x)[0]
-        now = footwork_now(x, self.role, self.feet if PLANTED_STILL[self.role] else None)
+        now = footwork_now(x, self.role, self.feet)
         self.mean = now if self.mean is None else self.mean + (now - self.mean) / (MEAN_SECONDS * FPS)
         turn = turn_now(x, self.role)
         self.spin = None
@@ -255,13 +251,8 @@ class OnCount:
 
     def took(self, output: np.ndarray) -> None:
         """The step the dancer took (its output [323]): the feet it plants count as still in the
-        footwork now of the next step's target, where PLANTED_STILL."""
+        footwork now of the next step's target."""
         self.feet = planted(output)[0]
-
-    def still(self, outputs: np.ndarray) -> np.ndarray | None:
-        """Which feet of each candidate [B, 323] the choice counts as still (planted), where
-        PLANTED_STILL; None otherwise (the feet read as the network draws them)."""
-        return planted(outputs) if PLANTED_STILL[self.role] else None
 
     def keeps(self, outputs: np.ndarray) -> np.ndarray | None:
         """While this step's target is a spin's, which candidates [B, 323] keep it (keeps_spin);

@@ -11,7 +11,7 @@ import { KEY_JOINTS, type Motion, N_JOINTS, POSITIONS_SIZE, ROTATIONS_SIZE } fro
 import { ContactLayer, HipGlide } from '../mirror/contact';
 import { FootLock } from '../mirror/footik';
 import { type GuardSettings, type Ranges, hipSlackFor, mostUpright, nearPlan, nearestPlan, showsPlan, slackFor, uprightBody, uprightMargin } from '../mirror/guard';
-import { OnCount, STEPPED, drawnFootwork, drawnSteps, hipsTurnBack, nearestCount } from '../mirror/on_count';
+import { OnCount, STEPPED, drawnFootwork, drawnSteps, hipsTurnBack, nearestCount, planted } from '../mirror/on_count';
 import { LeaderPlayback } from './playback';
 import { StepTimer } from './timing';
 import { createUniform } from './random';
@@ -97,7 +97,7 @@ export class DuetSimulation implements Simulation {
   private keeps: boolean[] = [];
   /** Which of them the figure being led asks for (OnCount.prefers, from the dancer's input), outside a turn. */
   private prefers: boolean[] = [];
-  /** The feet of one candidate the chooser counts as still (OnCount.still). */
+  /** The feet one candidate plants, which the chooser counts as still (on_count.ts planted). */
   private still: boolean[] = [false, false];
   /** Which of his samples are among those nearest a request's hands plan (guard.ts nearPlan). */
   private near: boolean[] = [];
@@ -354,7 +354,7 @@ export class DuetSimulation implements Simulation {
       this.standing[n] = uprightBody(output, n * OUTPUT_SIZE, ranges, offsets, slack, hipSlack, this.body);
       if (only && !only[n]) this.standing[n] = -Infinity; // not among those the choice may take
       drawnSteps(output, n * OUTPUT_SIZE, this.body, input, onCount.role, this.steps);
-      this.footwork[n] = drawnFootwork(this.steps, onCount.still(output, n * OUTPUT_SIZE, this.still));
+      this.footwork[n] = drawnFootwork(this.steps, planted(output, n * OUTPUT_SIZE, this.still));
       this.turnBack[n] = hipsTurnBack(this.steps, input, onCount.role);
     }
     const spinning = onCount.keeps(output, k, OUTPUT_SIZE, this.keeps);

@@ -18,12 +18,11 @@
 // more its way are preferred; while no figure runs or comes, those that turn less either way. Read by
 // the networks alone, the figure moved her turns little (on_count.py has the numbers). OnCount's spinKeep
 // and turnStart (keepsSpin, startsTurn) are two choices measured and not shipped, which the page
-// never sets (on_count.py says why they stay). The follower's feet are read as the contact layer draws
-// them (PLANTED_STILL): a foot her network calls planted, which the layer locks, counts as still, in
-// each candidate and in her footwork now (the feet of the step she last took, OnCount.took); her
-// network's feet move while it calls them planted, and a choice that read them where it drew them
-// timed her steps by feet the page holds still (on_count.py has the numbers). Every candidate is the network's own reaction from
-// the same state: nothing jumps, and nobody's input changes.
+// never sets (on_count.py says why they stay). The feet are read as the contact layer draws them: a
+// foot the network calls planted, which the layer locks, counts as still, in each candidate and in the
+// dancer's footwork now (the feet of the step last taken, OnCount.took); the networks' feet move while
+// they call them planted, and a choice that read them where the network drew them timed the steps by
+// feet the page holds still (on_count.py has the numbers).
 
 import {
   FIGURE_KINDS, FIGURE_OFFSETS, FOLLOWER_INPUT_LAYOUT, type FigureName, KEY_STEP, KEYS, LEADER_INPUT_LAYOUT, OUTPUT_LAYOUT, POSE_SIZE,
@@ -47,8 +46,6 @@ export const STILL = 0.002;
 export const FIGURE_TURN = 120.0;
 /** Future keys (of KEY_STEP frames) within which a figure coming counts as running. */
 export const FIGURE_AHEAD = 2;
-/** Whose feet the choice reads as the contact layer draws them: a foot its network calls planted counts as still. */
-export const PLANTED_STILL: Readonly<Record<Role, boolean>> = { leader: false, follower: true };
 
 /** The manifest's "onCount": samples each step, how far the footwork aimed at swings (0-1), what
  *  a candidate whose hips turn back adds to its miss (m/s; HIPS when absent), and the turn (degrees)
@@ -252,7 +249,7 @@ export class OnCount {
    *  the dancer turns faster than its TURNING (its footwork is left to the network), unless it keeps
    *  spins (spinKeep): then `spin` holds the turn the candidates are to keep. */
   target(input: ArrayLike<number>): number | null {
-    const now = footworkNow(input, this.role, PLANTED_STILL[this.role] ? this.feet : null);
+    const now = footworkNow(input, this.role, this.feet);
     this.mean = this.mean === null ? now : this.mean + (now - this.mean) / (MEAN_SECONDS * FPS);
     const turn = turnNow(input, this.role);
     this.spin = null;
@@ -271,15 +268,9 @@ export class OnCount {
   }
 
   /** The step the dancer took (output[at..]): the feet it plants count as still in the footwork now
-   *  of the next step's target, where PLANTED_STILL. */
+   *  of the next step's target. */
   took(output: ArrayLike<number>, at = 0): void {
     this.feet = planted(output, at, this.feet ?? [false, false]);
-  }
-
-  /** Which feet of the candidate at output[at..] the choice counts as still (planted), into `feet`,
-   *  where PLANTED_STILL; null otherwise (the feet read as the network draws them). */
-  still(output: ArrayLike<number>, at: number, feet: boolean[]): boolean[] | null {
-    return PLANTED_STILL[this.role] ? planted(output, at, feet) : null;
   }
 
   /** While this step's target is a spin's, which of `count` candidates laid one after another in
