@@ -264,7 +264,7 @@ export class DuetSimulation implements Simulation {
     }
     // The feet each chooser's dancer plants in the step it took: still in the next step's footwork now.
     if (!playing) this.leaderOnCount?.took(this.leaderOutput);
-    this.followerOutputs.forEach((output, i) => this.followerOnCount[i]?.took(output));
+    for (let i = 0; i < this.followerOutputs.length; i++) this.followerOnCount[i]?.took(this.followerOutputs[i]);
     if (this.playback) this.playback.advance(duet.leader.track, duet.leader.contacts);
     finishStep(duet, playing ? null : this.leaderOutput, this.followerOutputs, this.followerIntentions);
     this.updateViews(false);

@@ -103,10 +103,9 @@ export function planted(output: ArrayLike<number>, at: number, feet: boolean[]):
 /** The dancer's footwork now (m/s: the summed speed of both ankles) from its input; a foot `still`
  *  says is planted counts 0. */
 export function footworkNow(input: ArrayLike<number>, role: Role, still: ArrayLike<boolean> | null = null): number {
+  const ankles = ANKLE_VELOCITY_IN[role];
   let sum = 0;
-  ANKLE_VELOCITY_IN[role].forEach((c, k) => {
-    if (still === null || !still[k]) sum += speedAt(input, c);
-  });
+  for (let k = 0; k < ankles.length; k++) if (still === null || !still[k]) sum += speedAt(input, ankles[k]);
   return sum;
 }
 
