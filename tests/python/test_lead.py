@@ -4,6 +4,7 @@ hands plan and turn onsets, and the evaluation tool training.evaluation.lead."""
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -436,3 +437,39 @@ def test_a_branch_leaves_the_choosers_on_the_count_as_it_found_them(exported):
     lead.branch(duet, leader, follower, args.temperature, np.random.default_rng(7), 1, FPS)
     assert (leader.on_count.mean, follower.on_count.mean) == seen
     assert np.array_equal(unasked(), alone)
+
+
+
+SHIPPED = Path(__file__).resolve().parents[2] / "public" / "models"
+
+
+@pytest.mark.skipif(not (SHIPPED / "manifest.json").exists(), reason="no shipped models")
+def test_each_seed_dances_as_if_alone(tmp_path):
+    """A seed danced after another (`--first-seed 0 --seeds 2`) is the seed danced on its own, in
+    lead and in jitter: each duet starts its choosers on the count afresh (lead.restart_choosers),
+    not from the footwork the duet before left them. The shipped models, whose samples stand, so
+    that the choice on the count is what takes each step."""
+    import argparse
+
+    from training.evaluation import jitter
+    from training.evaluation import options as O
+    from training.evaluation.evaluate_inputs import find_models, load_onnx
+
+    manifest, onnx, leader_path = find_models(SHIPPED)
+    args = argparse.Namespace(temperature=None, follower_temperature=None, guard=None, guard_margin=None,
+                              leader_guard=None)
+    assert O.resolve(args, manifest) is None
+    leader = O.leader_policy(load_onnx(leader_path), manifest, args)
+    follower = O.follower_policy(load_onnx(onnx["ours"]), manifest, args, args.temperature)
+    assert leader.on_count is not None and follower.on_count is not None
+    alone = lead.one_duet(manifest, leader, follower, args.temperature, 1, 2.0)
+    lead.one_duet(manifest, leader, follower, args.temperature, 0, 2.0)
+    assert lead.one_duet(manifest, leader, follower, args.temperature, 1, 2.0) == alone
+
+    def seed_1(first: int, seeds: int) -> dict:   # jitter's duets (without its recording's figures)
+        ja = argparse.Namespace(models=str(SHIPPED), follower="follower", seeds=seeds, first_seed=first,
+                                seconds=2.0, tempo=None, quiet=True, temperature=None, follower_temperature=None,
+                                guard=None, guard_margin=None, leader_guard=None)
+        return next(r for r in jitter.rollouts(ja, True) if r["seed"] == 1)
+
+    assert seed_1(0, 2) == seed_1(1, 1)
