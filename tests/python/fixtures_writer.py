@@ -455,8 +455,6 @@ def on_count_cases(rng: np.random.Generator, outputs: np.ndarray, ranges: dict, 
     otherwise), three steps of each dancer's chooser, and the choice among the upright fixture's
     outputs at margins where all, some and none of them stand."""
     cases = {}
-    spinner = OC.OnCount("follower", 4, 0.8, spin_keep=0.7)   # her chooser that keeps spins
-    spins = []
     for role, size in (("leader", feat.LEADER_INPUT_SIZE), ("follower", feat.INPUT_SIZE)):
         chooser = OC.OnCount(role, 4, 0.8)
         steps = []
@@ -475,9 +473,6 @@ def on_count_cases(rng: np.random.Generator, outputs: np.ndarray, ranges: dict, 
                           "count": out7(OC.count_next(x)), "turnRate": out7(OC.turn_rate(x, role)),
                           "turnNow": out7(OC.turn_now(x, role)),
                           "target": None if target is None else out7(target), "mean": out7(chooser.mean)})
-            if role == "follower":
-                aimed = spinner.target(x)
-                spins.append({"target": out7(aimed), "spin": None if spinner.spin is None else out7(spinner.spin)})
         cases[role] = steps
     # The choice among the upright fixture's bodies, from a follower's input whose own hips and
     # ankles stand where the first body draws them, her hips having come in against the first's
@@ -495,13 +490,6 @@ def on_count_cases(rng: np.random.Generator, outputs: np.ndarray, ranges: dict, 
     planting[:, _CONTACTS_OUT] = np.resize(np.array([[0.8, 0.2], [0.4, 0.9], [0.6, 0.7], [0.5, 0.1]]), (len(outputs), 2))
     standing = G.upright_margin(outputs, ranges, offsets)
     target = float(0.55 * footwork[0] + 0.45 * footwork[1])   # nearer the first, unless its hips count
-    # Her spin at 3.2 rad/s clockwise, the same bodies turning on it (the first), slowing to half
-    # (the second), turning back (the third) and on at 0.9 of it (the fourth): at spinKeep 0.7 the
-    # first and fourth keep it, at 0 all but the third, at 1.5 none.
-    spun = outputs.copy()
-    spun[:, feat.block_slices(feat.OUTPUT_LAYOUT)["root_update"].start + 2] = np.array([-3.2, -1.6, 3.2, -2.9]) / FPS
-    spin = -3.2
-    keeps = {f"{k}": OC.keeps_spin(spun, spin, k).tolist() for k in (0.0, 0.7, 1.5)}
     # Her turn starts: the same bodies, their planned paths turning 300 degrees to her left (the
     # first), 90 (the second), 200 to her right (the third) and not at all (the fourth): from 180
     # degrees the first and third start a turn, from 60 all but the fourth, from 400 none.
@@ -513,18 +501,15 @@ def on_count_cases(rng: np.random.Generator, outputs: np.ndarray, ranges: dict, 
         keys[:, 2], keys[:, 3] = 0.8 * np.sin(h), 0.8 * np.cos(h)
         turned[i, future] = keys.ravel()
     starts = {f"{d}": OC.starts_turn(turned, d).tolist() for d in (60.0, 180.0, 400.0)}
-    return {"roles": cases, "spinner": spins, "outputs": exact(outputs), "input": exact(x), "spun": exact(spun),
+    return {"roles": cases, "outputs": exact(outputs), "input": exact(x),
             "turned": exact(turned), "plannedTurn": out7(OC.planned_turn(turned)), "starts": starts,
-            "bestPreferred": {f"{m}/{d}": OC.nearest_count(footwork, back, target, standing, m, 1.0, None, np.array(starts[f"{d}"]))
+            "bestPreferred": {f"{m}/{d}": OC.nearest_count(footwork, back, target, standing, m, 1.0, np.array(starts[f"{d}"]))
                               for m in (-9.0, 0.0, 0.05, 9.0) for d in (60.0, 180.0, 400.0)},
             "steps": out7(steps.reshape(len(outputs), -1)),
             "footwork": out7(footwork), "turnBack": back.tolist(), "planting": exact(planting),
             "planted": OC.planted(planting).tolist(), "footworkStill": out7(OC.drawn_footwork(steps, OC.planted(planting))), "standing": out7(standing), "target": out7(target),
             "best": {f"{m}/{h}": OC.nearest_count(footwork, back, target, standing, m, h)
                      for m in (-9.0, 0.0, 0.05, 9.0) for h in (0.0, 1.0)},
-            "spin": out7(spin), "keeps": keeps,
-            "bestKept": {f"{m}/{k}": OC.nearest_count(footwork, back, target, standing, m, 1.0, np.array(keeps[f"{k}"]))
-                         for m in (-9.0, 0.0, 0.05, 9.0) for k in (0.0, 0.7, 1.5)},
             **figure_choice_cases(outputs)}
 
 
@@ -552,7 +537,7 @@ def figure_choice_cases(outputs: np.ndarray) -> dict:
     fixture holds the block alone) whose figure block holds each kind now, coming within and beyond
     FIGURE_AHEAD, past, none, and two at once; and OnCount.prefers with figure_turn on 8 candidates
     whose planned paths turn various amounts, from inputs with and without a figure, turning or not,
-    and with turn_start alone."""
+    and without figure_turn."""
     ways = {}
     inputs = {}
     for role, size in (("leader", feat.LEADER_INPUT_SIZE), ("follower", feat.INPUT_SIZE)):
@@ -577,14 +562,14 @@ def figure_choice_cases(outputs: np.ndarray) -> dict:
     figured = np.round(figured, 6)
     chosen = []
     for role in ("leader", "follower"):
-        for figure_turn, turn_start in ((OC.FIGURE_TURN, None), (90.0, None), (None, 120.0), (OC.FIGURE_TURN, 120.0)):
+        for figure_turn in (OC.FIGURE_TURN, 90.0, None):
             for name in ("none", "her_left/now", "her_right/ahead", "his_left/next", "his_right/now",
                          "her_left/beyond", "her and his", None):
                 for turning in (False, True):
-                    chooser = OC.OnCount(role, 8, 1.0, turn_start=turn_start, figure_turn=figure_turn)
+                    chooser = OC.OnCount(role, 8, 1.0, figure_turn=figure_turn)
                     chooser.turning = turning
                     got = chooser.prefers(figured, None if name is None else inputs[role][name])
-                    chosen.append({"role": role, "figureTurn": figure_turn, "turnStart": turn_start, "figure": name,
+                    chosen.append({"role": role, "figureTurn": figure_turn, "figure": name,
                                    "turning": turning, "prefers": None if got is None else got.tolist()})
     return {"figureIn": OC.FIGURE_IN, "figureAhead": OC.FIGURE_AHEAD, "figureTurn": OC.FIGURE_TURN,
             "figureWays": ways, "figured": exact(figured), "figuredTurn": out7(OC.planned_turn(figured)),

@@ -253,44 +253,6 @@ def test_a_turn_leaves_the_footwork_to_the_network_and_keeps_the_hips_going():
     assert plain(x, 1.0, np.random.default_rng(0))["code"][0, 0] == 0 and calls == [1]
 
 
-def test_her_spin_steps_on_the_count_among_the_samples_that_keep_it():
-    """With spin_keep, her spin (facing 1.2 rad round in 5 frames: 7.2 rad/s clockwise) still aims
-    at the count's footwork, but only among the standing samples whose root turns on the same way at
-    spin_keep x 7.2 rad/s or faster: not the one that slows down, nor the one turning back, though
-    their feet are nearest. When no standing sample keeps the spin, the footwork is left alone as
-    without spin_keep (the first standing one whose hips go on)."""
-    x = input_at("follower", 0.5 - 2.9 / FPS, 0.5)   # between the beats: her target is 2x her mean of 1 m/s
-    c = OC.LAST_FACING["follower"]
-    x[c:c + 2] = np.sin(1.2), np.cos(1.2)
-    spin = -1.2 * FPS / feat.KEY_STEP
-    assert OC.turn_now(x, "follower") == pytest.approx(spin) and OC.turn_rate(x, "follower") == pytest.approx(-spin)
-    chooser = OC.OnCount("follower", samples=4, spin_keep=0.7)
-    assert chooser.target(x) == pytest.approx(2.0) and chooser.spin == pytest.approx(spin)
-    # footwork, turn (rad/s) and hips of each sample: keeps far off, slows, turns back, keeps near
-    samples = [(0.2, spin, 1.0), (2.0, -2.0, 1.0), (2.0, -spin, 1.0), (1.5, 0.85 * spin, 1.0)]
-
-    def spun(fw, turn, hip):
-        out = output(fw, hip)
-        out[ROOT_UPDATE.start + 2] = turn / FPS
-        return out
-
-    assert OC.keeps_spin(np.stack([spun(*s) for s in samples]), spin, 0.7).tolist() == [True, False, False, True]
-
-    def policy(xx, temperature, rng):
-        n = len(np.atleast_2d(xx))
-        return {"output": np.stack([spun(*samples[i % 4]) for i in range(n)]), "code": np.arange(n)[:, None]}
-
-    guard = UprightGuard(policy, RANGES, samples=4, margin=0.05, offsets=OFFSETS, on_count=chooser)
-    assert guard(x, 1.0, np.random.default_rng(0))["code"][0, 0] == 3 and guard.guarded == 0
-    # the two that keep the spin are low: none standing keeps it, the first standing one is taken
-    samples[0], samples[3] = (0.2, spin, 0.4), (1.5, 0.85 * spin, 0.4)
-    assert guard(x, 1.0, np.random.default_rng(0))["code"][0, 0] == 1
-    # without spin_keep her spin is the network's, as before
-    assert OC.OnCount("follower", samples=4).target(x) is None
-    with pytest.raises(ValueError, match="spin_keep"):
-        OC.OnCount("follower", spin_keep=-0.5)
-
-
 def test_every_option_reaches_the_seeds_workers():
     """seeds builds its dancers in worker processes from a dict of the resolved options: it takes
     every option add_options adds, so a new one cannot be left out."""
@@ -319,35 +281,43 @@ def turning_output(footwork: float, degrees: float, hip: float = 1.0) -> np.ndar
 FUTURE = feat.block_slices(feat.OUTPUT_LAYOUT)["trajectory_future"]
 
 
-def test_outside_a_spin_she_takes_the_turn_start_her_samples_offer():
-    """With turn_start, outside a spin the standing samples whose planned path turns turn_start
-    degrees or more (either way, a whole turn counted whole) are aimed at the count before the
-    others; none standing that starts one: the choice is the one without it. In a spin the spin's
-    own choice holds; without turn_start nothing is preferred."""
-    outs = np.stack([turning_output(2.0, 0.0), turning_output(0.3, 300.0), turning_output(1.9, -200.0),
-                     turning_output(2.0, 90.0)])
-    assert OC.planned_turn(outs) == pytest.approx([0.0, 300.0, -200.0, 90.0])
-    assert OC.starts_turn(outs, 180.0).tolist() == [False, True, True, False]
+def test_outside_a_spin_she_takes_the_turn_the_figure_leads():
+    """With figure_turn, while her turn to her left runs in the figure she reads, outside a spin the
+    standing samples whose planned path turns figure_turn degrees or more her left (a whole turn
+    counted whole) are aimed at the count before the others; none standing that turns so: the choice
+    is the one without it. No figure running or coming: those that start no turn either way. In a
+    spin the network's spin holds; without figure_turn nothing is preferred."""
+    outs = np.stack([turning_output(2.0, 0.0), turning_output(0.3, 300.0), turning_output(1.9, 200.0),
+                     turning_output(2.0, -200.0)])
+    assert OC.planned_turn(outs) == pytest.approx([0.0, 300.0, 200.0, -200.0])
+    assert OC.starts_turn(outs, 180.0).tolist() == [False, True, True, True]
     x = input_at("follower", 0.5 - 2.9 / FPS, 0.5)   # between the beats: her target is 2x her mean of 1 m/s
-    chooser = OC.OnCount("follower", samples=4, turn_start=180.0)
+    her_left = feat.FIGURE_KINDS.index(("her_turn", 1))
+    x[OC.FIGURE_IN["follower"]:OC.FIGURE_IN["follower"] + feat.FIGURE_SIZE] = feat.figure_block(
+        np.array([[her_left, 20, 60]]), np.array([30]))[0]
+    assert OC.figure_way(x, "follower") == 1
+    chooser = OC.OnCount("follower", samples=4, figure_turn=180.0)
     assert chooser.target(x) == pytest.approx(2.0) and not chooser.turning
-    assert chooser.prefers(outs).tolist() == [False, True, True, False]
+    assert chooser.prefers(outs, x).tolist() == [False, True, True, False]
 
     def policy(xx, temperature, rng):
         n = len(np.atleast_2d(xx))
         return {"output": np.stack([outs[i % 4] for i in range(n)]), "code": np.arange(n)[:, None]}
 
     guard = UprightGuard(policy, RANGES, samples=4, margin=0.05, offsets=OFFSETS, on_count=chooser)
-    assert guard(x, 1.0, np.random.default_rng(0))["code"][0, 0] == 2      # the turn start nearest the count
+    assert guard(x, 1.0, np.random.default_rng(0))["code"][0, 0] == 2      # her way's turn nearest the count
     plain = UprightGuard(policy, RANGES, samples=4, margin=0.05, offsets=OFFSETS, on_count=OC.OnCount("follower", 4))
     assert plain(x, 1.0, np.random.default_rng(0))["code"][0, 0] == 0      # without it: the nearest
+    unled = x.copy()
+    unled[OC.FIGURE_IN["follower"]:OC.FIGURE_IN["follower"] + feat.FIGURE_SIZE] = 0.0
+    assert chooser.prefers(outs, unled).tolist() == [True, False, False, False]   # no figure: no turn started
     outs[1] = turning_output(0.3, 300.0, hip=0.4)
-    outs[2] = turning_output(1.9, -200.0, hip=0.4)                          # the turn starts fall: none preferred
+    outs[2] = turning_output(1.9, 200.0, hip=0.4)                           # her way's turns fall: none preferred
     assert guard(x, 1.0, np.random.default_rng(0))["code"][0, 0] == 0
     c = OC.LAST_FACING["follower"]
     x[c:c + 2] = np.sin(1.2), np.cos(1.2)                                     # spinning
     chooser.target(x)
-    assert chooser.turning and chooser.prefers(outs) is None
-    assert OC.OnCount("follower", 4).prefers(outs) is None
-    with pytest.raises(ValueError, match="turn_start"):
-        OC.OnCount("follower", turn_start=0.0)
+    assert chooser.turning and chooser.prefers(outs, x) is None
+    assert OC.OnCount("follower", 4).prefers(outs, x) is None
+    with pytest.raises(ValueError, match="figure_turn"):
+        OC.OnCount("follower", figure_turn=0.0)

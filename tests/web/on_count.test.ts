@@ -8,7 +8,7 @@ import { describe, expect, it } from 'vitest';
 import { FIGURE_SIZE, INPUT_SIZE, LEADER_INPUT_SIZE, OUTPUT_SIZE } from '../../web/mirror/features';
 import { uprightBody } from '../../web/mirror/guard';
 import {
-  FIGURE_AHEAD, FIGURE_IN, FIGURE_TURN, MEAN_SECONDS, OWN_TURN, OnCount, TURNING, countNext, figureWay, drawnFootwork, drawnSteps, footworkNow, hipsTurnBack, keepsSpin, nearestCount,
+  FIGURE_AHEAD, FIGURE_IN, FIGURE_TURN, MEAN_SECONDS, OWN_TURN, OnCount, TURNING, countNext, figureWay, drawnFootwork, drawnSteps, footworkNow, hipsTurnBack, nearestCount,
   planted, plannedTurn, startsTurn, turnNow, turnRate,
 } from '../../web/mirror/on_count';
 import { FPS } from '../../web/mirror/skeleton';
@@ -62,22 +62,8 @@ describe('the footwork each dancer aims at on the count', () => {
     }
   });
 
-  it('aims her spins at the count too when she keeps them, as Python does', () => {
-    const spinner = new OnCount('follower', 4, 0.8, 1.0, 0.7);
-    data.roles.follower.forEach((step: { input: number[] }, i: number) => {
-      const target = spinner.target(Float32Array.from(step.input));
-      expectClose([target as number], data.spinner[i].target, `target ${i}`);
-      if (data.spinner[i].spin === null) expect(spinner.spin, `no spin at ${i}`).toBeNull();
-      else expectClose([spinner.spin as number], data.spinner[i].spin, `spin ${i}`);
-    });
-    // the last step spins: without spinKeep it had no target
-    expect(data.spinner[2].spin).not.toBeNull();
-    expect(data.roles.follower[2].target).toBeNull();
-  });
-
-  it('refuses a chooser with fewer than two samples, or a spin kept at a negative share', () => {
+  it('refuses a chooser with fewer than two samples', () => {
     expect(() => new OnCount('leader', 1)).toThrow(/at least 2 samples/);
-    expect(() => new OnCount('follower', 8, 1, 1, -0.5)).toThrow(/spinKeep/);
   });
 });
 
@@ -117,53 +103,22 @@ describe('nearestCount', () => {
     expect(data.best['0.0/1.0']).toBe(1);
   });
 
-  it('while she spins, takes only the standing samples that keep the spin, as Python does', () => {
-    const spun = Float64Array.from(data.spun);
-    const chooser = new OnCount('follower', 4, 1, 1, 0);
-    const keeps = new Array<boolean>(k).fill(false);
-    expect(chooser.keeps(spun, k, OUTPUT_SIZE, keeps), 'not spinning: no choice of the spin').toBe(false);
-    for (const [share, expected] of Object.entries(data.keeps)) {
-      const kept = Array.from({ length: k }, (_, i) => keepsSpin(spun, i * OUTPUT_SIZE, data.spin[0], Number(share)));
-      expect(kept, `keeps at ${share}`).toEqual(expected);
-      const spinner = new OnCount('follower', 4, 1, 1, Number(share));
-      spinner.spin = data.spin[0];
-      expect(spinner.keeps(spun, k, OUTPUT_SIZE, keeps)).toBe(true);
-      expect(keeps, `OnCount.keeps at ${share}`).toEqual(expected);
-    }
-    for (const [key, best] of Object.entries(data.bestKept)) {
-      const [margin, share] = key.split('/');
-      expect(nearestCount(data.footwork, data.turnBack, k, data.target[0], data.standing, Number(margin), 1, data.keeps[share]), key).toBe(best);
-    }
-    // where keeping the spin matters: the nearest going on (1) does not keep it, the first does;
-    // none keeps it (1.5): the footwork is left alone, the first standing one whose hips go on
-    expect(data.best['-9.0/1.0']).toBe(1);
-    expect(data.bestKept['-9.0/0.7']).toBe(0);
-    expect(data.bestKept['-9.0/1.5']).toBe(1);
-  });
-
-  it('outside a spin, prefers the standing samples that start a turn, as Python does', () => {
+  it('prefers the standing samples that start a turn when asked to, as Python does', () => {
     const turned = Float64Array.from(data.turned);
     for (let i = 0; i < k; i++) expect(plannedTurn(turned, i * OUTPUT_SIZE)).toBeCloseTo(data.plannedTurn[i], 4);
-    const prefers = new Array<boolean>(k).fill(false);
-    expect(new OnCount('follower', 4).prefers(turned, k, OUTPUT_SIZE, prefers), 'without turnStart: none preferred').toBe(false);
     for (const [degrees, expected] of Object.entries(data.starts)) {
       const started = Array.from({ length: k }, (_, i) => startsTurn(turned, i * OUTPUT_SIZE, Number(degrees)));
       expect(started, `starts from ${degrees}`).toEqual(expected);
-      const starter = new OnCount('follower', 4, 1, 1, 0.7, Number(degrees));
-      expect(starter.prefers(turned, k, OUTPUT_SIZE, prefers)).toBe(true);
-      expect(prefers, `OnCount.prefers from ${degrees}`).toEqual(expected);
-      starter.turning = true;   // in a spin the spin's own choice holds (keeps)
-      expect(starter.prefers(turned, k, OUTPUT_SIZE, prefers)).toBe(false);
     }
     for (const [key, best] of Object.entries(data.bestPreferred)) {
       const [margin, degrees] = key.split('/');
-      expect(nearestCount(data.footwork, data.turnBack, k, data.target[0], data.standing, Number(margin), 1, null, data.starts[degrees]), key).toBe(best);
+      expect(nearestCount(data.footwork, data.turnBack, k, data.target[0], data.standing, Number(margin), 1, data.starts[degrees]), key).toBe(best);
     }
     // where it matters: the nearest going on (1) starts no turn at 180, the first does; from 400
     // none does, and the choice is the one without a preference
+    expect(data.best['-9.0/1.0']).toBe(1);
     expect(data.bestPreferred['-9.0/180.0']).toBe(0);
     expect(data.bestPreferred['-9.0/400.0']).toBe(data.best['-9.0/1.0']);
-    expect(() => new OnCount('follower', 8, 1, 1, null, 0)).toThrow(/turnStart/);
   });
 });
 
@@ -214,18 +169,18 @@ describe('the figure being led, read by the choice', () => {
     const byName = (role: 'leader' | 'follower', name: string) => inputOf(role, cases(role).find((c) => c.name === name)!.figure);
     const prefers = new Array<boolean>(k).fill(false);
     const seen = new Set<string>();
-    for (const c of data.figurePrefers as { role: 'leader' | 'follower'; figureTurn: number | null; turnStart: number | null; figure: string | null; turning: boolean; prefers: boolean[] | null }[]) {
-      const chooser = new OnCount(c.role, 8, 1, 1, null, c.turnStart, c.figureTurn);
+    for (const c of data.figurePrefers as { role: 'leader' | 'follower'; figureTurn: number | null; figure: string | null; turning: boolean; prefers: boolean[] | null }[]) {
+      const chooser = new OnCount(c.role, 8, 1, 1, c.figureTurn);
       chooser.turning = c.turning;
-      const label = `${c.role} figureTurn ${c.figureTurn} turnStart ${c.turnStart} figure ${c.figure}${c.turning ? ' turning' : ''}`;
+      const label = `${c.role} figureTurn ${c.figureTurn} figure ${c.figure}${c.turning ? ' turning' : ''}`;
       prefers.fill(false);
       const got = chooser.prefers(figured, k, OUTPUT_SIZE, prefers, c.figure === null ? null : byName(c.role, c.figure));
       expect(got, label).toBe(c.prefers !== null);
       if (c.prefers !== null) expect(prefers, label).toEqual(c.prefers);
       seen.add(JSON.stringify(c.prefers));
     }
-    // the cases differ: none preferred, those turning little, each way's turns, turnStart's
+    // the cases differ: none preferred, those turning little, each way's turns, at each figureTurn
     expect(seen.size).toBeGreaterThanOrEqual(6);
-    expect(() => new OnCount('follower', 8, 1, 1, null, null, 0)).toThrow(/figureTurn/);
+    expect(() => new OnCount('follower', 8, 1, 1, 0)).toThrow(/figureTurn/);
   });
 });

@@ -270,7 +270,7 @@ class UprightGuard:
                 best = nearest_count(drawn_footwork(steps, planted(many["output"])),
                                      hips_turn_back(steps, x, self.on_count.role), target,
                                      np.where(near, standing, -np.inf), self.margin, self.on_count.hips,
-                                     self.on_count.keeps(many["output"]), self.on_count.prefers(many["output"], x))
+                                     self.on_count.prefers(many["output"], x))
             if best < 0:
                 best = nearest_plan(many["output"], x, self.ranges, self.offsets, self.margin, slack, hips)
             self.kept += 1
@@ -285,8 +285,7 @@ class UprightGuard:
             steps = drawn_steps(many["output"], joints, x, self.on_count.role)
             best = nearest_count(drawn_footwork(steps, planted(many["output"])),
                                  hips_turn_back(steps, x, self.on_count.role), target, standing,
-                                 self.margin, self.on_count.hips, self.on_count.keeps(many["output"]),
-                                 self.on_count.prefers(many["output"], x))
+                                 self.margin, self.on_count.hips, self.on_count.prefers(many["output"], x))
             if best >= 0:
                 return {k: v[best:best + 1] for k, v in many.items()}
             self.guarded += 1

@@ -52,10 +52,9 @@ seeds x 40 s at 170 (`rhythm --seeds 15 --seconds 40 --tempos 170`), nobody stee
 steps land on the beat at +0.45 against +0.38 and his at +0.14 against +0.09, his drawn footwork
 repeats at 0.75x the recorded leader's pulse against 0.62x, hers 0.58x against 0.52x.
 
-OnCount's `spin_keep` and `turn_start` (keeps_spin, starts_turn) are two choices measured and not
-shipped: no manifest and no option sets them, and tests/fixtures/features.json pins them in both
-languages. docs/results.md's tried table has what they did ("Her spins on the count", "Her turn
-starts taken").
+Two choices were measured and not shipped: her spins aimed at the count among the samples that keep
+them, and her turn starts taken outside a spin (docs/results.md's tried table, "Her spins on the
+count" and "Her turn starts taken"; their code is in the commits there).
 """
 from __future__ import annotations
 
@@ -160,13 +159,6 @@ def turn_rate(x: np.ndarray, role: str) -> float:
     return abs(turn_now(x, role))
 
 
-def keeps_spin(outputs: np.ndarray, spin: float, keep: float) -> np.ndarray:
-    """Whether each output [B, 323] keeps a spin of `spin` rad/s (turn_now) going: its root update
-    turns the same way at `keep` times that rate or faster [B]."""
-    turn = np.atleast_2d(outputs)[:, _ROOT_UPDATE_OUT + 2] * FPS
-    return turn * np.sign(spin) >= keep * abs(spin)
-
-
 _FUTURE_OUT = feat.block_slices(feat.OUTPUT_LAYOUT)["trajectory_future"]
 
 
@@ -207,42 +199,32 @@ def count_next(x: np.ndarray) -> float:
 
 class OnCount:
     """One dancer's footwork mean, kept across steps, and the footwork its next step aims at.
-    `spin_keep` (None: her spins are left to the network): while the dancer turns faster
-    than its TURNING, the footwork is still aimed at, among the candidates that keep the spin."""
+    `figure_turn` (None: the figure not read): outside a turn, the candidates the figure being led
+    asks for are preferred (prefers)."""
 
     def __init__(self, role: str, samples: int = SAMPLES, strength: float = STRENGTH, hips: float = HIPS,
-                 spin_keep: float | None = None, turn_start: float | None = None, figure_turn: float | None = None):
+                 figure_turn: float | None = None):
         if role not in ANKLE_VELOCITY_IN:
             raise ValueError(f"role must be 'leader' or 'follower', got {role!r}")
         if samples < 2:
             raise ValueError("choosing on the count needs at least 2 samples")
-        if spin_keep is not None and not spin_keep >= 0:
-            raise ValueError(f"spin_keep must be 0 or more (a share of the turn rate), got {spin_keep}")
-        self.role, self.samples, self.strength, self.hips = role, samples, strength, hips
-        if turn_start is not None and not turn_start > 0:
-            raise ValueError(f"turn_start must be more than 0 degrees, got {turn_start}")
         if figure_turn is not None and not figure_turn > 0:
             raise ValueError(f"figure_turn must be more than 0 degrees, got {figure_turn}")
-        self.spin_keep, self.turn_start, self.figure_turn = spin_keep, turn_start, figure_turn
+        self.role, self.samples, self.strength, self.hips = role, samples, strength, hips
+        self.figure_turn = figure_turn
         self.mean: float | None = None
         self.feet: np.ndarray | None = None   # [2] the feet planted in the step last taken (took)
-        self.spin: float | None = None   # rad/s (turn_now) while this step's target is a spin's
-        self.turning = False             # this step the dancer turns faster than its TURNING
+        self.turning = False                  # this step the dancer turns faster than its TURNING
 
     def target(self, x: np.ndarray) -> float | None:
         """The footwork the next step aims at, for input x [I] (this step's: it moves the mean on);
-        None while the dancer turns faster than its TURNING (its footwork is left to the network),
-        unless it keeps spins (spin_keep): then `spin` holds the turn the candidates are to keep."""
+        None while the dancer turns faster than its TURNING (its footwork is left to the network)."""
         x = np.atleast_2d(x)[0]
         now = footwork_now(x, self.role, self.feet)
         self.mean = now if self.mean is None else self.mean + (now - self.mean) / (MEAN_SECONDS * FPS)
-        turn = turn_now(x, self.role)
-        self.spin = None
-        self.turning = abs(turn) > TURNING[self.role]
+        self.turning = turn_rate(x, self.role) > TURNING[self.role]
         if self.turning:
-            if self.spin_keep is None:
-                return None
-            self.spin = turn
+            return None
         return self.mean * (1.0 - self.strength * np.cos(2 * np.pi * count_next(x)))
 
     def restart(self) -> None:
@@ -254,47 +236,32 @@ class OnCount:
         footwork now of the next step's target."""
         self.feet = planted(output)[0]
 
-    def keeps(self, outputs: np.ndarray) -> np.ndarray | None:
-        """While this step's target is a spin's, which candidates [B, 323] keep it (keeps_spin);
-        None otherwise (every candidate may be taken)."""
-        return None if self.spin is None else keeps_spin(outputs, self.spin, self.spin_keep)
-
     def prefers(self, outputs: np.ndarray, x: np.ndarray | None = None) -> np.ndarray | None:
         """Outside a turn, which candidates [B, 323] are preferred: with figure_turn, those that turn
         the way of the dancer's own turn the figure of input x [I] says runs or comes, or, no figure
-        running or coming, those that start no turn (figure_way); with turn_start, those that start
-        one (starts_turn); None otherwise (no candidate preferred)."""
-        if self.turning:
+        running or coming, those that start no turn (figure_way); None otherwise (no candidate
+        preferred)."""
+        if self.turning or self.figure_turn is None or x is None:
             return None
-        if self.figure_turn is not None and x is not None:
-            way = figure_way(np.atleast_2d(x)[0], self.role)
-            if way is None:
-                return ~starts_turn(outputs, self.figure_turn)
-            if way != 0:
-                return planned_turn(outputs) * way >= self.figure_turn
-            return None
-        return None if self.turn_start is None else starts_turn(outputs, self.turn_start)
+        way = figure_way(np.atleast_2d(x)[0], self.role)
+        if way is None:
+            return ~starts_turn(outputs, self.figure_turn)
+        if way != 0:
+            return planned_turn(outputs) * way >= self.figure_turn
+        return None
 
 
 def nearest_count(footwork: np.ndarray, turn_back: np.ndarray, target: float | None, standing: np.ndarray,
-                  margin: float, hips: float = HIPS, keeps: np.ndarray | None = None,
-                  prefers: np.ndarray | None = None) -> int:
+                  margin: float, hips: float = HIPS, prefers: np.ndarray | None = None) -> int:
     """The index of the candidate whose drawn footwork [B] (m/s) is nearest the target, `hips` m/s
     added to the miss of each whose hips turn back [B] (hips_turn_back), among those standing [B]
     (their upright margins, guard.py) at least `margin` inside the range; -1 when none does. With
     no target (the dancer turns) the footwork is left alone: the first standing one whose hips go on.
-    With `keeps` [B] (OnCount.keeps: the dancer spins), only the standing ones that keep the spin
-    are aimed; when none of them does, the footwork is left alone as without a target. With
-    `prefers` [B] (OnCount.prefers: the candidates that start a turn), only the standing ones among
-    them are aimed when there are any; otherwise all the standing ones, as without it."""
+    With `prefers` [B] (OnCount.prefers: the candidates the figure asks for), only the standing ones
+    among them are aimed when there are any; otherwise all the standing ones, as without it."""
     ok = np.asarray(standing) >= margin
     if not ok.any():
         return -1
-    if keeps is not None:
-        if (ok & keeps).any():
-            ok = ok & keeps
-        else:
-            target = None
     if prefers is not None and (ok & prefers).any():
         ok = ok & prefers
     miss = np.zeros(len(ok)) if target is None else np.abs(np.asarray(footwork) - target)

@@ -93,8 +93,6 @@ export class DuetSimulation implements Simulation {
   private standing = new Float64Array(0);
   private footwork = new Float64Array(0);
   private turnBack: boolean[] = [];
-  /** Which of the chooser's samples keep her spin (on_count.ts OnCount.keeps), while she spins. */
-  private keeps: boolean[] = [];
   /** Which of them the figure being led asks for (OnCount.prefers, from the dancer's input), outside a turn. */
   private prefers: boolean[] = [];
   /** The feet one candidate plants, which the chooser counts as still (on_count.ts planted). */
@@ -141,9 +139,9 @@ export class DuetSimulation implements Simulation {
     // The figure being led read by the choice (on_count.ts figureWay): figureTurn's degrees asked of a
     // candidate; absent (older exports) or 0: off.
     const figureTurn = oc?.figureTurn || null;
-    this.leaderOnCount = oc && this.leaderGuard ? new OnCount('leader', oc.samples, oc.strength, oc.hips, null, null, figureTurn) : null;
+    this.leaderOnCount = oc && this.leaderGuard ? new OnCount('leader', oc.samples, oc.strength, oc.hips, figureTurn) : null;
     this.followerOnCount = followers.map(() =>
-      (oc && this.uprightGuard ? new OnCount('follower', oc.samples, oc.strength, oc.hips, null, null, figureTurn) : null));
+      (oc && this.uprightGuard ? new OnCount('follower', oc.samples, oc.strength, oc.hips, figureTurn) : null));
     this.own = options.figures ?? true;
     this.duet = this.startDuet(null);
     this.shownBeat = this.duet.beat;
@@ -347,7 +345,6 @@ export class DuetSimulation implements Simulation {
       this.standing = new Float64Array(k);
       this.footwork = new Float64Array(k);
       this.turnBack = new Array<boolean>(k).fill(false);
-      this.keeps = new Array<boolean>(k).fill(false);
       this.prefers = new Array<boolean>(k).fill(false);
     }
     for (let n = 0; n < k; n++) {
@@ -357,10 +354,9 @@ export class DuetSimulation implements Simulation {
       this.footwork[n] = drawnFootwork(this.steps, planted(output, n * OUTPUT_SIZE, this.still));
       this.turnBack[n] = hipsTurnBack(this.steps, input, onCount.role);
     }
-    const spinning = onCount.keeps(output, k, OUTPUT_SIZE, this.keeps);
-    const starting = onCount.prefers(output, k, OUTPUT_SIZE, this.prefers, input);
+    const preferred = onCount.prefers(output, k, OUTPUT_SIZE, this.prefers, input);
     return nearestCount(this.footwork, this.turnBack, k, target, this.standing, margin, onCount.hips,
-      spinning ? this.keeps : null, starting ? this.prefers : null);
+      preferred ? this.prefers : null);
   }
 
   /** The leader's output of this step, under the same guard (mirror/guard.py's UprightGuard wraps

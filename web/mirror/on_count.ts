@@ -16,9 +16,8 @@
 // FIGURE_TURN): while a turn of the dancer's own runs or begins within FIGURE_AHEAD keys (hers for the
 // follower, his own for the leader), the candidates whose planned path turns FIGURE_TURN degrees or
 // more its way are preferred; while no figure runs or comes, those that turn less either way. Read by
-// the networks alone, the figure moved her turns little (on_count.py has the numbers). OnCount's spinKeep
-// and turnStart (keepsSpin, startsTurn) are two choices measured and not shipped, which the page
-// never sets (on_count.py says why they stay). The feet are read as the contact layer draws them: a
+// the networks alone, the figure moved her turns little (on_count.py has the numbers). The feet are
+// read as the contact layer draws them: a
 // foot the network calls planted, which the layer locks, counts as still, in each candidate and in the
 // dancer's footwork now (the feet of the step last taken, OnCount.took); the networks' feet move while
 // they call them planted, and a choice that read them where the network drew them timed the steps by
@@ -163,12 +162,6 @@ export function turnRate(input: ArrayLike<number>, role: Role): number {
   return Math.abs(turnNow(input, role));
 }
 
-/** Whether output[at..] keeps a spin of `spin` rad/s (turnNow) going: its root update turns the same
- *  way at `keep` times that rate or faster. */
-export function keepsSpin(output: ArrayLike<number>, at: number, spin: number, keep: number): boolean {
-  return output[at + ROOT_UPDATE_OUT + 2] * FPS * Math.sign(spin) >= keep * Math.abs(spin);
-}
-
 const FUTURE_OUT = blockSlices(OUTPUT_LAYOUT).trajectory_future.start;
 
 /** How far output[at..]'s planned path turns over the next second (degrees, signed as the root update
@@ -216,16 +209,12 @@ export function countNext(input: ArrayLike<number>): number {
 }
 
 /** One dancer's footwork mean, kept across steps, and the footwork its next step aims at.
- *  `spinKeep` (null: spins left to the network): while the dancer turns faster than its TURNING, the
- *  footwork is still aimed at, among the candidates that keep the spin. `figureTurn` (null: the
- *  figure not read): outside a turn, the candidates the figure being led asks for are preferred
- *  (prefers). */
+ *  `figureTurn` (null: the figure not read): outside a turn, the candidates the figure being led
+ *  asks for are preferred (prefers). */
 export class OnCount {
   mean: number | null = null;
   /** The feet planted in the step last taken (took); null before the first. */
   feet: boolean[] | null = null;
-  /** rad/s (turnNow) while this step's target is a spin's; null otherwise. */
-  spin: number | null = null;
   /** This step the dancer turns faster than its TURNING. */
   turning = false;
 
@@ -234,29 +223,19 @@ export class OnCount {
     readonly samples: number = SAMPLES,
     readonly strength: number = STRENGTH,
     readonly hips: number = HIPS,
-    readonly spinKeep: number | null = null,
-    readonly turnStart: number | null = null,
     readonly figureTurn: number | null = null,
   ) {
     if (samples < 2) throw new Error('choosing on the count needs at least 2 samples');
-    if (spinKeep !== null && !(spinKeep >= 0)) throw new Error(`spinKeep must be 0 or more (a share of the turn rate), got ${spinKeep}`);
-    if (turnStart !== null && !(turnStart > 0)) throw new Error(`turnStart must be more than 0 degrees, got ${turnStart}`);
     if (figureTurn !== null && !(figureTurn > 0)) throw new Error(`figureTurn must be more than 0 degrees, got ${figureTurn}`);
   }
 
   /** The footwork the next step aims at, for this step's input (it moves the mean on); null while
-   *  the dancer turns faster than its TURNING (its footwork is left to the network), unless it keeps
-   *  spins (spinKeep): then `spin` holds the turn the candidates are to keep. */
+   *  the dancer turns faster than its TURNING (its footwork is left to the network). */
   target(input: ArrayLike<number>): number | null {
     const now = footworkNow(input, this.role, this.feet);
     this.mean = this.mean === null ? now : this.mean + (now - this.mean) / (MEAN_SECONDS * FPS);
-    const turn = turnNow(input, this.role);
-    this.spin = null;
-    this.turning = Math.abs(turn) > TURNING[this.role];
-    if (this.turning) {
-      if (this.spinKeep === null) return null;
-      this.spin = turn;
-    }
+    this.turning = turnRate(input, this.role) > TURNING[this.role];
+    if (this.turning) return null;
     return this.mean * (1 - this.strength * Math.cos(2 * Math.PI * countNext(input)));
   }
 
@@ -272,31 +251,18 @@ export class OnCount {
     this.feet = planted(output, at, this.feet ?? [false, false]);
   }
 
-  /** While this step's target is a spin's, which of `count` candidates laid one after another in
-   *  `output` keep it (keepsSpin), written into `keeps`; false (every candidate may be taken) otherwise. */
-  keeps(output: ArrayLike<number>, count: number, size: number, keeps: boolean[]): boolean {
-    if (this.spin === null || this.spinKeep === null) return false;
-    for (let i = 0; i < count; i++) keeps[i] = keepsSpin(output, i * size, this.spin, this.spinKeep);
-    return true;
-  }
-
   /** Outside a turn, which of `count` candidates laid one after another in `output` are preferred,
    *  written into `prefers`: with figureTurn and the step's `input`, those that turn figureTurn
    *  degrees or more the way of the dancer's own turn the figure says runs or comes, or, no figure
-   *  running or coming, those that start no turn (figureWay; another figure: none preferred); with
-   *  turnStart, those that start one (startsTurn). Returns false (no candidate preferred) otherwise. */
+   *  running or coming, those that start no turn (figureWay; another figure: none preferred).
+   *  Returns false (no candidate preferred) otherwise. */
   prefers(output: ArrayLike<number>, count: number, size: number, prefers: boolean[], input: ArrayLike<number> | null = null): boolean {
-    if (this.turning) return false;
-    if (this.figureTurn !== null && input !== null) {
-      const way = figureWay(input, this.role);
-      if (way === 0) return false;
-      for (let i = 0; i < count; i++) {
-        prefers[i] = way === null ? !startsTurn(output, i * size, this.figureTurn) : plannedTurn(output, i * size) * way >= this.figureTurn;
-      }
-      return true;
+    if (this.turning || this.figureTurn === null || input === null) return false;
+    const way = figureWay(input, this.role);
+    if (way === 0) return false;
+    for (let i = 0; i < count; i++) {
+      prefers[i] = way === null ? !startsTurn(output, i * size, this.figureTurn) : plannedTurn(output, i * size) * way >= this.figureTurn;
     }
-    if (this.turnStart === null) return false;
-    for (let i = 0; i < count; i++) prefers[i] = startsTurn(output, i * size, this.turnStart);
     return true;
   }
 }
@@ -306,28 +272,21 @@ export class OnCount {
  * m/s added to the miss of each whose hips turn back (hipsTurnBack), among those standing (their
  * upright margins, guard.ts) at least `margin` inside the range; -1 when none does. With no target
  * (the dancer turns) the footwork is left alone: the first standing one whose hips go on. With
- * `keeps` (OnCount.keeps: the dancer spins), only the standing ones that keep the spin are aimed;
- * when none of them does, the footwork is left alone as without a target. With `prefers`
- * (OnCount.prefers: the candidates the figure or turnStart asks for), only the standing ones among them are aimed
- * when there are any; otherwise all the standing ones, as without it.
+ * `prefers` (OnCount.prefers: the candidates the figure asks for), only the standing ones among them
+ * are aimed when there are any; otherwise all the standing ones, as without it.
  */
 export function nearestCount(
   footwork: ArrayLike<number>, turnBack: ArrayLike<boolean>, count: number, target: number | null, standing: ArrayLike<number>,
-  margin: number, hips = HIPS, keeps: ArrayLike<boolean> | null = null, prefers: ArrayLike<boolean> | null = null,
+  margin: number, hips = HIPS, prefers: ArrayLike<boolean> | null = null,
 ): number {
-  let only = false;
-  if (keeps !== null) {
-    for (let i = 0; i < count; i++) if (standing[i] >= margin && keeps[i]) only = true;
-    if (!only) target = null;
-  }
   let preferred = false;
   if (prefers !== null) {
-    for (let i = 0; i < count; i++) if (standing[i] >= margin && (!only || keeps![i]) && prefers[i]) preferred = true;
+    for (let i = 0; i < count; i++) if (standing[i] >= margin && prefers[i]) preferred = true;
   }
   let best = -1;
   let bestMiss = Infinity;
   for (let i = 0; i < count; i++) {
-    if (!(standing[i] >= margin) || (only && !keeps![i]) || (preferred && !prefers![i])) continue;
+    if (!(standing[i] >= margin) || (preferred && !prefers![i])) continue;
     const miss = (target === null ? 0 : Math.abs(footwork[i] - target)) + (turnBack[i] ? hips : 0);
     if (miss < bestMiss) {
       best = i;
