@@ -300,58 +300,15 @@ def test_moving_the_partner_closer_shifts_its_whole_window_rigidly(prepared3):
         torch.testing.assert_close(xm[:, sl[block]], x[:, sl[block]], rtol=0, atol=0)
 
 
-def test_lowering_the_partner_drops_only_his_heights_by_one_amount(prepared3):
-    from training.data.prepared import load_split
-    x = torch.from_numpy(load_split(str(prepared3), "train", "follower")["input"][:2000]).float()
-    xl, lowered = T.lower_partner(x, 0.25, 0.15, torch.Generator().manual_seed(0))
-    assert 0.2 < lowered.float().mean() < 0.3
-    torch.testing.assert_close(xl[~lowered], x[~lowered], rtol=0, atol=0)
-    sl = feat.block_slices(feat.FOLLOWER_INPUT_LAYOUT)
-    pose = lambda t: t[:, sl["partner_pose"]].reshape(len(t), feat.N_JOINTS, 12)[lowered]
-    keys = lambda t: t[:, sl["partner_key_joints_past"]].reshape(len(t), -1, 3)[lowered]
-    drop = pose(x)[:, 0, 1] - pose(xl)[:, 0, 1]
-    assert drop.min() >= 0 and drop.max() <= 0.15 + 1e-6 and drop.std() > 0.02   # drawn per sample
-    # The same drop for every joint and key of his body; nothing else of his or hers moves.
-    torch.testing.assert_close(pose(x)[..., 1] - pose(xl)[..., 1], drop[:, None].expand(-1, feat.N_JOINTS),
-                               rtol=0, atol=1e-5)
-    torch.testing.assert_close(keys(x)[..., 1] - keys(xl)[..., 1], drop[:, None].expand(-1, keys(x).shape[1]),
-                               rtol=0, atol=1e-5)
-    torch.testing.assert_close(pose(xl)[..., [0, 2] + list(range(3, 12))], pose(x)[..., [0, 2] + list(range(3, 12))],
-                               rtol=0, atol=0)
-    for block in ("partner_trajectory_past", "partner_trajectory_future", "self_trajectory_past",
-                  "self_key_joints_past", "self_pose"):
-        torch.testing.assert_close(xl[:, sl[block]], x[:, sl[block]], rtol=0, atol=0)
-
-
-def test_intention_early_stopping_keeps_the_best_validation_epoch(prepared3, tmp_path):
-    from training.learning.models import IntentionPredictor
-    from training.data.prepared import load_split, load_stats, normalize
-    cfg = replace(T.smoke(T.MODELS["follower"]), intention_epochs=4, epochs=0, intention_best=True,
-                  intention_dropout=0.0, lr=3e-2)
-    T.train_model("f", cfg, str(prepared3), str(tmp_path), quiet=True)
-    h = json.loads((tmp_path / "f" / "history.json").read_text())
-    assert h["intention_kept_epoch"] == int(np.argmin(h["intention_val"])) + 1
-    ck = torch.load(tmp_path / "f" / "checkpoint.pt", weights_only=False)
-    predictor = IntentionPredictor(cfg.model)
-    predictor.load_state_dict(ck["predictor"])
-    predictor.eval()
-    val, stats = load_split(str(prepared3), "validation", "follower"), load_stats(str(prepared3), "follower")
-    with torch.no_grad():
-        mse = torch.nn.functional.mse_loss(predictor(normalize(val["input"], stats, "input")),
-                                           normalize(val["intention"], stats, "intention")).item()
-    assert mse == pytest.approx(min(h["intention_val"]), rel=1e-5)
-
-
 def test_command_line_overrides_change_only_what_was_given():
     import argparse
-    unset = argparse.Namespace(**{**{k: None for k in T.OVERRIDES}, "intention_best": False})
+    unset = argparse.Namespace(**{k: None for k in T.OVERRIDES})
     base = T.MODELS["follower"]
     assert T.apply_overrides(base, unset) == base
-    given = argparse.Namespace(**{**vars(unset), "seed": 3, "channels": 8, "intention_hidden": 64,
-                                  "intention_best": True})
+    given = argparse.Namespace(**{**vars(unset), "seed": 3, "channels": 8, "intention_hidden": 64})
     cfg = T.apply_overrides(base, given)
-    assert (cfg.seed, cfg.model.channels, cfg.model.intention_hidden, cfg.intention_best) == (3, 8, 64, True)
-    assert replace(cfg, seed=base.seed, model=base.model, intention_best=False) == base
+    assert (cfg.seed, cfg.model.channels, cfg.model.intention_hidden) == (3, 8, 64)
+    assert replace(cfg, seed=base.seed, model=base.model) == base
 
 
 def test_state_dropout_hides_the_state_from_the_decoder_only():

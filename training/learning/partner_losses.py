@@ -29,8 +29,7 @@ from ..mirror.skeleton import FEET, HANDS, PARENTS, SPINE
 OUT = feat.block_slices(feat.OUTPUT_LAYOUT)
 REACH = 0.5              # m: joint pairs closer than this in the recording keep their distance
 SPINE_SAMPLES = 5        # points per spine segment for the penetration distance
-# Joints of each dancer whose mutual distances the interaction term keeps: head, chest, hands
-# (a recipe can keep the hands only: TrainConfig.interaction_hands_only).
+# Joints of each dancer whose mutual distances the interaction term keeps: head, chest, hands.
 INTERACTION_JOINTS = [4, 2, *HANDS]
 HEADING_CHANGE = OUT["root_update"].start + 2   # the output's heading change (radians per frame)
 

@@ -40,19 +40,13 @@ from ..data.prepared import (TrainError, load_mirror_flags, load_offsets, load_s
 from .runs import load_checkpoint, save_checkpoint
 from .partner_losses import (INTERACTION_JOINTS, block_positions, decoded_positions, input_slices,
                              partner_terms, penetration_loss)
-from ..mirror.skeleton import FPS, HANDS
+from ..mirror.skeleton import FPS
 
 
 @dataclass
 class TrainConfig:
     model: ModelConfig = field(default_factory=ModelConfig)
     intention_epochs: int = 20
-    # Regularizing the predictor alone (docs/results.md, "Learning more from the same frames"):
-    # its dropout and weight decay (None: the model's dropout, the shared weight decay), and
-    # whether to keep the epoch with the lowest validation MSE instead of the last one.
-    intention_dropout: float | None = None
-    intention_weight_decay: float | None = None
-    intention_best: bool = False
     epochs: int = 40
     batch_size: int = 256
     lr: float = 1e-3
@@ -76,19 +70,11 @@ class TrainConfig:
     # second; 0: none): in a pivot the planted foot turns under the dancer, and a decoder that
     # cannot yet place it exactly learns that not turning is the cheapest way to keep it still.
     contact_spare_turning: float = 0.0
-    interaction_hands_only: bool = False  # the interaction term keeps hand distances only
     # Follower: this share of samples has the partner's whole window moved closer (a leader
     # steered into the follower, which the recording never shows), penalized by penetration
     # with its own weight; the interaction term skips them (their recorded distances are moot).
     proximity_share: float = 0.0
     lambda_proximity: float = 0.0
-    # Follower: this share of samples has the partner's whole body lowered by up to
-    # `partner_lowered_depth` metres (lower_partner), the target still her recorded next frame.
-    # Our leader lunges deeper and more often than the recorded one, and she followed him down and
-    # fell (docs/results.md, "Room for his head, her hips guarded"); lowered, he teaches her that his height
-    # alone does not take her to the floor. The body terms skip these samples, as the moved ones.
-    partner_lowered_share: float = 0.0
-    partner_lowered_depth: float = 0.0
     # Std of Gaussian noise (in normalized units) on the dancer's own past and pose in the input,
     # the target staying the recorded next frame: at run time those blocks are the model's own
     # earlier outputs, and a model that only ever saw recorded ones has never learnt to come back
@@ -100,11 +86,6 @@ class TrainConfig:
     # the spot: Diversity 13 against the recording's 24). Hidden now and then, the pose has to be
     # carried by the code, which the decoder then keeps reading.
     state_dropout: float = 0.0
-    # Share of samples whose past paths and past key joints (both dancers': what says when the last
-    # steps fell) are shown at their mean. Teacher-forced, the last second of motion tells when the
-    # next step falls so well that the count adds little (a half-beat shift of it changes the step
-    # by a tenth of the ankles' speed: docs/music.md); hidden, only the pose and the music do.
-    past_dropout: float = 0.0
     # Train on the tempo copies too (prepare's train_tempo.npz): more varied samples, same steps.
     tempo_copies: bool = False
     # Weight of the samples where the follower's turn starts (turn_onsets) in the reconstruction
@@ -328,22 +309,6 @@ def move_partner_closer(x: torch.Tensor, share: float, gen: torch.Generator) -> 
     return x, moved
 
 
-def lower_partner(x: torch.Tensor, share: float, depth: float, gen: torch.Generator) -> tuple[torch.Tensor, torch.Tensor]:
-    """Follower inputs (raw) -> a copy where `share` of the samples have every partner height (key
-    joints, pose) lowered by one amount drawn from [0, depth] m; his path on the floor, directions
-    and velocities stay. Returns (x, lowered mask)."""
-    sl = feat.block_slices(feat.FOLLOWER_INPUT_LAYOUT)
-    b = len(x)
-    lowered = torch.rand(b, generator=gen) < share
-    drop = torch.where(lowered, depth * torch.rand(b, generator=gen), torch.zeros(b))
-    x = x.clone()
-    for block, width in (("partner_key_joints_past", 3), ("partner_pose", 12)):
-        part = x[:, sl[block]].reshape(b, -1, width)
-        part[..., 1] -= drop[:, None]
-        x[:, sl[block]] = part.reshape(b, -1)
-    return x, lowered
-
-
 ONSET_FUTURE_DEGREES = 180.0   # the dancer's own heading turns this much over the next second ...
 ONSET_PAST_DEGREES = 90.0      # ... after turning less than this over the last one
 
@@ -443,12 +408,10 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
     weighted = cfg.turn_weight != 1.0 or cfg.own_turn_weight != 1.0
     xv, yv, jv = (normalize(val[k], stats, k) for k in ("input", "output", "intention"))
     mcfg = cfg.model
-    predictor = IntentionPredictor(mcfg if cfg.intention_dropout is None
-                                   else replace(mcfg, dropout=cfg.intention_dropout)).to(device)
+    predictor = IntentionPredictor(mcfg).to(device)
     matching = CodebookMatching(mcfg).to(device)
     disc = Discriminator(mcfg).to(device)
-    opt_p = torch.optim.AdamW(predictor.parameters(), lr=cfg.lr, weight_decay=cfg.weight_decay
-                              if cfg.intention_weight_decay is None else cfg.intention_weight_decay)
+    opt_p = torch.optim.AdamW(predictor.parameters(), lr=cfg.lr, weight_decay=cfg.weight_decay)
     gen_params = list(matching.parameters()) + (list(predictor.parameters()) if cfg.end_to_end else [])
     opt_g = torch.optim.AdamW(gen_params, lr=cfg.lr, weight_decay=cfg.weight_decay)
     opt_d = torch.optim.AdamW(disc.parameters(), lr=cfg.lr, weight_decay=cfg.weight_decay)
@@ -511,9 +474,6 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
     slices = feat.block_slices(feat.LEADER_INPUT_LAYOUT if role == "leader" else feat.FOLLOWER_INPUT_LAYOUT)
     own = torch.cat([torch.arange(slices[k].start, slices[k].stop)
                      for k in ("self_trajectory_past", "self_key_joints_past", "self_pose")])
-    pasts = torch.cat([torch.arange(slices[k].start, slices[k].stop)
-                       for k in ("partner_trajectory_past", "partner_key_joints_past",
-                                 "self_trajectory_past", "self_key_joints_past")])
 
     def inputs(idx, proximity: bool = False):
         """Normalized inputs of a batch as the networks read them (with state noise), which samples
@@ -528,18 +488,11 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
         if proximity and role == "follower" and cfg.proximity_share > 0:
             x, moved = move_partner_closer(x, cfg.proximity_share, gen)
             altered = moved
-        if proximity and role == "follower" and cfg.partner_lowered_share > 0:
-            x, lowered = lower_partner(x, cfg.partner_lowered_share, cfg.partner_lowered_depth, gen)
-            altered = lowered if altered is None else altered | lowered
         clean = ((x - stats["input_mean"]) / stats["input_std"]).to(device)
-        if cfg.state_noise == 0 and cfg.past_dropout == 0:
+        if cfg.state_noise == 0:
             return clean, moved, altered, clean
         noisy = clean.clone()
-        if cfg.state_noise:
-            noisy[:, own] += cfg.state_noise * torch.randn(len(noisy), len(own), generator=gen).to(device)
-        if cfg.past_dropout:
-            hidden = (torch.rand(len(noisy), generator=gen) < cfg.past_dropout).to(device)
-            noisy[hidden.nonzero()[:, 0][:, None], pasts[None].to(device)] = 0.0
+        noisy[:, own] += cfg.state_noise * torch.randn(len(noisy), len(own), generator=gen).to(device)
         return noisy, moved, altered, clean
 
     def save(stage_, epoch_):
@@ -553,7 +506,6 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
     # Stage 1: the intention predictor alone (MSE), then frozen. End-to-end variants skip it.
     if mcfg.intention and not cfg.end_to_end and stage == "intention":
         total = cfg.intention_epochs * steps_per_epoch
-        best = (math.inf, None)   # validation MSE and weights of the best epoch (intention_best)
         while epoch < cfg.intention_epochs:
             t0 = time.time()
             predictor.train()
@@ -578,15 +530,11 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
                 v = F.mse_loss(predictor(xv.to(device)), jv.to(device)).item()
             history["intention_train"].append(float(np.mean(losses)))
             history["intention_val"].append(v)
-            if v < best[0]:
-                best = (v, {k: t.clone() for k, t in predictor.state_dict().items()})
             epoch += 1
             seconds += time.time() - t0
             if rank == 0 and not quiet:
                 print(f"{name} intention {epoch}/{cfg.intention_epochs}  train {np.mean(losses):.4f}  val {v:.4f}")
             save("intention", epoch)
-        if cfg.intention_best and best[1] is not None:
-            predictor.load_state_dict(best[1])
         stage, epoch = "matching", 0
         save(stage, epoch)
     elif stage == "intention":
@@ -678,7 +626,7 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
                 off = offsets[mirrored[idx]]
                 terms = partner_terms(raw(recon[keep], "output"), raw(yb[keep], "output"), raw(x_clean[keep], "input"),
                                       off[keep], role, cfg.recorded_contacts,
-                                      HANDS if cfg.interaction_hands_only else INTERACTION_JOINTS,
+                                      INTERACTION_JOINTS,
                                       math.radians(cfg.contact_spare_turning) / FPS)
                 for k, w in partner_weights.items():
                     if w:
@@ -727,9 +675,7 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
     save(stage, epoch)
     if rank == 0:
         plot_history(history, run / "losses.png", name)
-        kept = {"intention_kept_epoch": int(np.argmin(history["intention_val"])) + 1} \
-            if cfg.intention_best and history["intention_val"] else {}
-        (run / "history.json").write_text(json.dumps({"seconds": seconds, **kept, **history}, indent=1))
+        (run / "history.json").write_text(json.dumps({"seconds": seconds, **history}, indent=1))
     return {"name": name, "seconds": seconds, "val_mse": history["val_mse"][-1] if history["val_mse"] else None}
 
 
@@ -785,11 +731,8 @@ OVERRIDES = {
     "seed": lambda c, v: replace(c, seed=v),
     "channels": lambda c, v: replace(c, model=replace(c.model, channels=v)),
     "lambda_generator": lambda c, v: replace(c, lambda_generator=v),
-    "intention_dropout": lambda c, v: replace(c, intention_dropout=v),
-    "intention_weight_decay": lambda c, v: replace(c, intention_weight_decay=v),
     "hidden": lambda c, v: replace(c, model=replace(c.model, hidden=v)),
     "intention_hidden": lambda c, v: replace(c, model=replace(c.model, intention_hidden=v)),
-    "intention_best": lambda c, v: replace(c, intention_best=True),
     "teacher": lambda c, v: replace(c, teacher=v),
 }
 
@@ -816,12 +759,8 @@ def main(argv=None) -> int:
     ap.add_argument("--lambda-generator", type=float, help="override λG (λC stays as configured)")
     ap.add_argument("--seed", type=int, help="override the seed (seed-to-seed spread)")
     ap.add_argument("--channels", type=int, help="override the number of code channels C")
-    ap.add_argument("--intention-dropout", type=float, help="override the intention predictor's dropout")
-    ap.add_argument("--intention-weight-decay", type=float, help="override the predictor's weight decay")
     ap.add_argument("--hidden", type=int, help="override the codebook-matching width (encoders and decoder)")
     ap.add_argument("--intention-hidden", type=int, help="override the predictor's width")
-    ap.add_argument("--intention-best", action="store_true",
-                    help="keep the predictor's epoch with the lowest validation MSE (early stopping)")
     ap.add_argument("--teacher", metavar="FILE", help="distill from FILE, a wider network's step model as "
                     "export wrote it (training/learning/distill.py)")
     ap.add_argument("--smoke", action="store_true", help="tiny sizes and 2 epochs (CI)")
