@@ -439,14 +439,13 @@ def test_a_branch_leaves_the_choosers_on_the_count_as_it_found_them(exported):
     assert np.array_equal(unasked(), alone)
 
 
-
 SHIPPED = Path(__file__).resolve().parents[2] / "public" / "models"
 
 
 @pytest.mark.skipif(not (SHIPPED / "manifest.json").exists(), reason="no shipped models")
 def test_each_seed_dances_as_if_alone(tmp_path):
     """A seed danced after another (`--first-seed 0 --seeds 2`) is the seed danced on its own, in
-    lead and in jitter: each duet starts its choosers on the count afresh (lead.restart_choosers),
+    lead and in jitter: each duet starts its choosers on the count afresh (options.restart_count),
     not from the footwork the duet before left them. The shipped models, whose samples stand, so
     that the choice on the count is what takes each step."""
     import argparse

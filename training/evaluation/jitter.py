@@ -63,8 +63,7 @@ def rollouts(args, steer: bool) -> list[dict]:
     for seed in tqdm(range(args.first_seed, args.first_seed + args.seeds), desc="steered" if steer else "nobody steering",
                      disable=args.quiet):
         rec = {}
-        for policy in (leader, follower):   # each seed dances as if alone (on_count.OnCount.restart)
-            restart_count(policy)
+        restart_count(leader, follower)   # each seed dances as if alone (on_count.OnCount.restart)
         soak_one(manifest, leader, follower, seed, int(args.seconds * FPS), temperature, record=rec,
                  tempo=args.tempo, steer=steer)
         out.append({"seed": seed, **{f"{role}_{kind}": hip_jitter(rec[role if kind == "raw" else f"{role}_shown"])
@@ -89,7 +88,6 @@ def plot(path: str, args, seed: int, steer: bool, seconds: float = 4.0) -> None:
     import matplotlib.pyplot as plt
     from .rhythm import load_dancers
     from .duet import soak_one
-    from .options import restart_count
     manifest, leader, follower, temperature = load_dancers(args)
     rec = {}
     soak_one(manifest, leader, follower, seed, int(args.seconds * FPS), temperature, record=rec,

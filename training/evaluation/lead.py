@@ -81,14 +81,6 @@ def branch(duet, leader, follower, temperature: float, rng: np.random.Generator,
     return out, body, hand, winding(hands), float(np.degrees(facing[-1] - facing[0]))
 
 
-def restart_choosers(*policies) -> None:
-    """Each duet dances as if alone: the guards' counts zeroed and the choosers on the count
-    forgetting the footwork and feet of the duet danced before (options.restart_count), so that a
-    seed danced in a run of many (`--first-seed`) is the seed danced on its own."""
-    for policy in policies:
-        O.restart_count(policy)
-
-
 def count_state(*policies) -> list[tuple[object, dict]]:
     """What each policy's chooser on the count has seen (on_count.OnCount's fields), to put back
     with put_count_state."""
@@ -128,7 +120,7 @@ def request_frames(frames: int) -> set[int]:
 def one_duet(manifest, leader, follower, temperature: float, seed: int, seconds: float,
              detector: C.Detector | None = None, tempo: float | None = None, figures: bool = False) -> dict:
     rng = np.random.default_rng(seed)
-    restart_choosers(leader, follower)
+    O.restart_count(leader, follower)   # a seed of a run of many dances as it does alone
     duet = start_duet(manifest, tempo=tempo, figures=figures, seed=seed)
     frames = int(seconds * FPS)
     window = int(REQUEST_SECONDS * FPS)
@@ -182,7 +174,7 @@ def unasked_duet(manifest, leader, follower, temperature: float, seed: int, seco
     the duet itself is asked for a turn then (one_duet asks that request's copy at frame
     seconds * FPS, with its own random stream: the film shows the request, not the same draws)."""
     rng = np.random.default_rng(seed)
-    restart_choosers(leader, follower)
+    O.restart_count(leader, follower)
     duet = start_duet(manifest, tempo=tempo, figures=figures, seed=seed)
     frames = int(seconds * FPS)
     ask_at = request_frames(frames)

@@ -158,10 +158,11 @@ def on_count_for(role: str, args) -> OnCount | None:
                    getattr(args, "on_count_hips", ON_COUNT_HIPS), figure_turn=getattr(args, "on_count_figure", 0.0) or None)
 
 
-def restart_count(policy) -> None:
-    """Zero the guard's count before a duet (a plain policy has none), and forget the footwork its
-    chooser on the count has seen."""
-    if hasattr(policy, "guarded"):
-        policy.guarded = 0
-    if getattr(policy, "on_count", None) is not None:
-        policy.on_count.restart()
+def restart_count(*policies) -> None:
+    """Before a duet, so that it dances as if alone: zero each policy's guard count (a plain policy
+    has none), and make its chooser on the count forget the footwork it has seen."""
+    for policy in policies:
+        if hasattr(policy, "guarded"):
+            policy.guarded = 0
+        if getattr(policy, "on_count", None) is not None:
+            policy.on_count.restart()

@@ -198,8 +198,7 @@ def duet_rhythm(manifest, leader, follower, seed: int, frames: int, temperature:
     from .duet import soak_one
     from .options import restart_count
     record: dict = {}
-    for policy in (leader, follower):   # each duet starts from its own footwork (on_count.OnCount)
-        restart_count(policy)
+    restart_count(leader, follower)   # each duet starts from its own footwork (on_count.OnCount)
     soak_one(manifest, leader, follower, seed, frames, temperature, record=record, tempo=tempo,
              steer=steered)
     return bodies_rhythm(record, tempo, seed)

@@ -98,8 +98,7 @@ def _one(job: tuple[int, int, float, float]) -> dict:
     seed, frames, temperature, tempo = job
     w = _WORKER
     rec: dict = {}
-    O.restart_count(w["follower"])
-    O.restart_count(w["leader"])
+    O.restart_count(w["follower"], w["leader"])
     soak = soak_one(w["manifest"], w["leader"], w["follower"], seed, frames, temperature, rec, tempo=tempo)
     out = {"seed": seed, "resets": soak["resets"], "guarded": getattr(w["follower"], "guarded", 0),
            "leader_guarded": getattr(w["leader"], "guarded", 0),

@@ -149,8 +149,7 @@ def main(argv=None) -> int:
         # Each rollout its own duet: both choosers forget the footwork of the rollout before, so
         # rollout SEED dances as `--seed SEED --rollouts 1` does (scripts/fall_continuations.py
         # dances a soak's rollout again from its seed alone).
-        O.restart_count(follower)
-        O.restart_count(leader)
+        O.restart_count(follower, leader)
         r = soak_one(manifest, leader, follower, args.seed + i, frames, temperature, rec, tempo=args.tempo)
         r["guarded"] = getattr(follower, "guarded", 0)
         r["interaction"] = M.interaction(rec["leader"], rec["follower"], rec["leader_contacts"], rec["follower_contacts"])

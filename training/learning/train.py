@@ -477,23 +477,21 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
 
     def inputs(idx, proximity: bool = False):
         """Normalized inputs of a batch as the networks read them (with state noise), which samples
-        had their partner moved closer, which had him moved at all (closer or lowered), and the
-        inputs without noise (what the body terms compare the decoded pose with: the pose the
-        dancer really was in)."""
-        x, moved, altered = xr[idx], None, None
+        had their partner moved closer, and the inputs without noise (what the body terms compare
+        the decoded pose with: the pose the dancer really was in)."""
+        x, moved = xr[idx], None
         if role == "leader" and cfg.control_noise + cfg.control_rotation > 0:
             x = augment_control(x, cfg, gen)
         if role == "leader" and cfg.hands_plan_dropout > 0:
             x = hide_block(x, "hands_plan", cfg.hands_plan_dropout, gen)
         if proximity and role == "follower" and cfg.proximity_share > 0:
             x, moved = move_partner_closer(x, cfg.proximity_share, gen)
-            altered = moved
         clean = ((x - stats["input_mean"]) / stats["input_std"]).to(device)
         if cfg.state_noise == 0:
-            return clean, moved, altered, clean
+            return clean, moved, clean
         noisy = clean.clone()
         noisy[:, own] += cfg.state_noise * torch.randn(len(noisy), len(own), generator=gen).to(device)
-        return noisy, moved, altered, clean
+        return noisy, moved, clean
 
     def save(stage_, epoch_):
         if rank == 0:
@@ -587,7 +585,7 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
             for o in (opt_g, opt_d):
                 for g in o.param_groups:
                     g["lr"] = lr
-            (x, moved, altered, x_clean), yb = inputs(idx, proximity=True), y[idx].to(device)
+            (x, moved, x_clean), yb = inputs(idx, proximity=True), y[idx].to(device)
             intention, extra = None, 0.0
             if mcfg.intention:
                 if cfg.end_to_end:
@@ -622,7 +620,7 @@ def train_model(name: str, cfg: TrainConfig, data: str, out: str, device: str = 
                 loss = loss + l_kl + l_dec
                 sums["distill_codes"].append(l_kl.item()); sums["distill_decoder"].append(l_dec.item())
             if any(partner_weights.values()):
-                keep = slice(None) if altered is None else ~altered.to(device)   # recorded relations only
+                keep = slice(None) if moved is None else ~moved.to(device)   # recorded relations only
                 off = offsets[mirrored[idx]]
                 terms = partner_terms(raw(recon[keep], "output"), raw(yb[keep], "output"), raw(x_clean[keep], "input"),
                                       off[keep], role, cfg.recorded_contacts,
